@@ -1,0 +1,25 @@
+"""tvoronoi: exact, fast 2D Voronoi diagrams, with a terminal UI and a batch mode."""
+
+__version__ = "0.1.0"
+
+__all__ = ["voronoi", "Diagram", "TvoronoiError", "generate"]
+
+from tvoronoi.errors import TvoronoiError
+
+
+def __getattr__(name):
+    # The engines are loaded on first use, so `tvoronoi --help` and the
+    # readers start without importing the compiled kernels.
+    if name == "voronoi":
+        from tvoronoi.api import voronoi
+
+        return voronoi
+    if name == "Diagram":
+        from tvoronoi.diagram import Diagram
+
+        return Diagram
+    if name == "generate":
+        from tvoronoi.generators import generate
+
+        return generate
+    raise AttributeError(f"module 'tvoronoi' has no attribute {name!r}")

@@ -1,0 +1,137 @@
+"""From checked points to a Diagram: scale exactly, run an engine, clip the cells, map back to input rows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tvoronoi.diagram import Diagram
+from tvoronoi.errors import EngineError
+from tvoronoi.kernels import clip, dcel, delaunay
+
+
+def power_of_two_scale(pts: np.ndarray, box) -> int:
+    """Exponent e such that coordinates * 2**-e are at most 1 in magnitude.
+
+    Scaling by a power of two is exact, and keeps the predicates' products
+    (degree four in incircle) far from overflow and underflow at any scale.
+    """
+    top = max(float(np.abs(pts).max()) if len(pts) else 0.0, *(abs(v) for v in box))
+    return math.frexp(top)[1] if top > 0 else 0
+
+
+def first_copies(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """For each point, the first earlier index with identical coordinates, or -1."""
+    n = len(xs)
+    dup = np.full(n, -1, np.int32)
+    if n < 2:
+        return dup
+    order = np.lexsort((ys, xs))            # stable: earlier indices first within a tie
+    same = (xs[order][1:] == xs[order][:-1]) & (ys[order][1:] == ys[order][:-1])
+    if not same.any():
+        return dup
+    # the start of each run of equal points, carried along the run
+    start = np.maximum.accumulate(np.where(np.concatenate(([True], ~same)), np.arange(n), 0))
+    first = order[start]
+    dup[order] = np.where(first != order, first, -1)
+    return dup
+
+
+def collinear_dcel(xs: np.ndarray, ys: np.ndarray) -> dict:
+    """Voronoi DCEL of 0, 1, 2 or more collinear sites (parallel strips), repeats included."""
+    dup = first_copies(xs, ys)
+    distinct = np.flatnonzero(dup < 0)
+    line = distinct[np.lexsort((ys[distinct], xs[distinct]))]   # sorted by x then y: line order
+    out = dcel.voronoi_collinear(np.ascontiguousarray(xs[line]), np.ascontiguousarray(ys[line]))
+    out["he_face"] = line[out["he_face"]].astype(np.int32)
+    face_edge = np.full(len(xs), -1, np.int32)
+    face_edge[line] = out["face_edge"]
+    out["face_edge"] = face_edge
+    out["dup"] = dup
+    return out
+
+
+def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: int):
+    """Run the randomized incremental engine on sites in input order.
+
+    Returns (perm, out): the engine numbers site k = input site perm[k]
+    (insertion order), and out holds its Voronoi DCEL and repeats in that
+    numbering.
+    """
+    n = len(xs)
+    rng = np.random.default_rng(seed)
+    if insertion == "brio":
+        rank = rng.permutation(n).astype(np.int64)
+        perm = np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+    else:
+        perm = rng.permutation(n).astype(np.int32)
+    xs = np.ascontiguousarray(xs[perm])
+    ys = np.ascontiguousarray(ys[perm])
+    status, tv, opp, dup = delaunay.triangulate(xs, ys, conflict_lists=(insertion == "random"))
+    if status != delaunay.STATUS_OK:
+        return perm, xs, ys, collinear_dcel(xs, ys)
+    out = dcel.voronoi_from_delaunay(xs, ys, tv, opp)
+    out["dup"] = dup
+    return perm, xs, ys, out
+
+
+def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int) -> Diagram:
+    """Build the Diagram of checked points (n, 2) in the checked box."""
+    n = len(pts)
+    e = power_of_two_scale(pts, box)
+    xs = np.ldexp(pts[:, 0], -e)
+    ys = np.ldexp(pts[:, 1], -e)
+    sbox = tuple(math.ldexp(v, -e) for v in box)
+
+    if engine == "incremental":
+        perm, exs, eys, out = incremental_dcel(xs, ys, insertion=insertion, seed=seed)
+    else:
+        raise EngineError("engine 'fortune' is not available yet: use engine='incremental'")
+
+    dup = out["dup"]
+    active = (dup < 0).astype(np.int8)
+    points, offsets, ring = clip.clip_cells(
+        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"],
+        out["he_face"], out["face_edge"], active, sbox,
+    )
+
+    # the cell of a repeated point belongs to the first input row at that place
+    root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
+    owner = perm.copy()                              # engine site -> input row owning its cell
+    if (dup >= 0).any():
+        np.minimum.at(owner, root, perm)
+    site_of = np.empty(n, np.int32)
+    site_of[perm] = owner[root]
+
+    # cells to input rows (CSR gather)
+    lengths = np.diff(offsets)
+    cell_of_row = np.full(n, -1, np.int64)           # engine site whose cell row r shows
+    firsts = np.flatnonzero(active)
+    cell_of_row[owner[firsts]] = firsts
+    row_len = np.where(cell_of_row >= 0, lengths[np.maximum(cell_of_row, 0)], 0)
+    cell_offsets = np.zeros(n + 1, np.int64)
+    np.cumsum(row_len, out=cell_offsets[1:])
+    src_start = np.where(cell_of_row >= 0, offsets[:-1][np.maximum(cell_of_row, 0)], 0)
+    gather = np.repeat(src_start - cell_offsets[:-1], row_len) + np.arange(cell_offsets[-1])
+    cell_vertices = ring[gather]
+
+    face_edge = np.full(n, -1, np.int32)
+    face_edge[owner[firsts]] = out["face_edge"][firsts]
+    return Diagram(
+        sites=pts,
+        site_of=site_of,
+        vertices=np.ldexp(out["vertices"], e),
+        he_origin=out["he_origin"],
+        he_twin=out["he_twin"],
+        he_next=out["he_next"],
+        he_prev=out["he_prev"],
+        he_face=owner[out["he_face"]],
+        face_edge=face_edge,
+        triangles=owner[out["triangles"]].astype(np.int32).reshape(-1, 3),
+        bbox=tuple(float(v) for v in box),
+        cell_points=np.ldexp(points, e),
+        cell_offsets=cell_offsets,
+        cell_vertices=cell_vertices,
+        engine=engine,
+    )

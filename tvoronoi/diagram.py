@@ -1,0 +1,128 @@
+"""The Diagram: sites, Voronoi vertices, the half-edge structure, clipped cells and the Delaunay dual."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class Diagram:
+    """A Voronoi diagram of n input points, bounded by a box.
+
+    Cell i is always input point i. Points that repeat an earlier point share
+    its cell: their own cell is empty and ``site_of`` names the first copy.
+
+    Attributes
+    ----------
+    sites : (n, 2) float64
+        The input points, in input order.
+    site_of : (n,) int32
+        The first input row with the same coordinates (itself if unique).
+    vertices : (m, 2) float64
+        Voronoi vertices (unclipped), one per distinct circumcircle.
+    he_origin, he_twin, he_next, he_prev, he_face : (h,) int32
+        The half-edge structure (DCEL). ``he_origin`` is -1 for a half-edge
+        coming from infinity; ``he_next`` cycles counter-clockwise around
+        the cell ``he_face`` (an input row), through infinity for an
+        unbounded cell. Half-edge h lies on the bisector of ``he_face[h]``
+        and ``he_face[he_twin[h]]``.
+    face_edge : (n,) int32
+        One half-edge of each cell, -1 where the cell has none (a lone site,
+        a repeated point).
+    triangles : (k, 3) int32
+        Delaunay triangles (input rows, counter-clockwise).
+    bbox : (xmin, ymin, xmax, ymax)
+        The box the cells are clipped to.
+    cell_points : (p, 2) float64
+        Points of the clipped cells (vertices inside the box, points on the
+        box, corners); neighbouring cells share identical points.
+    cell_offsets : (n + 1,) int64, cell_vertices : (K,) int32
+        Clipped cells in CSR form: cell i is
+        ``cell_points[cell_vertices[cell_offsets[i]:cell_offsets[i + 1]]]``.
+    engine : str
+        The engine that built the diagram.
+    """
+
+    sites: np.ndarray
+    site_of: np.ndarray
+    vertices: np.ndarray
+    he_origin: np.ndarray
+    he_twin: np.ndarray
+    he_next: np.ndarray
+    he_prev: np.ndarray
+    he_face: np.ndarray
+    face_edge: np.ndarray
+    triangles: np.ndarray
+    bbox: tuple
+    cell_points: np.ndarray
+    cell_offsets: np.ndarray
+    cell_vertices: np.ndarray
+    engine: str = "incremental"
+    _extra: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def n_sites(self) -> int:
+        """Number of input points (repeated points included)."""
+        return len(self.sites)
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_edges(self) -> int:
+        """Number of Voronoi edges (each is two half-edges)."""
+        return len(self.he_origin) // 2
+
+    def cell_polygon(self, i: int) -> np.ndarray:
+        """Cell i clipped to the box, as a (k, 2) ring.
+
+        Counter-clockwise, first vertex not repeated; empty (shape (0, 2)) for
+        a repeated point and for a cell that misses the box.
+
+        >>> import tvoronoi
+        >>> d = tvoronoi.voronoi([[0, 0], [2, 0]], bbox=(-1, -1, 3, 1))
+        >>> d.cell_polygon(0).tolist()
+        [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+        """
+        i = int(i)
+        if not -self.n_sites <= i < self.n_sites:
+            raise IndexError(f"site {i} out of range for a diagram of {self.n_sites} sites")
+        i %= self.n_sites
+        lo, hi = self.cell_offsets[i], self.cell_offsets[i + 1]
+        return self.cell_points[self.cell_vertices[lo:hi]]
+
+    def cells(self):
+        """Iterate over (i, ring) for every cell, rings as in cell_polygon."""
+        for i in range(self.n_sites):
+            yield i, self.cell_polygon(i)
+
+    def delaunay_triangles(self) -> np.ndarray:
+        """The Delaunay triangles as a (k, 3) int32 array of input rows, counter-clockwise.
+
+        Where four or more sites are cocircular, one of the valid
+        triangulations is given.
+        """
+        return self.triangles.copy()
+
+    def duplicates(self) -> dict[int, list[int]]:
+        """Map each repeated site's first row to the later rows at the same place."""
+        rows = np.flatnonzero(self.site_of != np.arange(self.n_sites))
+        groups: dict[int, list[int]] = {}
+        for r in rows.tolist():
+            groups.setdefault(int(self.site_of[r]), []).append(r)
+        return groups
+
+    def half_edge_cycle(self, i: int) -> np.ndarray:
+        """Half-edges of cell i in counter-clockwise order (empty if it has none)."""
+        start = int(self.face_edge[i])
+        if start < 0:
+            return np.empty(0, np.int32)
+        out = [start]
+        h = int(self.he_next[start])
+        while h != start:
+            out.append(h)
+            h = int(self.he_next[h])
+        return np.asarray(out, np.int32)
