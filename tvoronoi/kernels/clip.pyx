@@ -121,24 +121,19 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 continue
             a = he_face[h]
             b = he_face[tw]
-            # direction along the bisector, counter-clockwise about site a
+            # the edge as a stretch of the bisector M + t D, M the sites' midpoint
+            # and D along the bisector, counter-clockwise about site a: points
+            # computed from M keep their precision even when a far-off vertex
+            # (of nearly collinear sites) ends the edge
+            bx = 0.5 * (xs[a] + xs[b]); by = 0.5 * (ys[a] + ys[b])
             dx = -(ys[b] - ys[a])
             dy = xs[b] - xs[a]
             lo = -INFINITY
             hi = INFINITY
-            if o >= 0 and d >= 0:
-                bx = vertices[o, 0]; by = vertices[o, 1]
-                dx = vertices[d, 0] - bx; dy = vertices[d, 1] - by
-                lo = 0.0; hi = 1.0
-            elif o >= 0:
-                bx = vertices[o, 0]; by = vertices[o, 1]
-                lo = 0.0
-            elif d >= 0:
-                bx = vertices[d, 0]; by = vertices[d, 1]
-                hi = 0.0
-            else:
-                # degenerate case: a whole line (collinear sites)
-                bx = 0.5 * (xs[a] + xs[b]); by = 0.5 * (ys[a] + ys[b])
+            if o >= 0:
+                lo = ((vertices[o, 0] - bx) * dx + (vertices[o, 1] - by) * dy) / (dx * dx + dy * dy)
+            if d >= 0:
+                hi = ((vertices[d, 0] - bx) * dx + (vertices[d, 1] - by) * dy) / (dx * dx + dy * dy)
             t0 = lo
             t1 = hi
             if not (clip_param(-dx, bx - box.xmin, &t0, &t1)
@@ -148,7 +143,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 continue
             if not t0 < t1:
                 continue          # the edge only touches the box
-            if t0 == lo and o >= 0:
+            # an end inside the box is the vertex itself, shared with its other edges
+            if o >= 0 and inside[o]:
                 seg_start[h] = o
             else:
                 x = bx + t0 * dx; y = by + t0 * dy
@@ -156,7 +152,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 pts[n_pts, 0] = x; pts[n_pts, 1] = y
                 seg_start[h] = n_pts
                 n_pts += 1
-            if t1 == hi and d >= 0:
+            if d >= 0 and inside[d]:
                 seg_end[h] = d
             else:
                 x = bx + t1 * dx; y = by + t1 * dy

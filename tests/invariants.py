@@ -1,0 +1,93 @@
+"""Invariants every Diagram must satisfy, checked without stored answers."""
+
+import numpy as np
+import shapely
+
+# Relative tolerances for floating-point geometry (coordinates are rounded,
+# the topology is exact).
+AREA_RTOL = 1e-9
+DIST_RTOL = 1e-7
+
+
+def check_dcel(d):
+    """Twin symmetry, next/prev inverse, face cycles, Euler's formula."""
+    h = np.arange(len(d.he_origin))
+    assert np.all(d.he_twin[d.he_twin] == h), "twin of twin"
+    assert np.all(d.he_twin != h)
+    assert np.all(d.he_prev[d.he_next] == h), "prev of next"
+    assert np.all(d.he_face[d.he_next] == d.he_face), "next stays in the face"
+    assert np.all(d.he_face[d.he_twin] != d.he_face), "twins bound different cells"
+    # the end of h is the start of next[h] (both may be at infinity)
+    assert np.all(d.he_origin[d.he_next] == d.he_origin[d.he_twin])
+    # each cell's cycle holds exactly the half-edges of that cell
+    counts = np.bincount(d.he_face, minlength=d.n_sites) if len(h) else np.zeros(d.n_sites, int)
+    for i in range(d.n_sites):
+        cycle = d.half_edge_cycle(i)
+        assert len(cycle) == counts[i], f"cell {i}: cycle of {len(cycle)} of {counts[i]} half-edges"
+        assert np.all(d.he_face[cycle] == i)
+    # no zero-length edge: the two ends of a finite edge differ
+    o, t = d.he_origin, d.he_origin[d.he_twin]
+    both = (o >= 0) & (t >= 0)
+    assert np.all(o[both] != t[both]), "an edge from a vertex to itself"
+    faces = int(np.sum(d.site_of == np.arange(d.n_sites)))
+    if len(h):
+        unbounded = np.any(d.he_origin < 0)
+        v = d.n_vertices + (1 if unbounded else 0)
+        assert v - len(h) // 2 + faces == 2, "Euler's formula V - E + F = 2"
+
+
+def check_vertices(d):
+    """Each Voronoi vertex is equidistant from the sites of the cells around it."""
+    if d.n_vertices == 0:
+        return
+    scale = max(np.ptp(d.sites[:, 0]), np.ptp(d.sites[:, 1]))
+    finite = d.he_origin >= 0
+    v = d.he_origin[finite]
+    s = d.sites[d.he_face[finite]]
+    dist = np.hypot(*(d.vertices[v] - s).T)
+    ref = np.zeros(d.n_vertices)
+    np.maximum.at(ref, v, dist)
+    lo = np.full(d.n_vertices, np.inf)
+    np.minimum.at(lo, v, dist)
+    assert np.all(ref - lo <= DIST_RTOL * (scale + ref)), "a vertex not equidistant from its sites"
+    # and no other site is closer (the empty circle)
+    from scipy.spatial import cKDTree
+
+    nearest, _ = cKDTree(d.sites).query(d.vertices)
+    assert np.all(nearest >= lo - DIST_RTOL * (scale + ref)), "a site inside a vertex's circle"
+
+
+def cell_polygons(d):
+    return {i: shapely.Polygon(d.cell_polygon(i)) for i in range(d.n_sites) if len(d.cell_polygon(i))}
+
+
+def check_cells(d, *, sites_in_box=True):
+    """Valid CCW cells, each holding its site, tiling the box exactly once."""
+    polys = cell_polygons(d)
+    xmin, ymin, xmax, ymax = d.bbox
+    box_area = (xmax - xmin) * (ymax - ymin)
+    for i in range(d.n_sites):
+        first = d.site_of[i] == i
+        if not first:
+            assert len(d.cell_polygon(i)) == 0, f"repeated point {i} has a cell of its own"
+            continue
+        if sites_in_box:
+            assert i in polys, f"site {i} has no cell"
+    for i, p in polys.items():
+        assert p.is_valid, f"cell {i} invalid: {shapely.is_valid_reason(p)}"
+        assert p.exterior.is_ccw, f"cell {i} is clockwise"
+        assert p.area > 0
+        if sites_in_box:
+            assert p.covers(shapely.Point(d.sites[i])), f"site {i} outside its cell"
+    total = sum(p.area for p in polys.values())
+    if d.n_sites == 0:
+        assert total == 0
+        return
+    assert abs(total - box_area) <= AREA_RTOL * box_area, f"cells cover {total}, box {box_area}"
+    assert shapely.coverage_is_valid(shapely.GeometryCollection(list(polys.values())))
+
+
+def validate(d, *, sites_in_box=True):
+    check_dcel(d)
+    check_vertices(d)
+    check_cells(d, sites_in_box=sites_in_box)
