@@ -7,8 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.diagram import Diagram
-from tvoronoi.errors import EngineError
-from tvoronoi.kernels import clip, dcel, delaunay
+from tvoronoi.kernels import clip, dcel, delaunay, fortune
 
 
 def power_of_two_scale(pts: np.ndarray, box) -> int:
@@ -76,6 +75,29 @@ def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: in
     return perm, xs, ys, out
 
 
+def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Event order of Fortune's sweep: by y, then x (int32)."""
+    perm = np.argsort(ys)
+    sy = ys[perm]
+    if len(sy) > 1 and np.any(sy[1:] == sy[:-1]):
+        # rows of equal y: order them by x (a complex sort compares real, then imaginary parts)
+        perm = np.argsort(ys + 1j * xs, kind="stable")
+    return perm.astype(np.int32)
+
+
+def fortune_dcel(xs: np.ndarray, ys: np.ndarray):
+    """Run Fortune's sweep on sites in input order; returns (perm, xs, ys, out) as incremental_dcel."""
+    perm = sweep_order(xs, ys)
+    xs = np.ascontiguousarray(xs[perm])
+    ys = np.ascontiguousarray(ys[perm])
+    result = fortune.sweep(xs, ys)
+    if "tv" not in result:
+        return perm, xs, ys, collinear_dcel(xs, ys)
+    out = dcel.voronoi_from_delaunay(xs, ys, result["tv"], result["opp"])
+    out["dup"] = result["dup"]
+    return perm, xs, ys, out
+
+
 def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int) -> Diagram:
     """Build the Diagram of checked points (n, 2) in the checked box."""
     n = len(pts)
@@ -87,7 +109,7 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     if engine == "incremental":
         perm, exs, eys, out = incremental_dcel(xs, ys, insertion=insertion, seed=seed)
     else:
-        raise EngineError("engine 'fortune' is not available yet: use engine='incremental'")
+        perm, exs, eys, out = fortune_dcel(xs, ys)
 
     dup = out["dup"]
     active = (dup < 0).astype(np.int8)

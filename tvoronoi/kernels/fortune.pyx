@@ -1,0 +1,705 @@
+"""Fortune's sweepline: site and circle events, the beach line in an AVL tree, the result as a triangulation."""
+
+import numpy as np
+
+from libc.stdint cimport int8_t, int32_t, int64_t
+from libc.math cimport sqrt, INFINITY
+
+from tvoronoi.kernels.predicates cimport orient2d, incircle
+from tvoronoi.kernels.parabola cimport parabola_order
+
+# The sweep line y = L moves upwards; sites are numbered in event order
+# (by y, then x). Each arc of the beach line is a node of an AVL tree (in
+# arrays) and of a doubly linked list, left to right. A breakpoint between an
+# arc and the next one traces a Voronoi edge; each edge has a record that
+# collects the (at most two) Delaunay half-edges on its sides.
+#
+# The result is written as the sweep goes in the dual form the incremental
+# engine also builds: each circle event is a Voronoi vertex, stored as the
+# Delaunay triangle of its three sites, and the records link the triangles
+# into a half-edge structure (tv, opp, with vertex n at infinity closing the
+# hull). dcel.voronoi_from_delaunay turns it into the Voronoi DCEL.
+#
+# Every decision is exact: which arc a site falls on (parabola_order and
+# coordinate comparisons), whether three arcs converge (orient2d). Event
+# positions are rounded doubles; where rounding could order two events that
+# are equal up to an ulp the wrong way (cocircular and nearly cocircular
+# sites), a final pass of exact Lawson flips restores the Delaunay property,
+# so the diagram is exact on every input.
+
+cdef enum:
+    NONE = -1
+    EVENT_SITE = 0
+    EVENT_CIRCLE = 1
+    EVENT_REPEAT = 2      # a site at the same place as an earlier one
+
+
+cdef inline int nxt(int e) noexcept nogil:
+    return e - 2 if e % 3 == 2 else e + 1
+
+
+cdef inline int prv(int e) noexcept nogil:
+    return e + 2 if e % 3 == 0 else e - 1
+
+
+cdef struct Sweep:
+    const double* x
+    const double* y
+    int n
+    # arcs: site, list neighbours, tree links, pending event, record of the breakpoint to the right
+    int32_t* arc_site
+    int32_t* arc_prev
+    int32_t* arc_next
+    int32_t* left
+    int32_t* right
+    int32_t* parent
+    int8_t* height
+    int32_t* arc_event
+    int32_t* arc_edge
+    int root
+    int n_arcs
+    int first_arc
+    int32_t* free_arcs     # slots of removed arcs, reused so the live beach line stays in cache
+    int n_free
+    # circle events: position (top of the circle), centre, arc; a binary heap of their ids
+    double* ev_y
+    double* ev_x
+    double* ev_cy
+    int32_t* ev_arc
+    int32_t* heap
+    int32_t* ev_pos        # where each pending event sits in the heap
+    int n_heap
+    int n_events
+    int32_t* free_events
+    int n_free_ev
+    # edge records: the sites on each side, the Delaunay half-edges found so far, where it began
+    int32_t* rec_a
+    int32_t* rec_b
+    int32_t* rec_e0
+    int32_t* rec_e1
+    double* rec_x
+    double* rec_y
+    int n_recs
+    # the triangulation
+    int32_t* tv
+    int32_t* opp
+    int n_tri
+    int32_t* dup
+    # the first row of sites (equal y), before any other site
+    bint row_mode
+    int row_last
+    # the last event, for the step trace
+    int last_kind
+    int last_site
+    int last_tri
+    double sweep_y
+
+
+# ---------------------------------------------------------------------------------------------------------
+# AVL tree of arcs (ordered left to right; positions are given, never searched by key, except in locate)
+
+cdef inline int h_of(Sweep* s, int v) noexcept nogil:
+    return 0 if v == NONE else s.height[v]
+
+
+cdef inline void fix_height(Sweep* s, int v) noexcept nogil:
+    cdef int hl = h_of(s, s.left[v]), hr = h_of(s, s.right[v])
+    s.height[v] = <int8_t>(1 + (hl if hl > hr else hr))
+
+
+cdef inline void replace_child(Sweep* s, int p, int old, int new) noexcept nogil:
+    if p == NONE:
+        s.root = new
+    elif s.left[p] == old:
+        s.left[p] = new
+    else:
+        s.right[p] = new
+
+
+cdef int rotate_left(Sweep* s, int x) noexcept nogil:
+    cdef int y = s.right[x]
+    s.right[x] = s.left[y]
+    if s.left[y] != NONE:
+        s.parent[s.left[y]] = x
+    s.parent[y] = s.parent[x]
+    replace_child(s, s.parent[x], x, y)
+    s.left[y] = x
+    s.parent[x] = y
+    fix_height(s, x)
+    fix_height(s, y)
+    return y
+
+
+cdef int rotate_right(Sweep* s, int x) noexcept nogil:
+    cdef int y = s.left[x]
+    s.left[x] = s.right[y]
+    if s.right[y] != NONE:
+        s.parent[s.right[y]] = x
+    s.parent[y] = s.parent[x]
+    replace_child(s, s.parent[x], x, y)
+    s.right[y] = x
+    s.parent[x] = y
+    fix_height(s, x)
+    fix_height(s, y)
+    return y
+
+
+cdef void rebalance_up(Sweep* s, int v) noexcept nogil:
+    cdef int bal, before
+    while v != NONE:
+        before = s.height[v]
+        fix_height(s, v)
+        bal = h_of(s, s.left[v]) - h_of(s, s.right[v])
+        if -1 <= bal <= 1 and s.height[v] == before:
+            return          # this subtree's height did not change: nothing above it did
+
+        if bal > 1:
+            if h_of(s, s.left[s.left[v]]) < h_of(s, s.right[s.left[v]]):
+                rotate_left(s, s.left[v])
+            v = rotate_right(s, v)
+        elif bal < -1:
+            if h_of(s, s.right[s.right[v]]) < h_of(s, s.left[s.right[v]]):
+                rotate_right(s, s.right[v])
+            v = rotate_left(s, v)
+        v = s.parent[v]
+
+
+cdef int new_arc(Sweep* s, int site) noexcept nogil:
+    cdef int a
+    if s.n_free > 0:
+        s.n_free -= 1
+        a = s.free_arcs[s.n_free]
+    else:
+        a = s.n_arcs
+        s.n_arcs += 1
+    s.arc_site[a] = site
+    s.arc_prev[a] = NONE
+    s.arc_next[a] = NONE
+    s.left[a] = NONE
+    s.right[a] = NONE
+    s.parent[a] = NONE
+    s.height[a] = 1
+    s.arc_event[a] = NONE
+    s.arc_edge[a] = NONE
+    return a
+
+
+cdef void insert_after(Sweep* s, int x, int z) noexcept nogil:
+    """Put arc z right after arc x, in the list and in the tree."""
+    cdef int y
+    s.arc_prev[z] = x
+    s.arc_next[z] = s.arc_next[x]
+    if s.arc_next[x] != NONE:
+        s.arc_prev[s.arc_next[x]] = z
+    s.arc_next[x] = z
+    if s.right[x] == NONE:
+        s.right[x] = z
+        s.parent[z] = x
+    else:
+        y = s.right[x]
+        while s.left[y] != NONE:
+            y = s.left[y]
+        s.left[y] = z
+        s.parent[z] = y
+    rebalance_up(s, s.parent[z])
+
+
+cdef void remove_arc(Sweep* s, int z) noexcept nogil:
+    """Take arc z out of the list and the tree."""
+    cdef int y, zp, zl, zr, yp, yr, child, p
+    cdef int8_t zh
+    if s.arc_prev[z] != NONE:
+        s.arc_next[s.arc_prev[z]] = s.arc_next[z]
+    else:
+        s.first_arc = s.arc_next[z]
+    if s.arc_next[z] != NONE:
+        s.arc_prev[s.arc_next[z]] = s.arc_prev[z]
+    if s.left[z] != NONE and s.right[z] != NONE:
+        # swap z with its successor y in the tree (y has no left child)
+        y = s.right[z]
+        while s.left[y] != NONE:
+            y = s.left[y]
+        zp = s.parent[z]; zl = s.left[z]; zr = s.right[z]; zh = s.height[z]
+        yp = s.parent[y]; yr = s.right[y]
+        replace_child(s, zp, z, y)
+        s.parent[y] = zp
+        s.left[y] = zl
+        s.parent[zl] = y
+        if yp == z:
+            s.right[y] = z
+            s.parent[z] = y
+        else:
+            s.right[y] = zr
+            s.parent[zr] = y
+            s.left[yp] = z
+            s.parent[z] = yp
+        s.left[z] = NONE
+        s.right[z] = yr
+        if yr != NONE:
+            s.parent[yr] = z
+        s.height[z] = s.height[y]
+        s.height[y] = zh
+    child = s.left[z] if s.left[z] != NONE else s.right[z]
+    p = s.parent[z]
+    replace_child(s, p, z, child)
+    if child != NONE:
+        s.parent[child] = p
+    rebalance_up(s, p)
+    s.free_arcs[s.n_free] = z
+    s.n_free += 1
+
+
+# ---------------------------------------------------------------------------------------------------------
+# locating a new site on the beach line
+
+cdef int breakpoint_side(Sweep* s, int a, int b, double px, double py) noexcept nogil:
+    """-1 if p is left of the breakpoint between arcs of sites a (left) and b, +1 right, 0 on it."""
+    cdef double ax = s.x[a], ay = s.y[a], bx = s.x[b], by = s.y[b]
+    cdef int o
+    # of two parabolas, the narrower (its site nearer the sweep line) is above the
+    # other between their two crossings, and its apex lies between them: the
+    # breakpoint with a on the left is the right crossing if a is narrower
+    if ay > by:
+        if px <= ax:
+            return -1
+    elif by > ay:
+        if px >= bx:
+            return 1
+    elif ay == py:
+        return 1          # degenerate case: both on the sweep row; p comes after them
+    o = parabola_order(ax, ay, bx, by, px, py)
+    return -1 if o > 0 else (1 if o < 0 else 0)
+
+
+cdef int locate_arc(Sweep* s, double px, double py) noexcept nogil:
+    """The arc above p (at a breakpoint: the arc right of it)."""
+    cdef int v = s.root, a, c, step
+    while True:
+        a = s.arc_prev[v]
+        c = s.arc_next[v]
+        step = 0
+        if a != NONE and breakpoint_side(s, s.arc_site[a], s.arc_site[v], px, py) < 0:
+            step = -1
+        elif c != NONE and breakpoint_side(s, s.arc_site[v], s.arc_site[c], px, py) > 0:
+            step = 1
+        if step == -1 and s.left[v] != NONE:
+            v = s.left[v]
+        elif step == 1 and s.right[v] != NONE:
+            v = s.right[v]
+        else:
+            return v
+
+
+# ---------------------------------------------------------------------------------------------------------
+# circle events
+
+cdef inline bint ev_less(Sweep* s, int i, int j) noexcept nogil:
+    return s.ev_y[i] < s.ev_y[j] or (s.ev_y[i] == s.ev_y[j] and s.ev_x[i] < s.ev_x[j])
+
+
+cdef inline void heap_set(Sweep* s, int k, int ev) noexcept nogil:
+    s.heap[k] = ev
+    s.ev_pos[ev] = k
+
+
+cdef void sift_up(Sweep* s, int k) noexcept nogil:
+    cdef int ev = s.heap[k], up
+    while k > 0:
+        up = (k - 1) // 2
+        if not ev_less(s, ev, s.heap[up]):
+            break
+        heap_set(s, k, s.heap[up])
+        k = up
+    heap_set(s, k, ev)
+
+
+cdef void sift_down(Sweep* s, int k) noexcept nogil:
+    cdef int ev = s.heap[k], c
+    while True:
+        c = 2 * k + 1
+        if c >= s.n_heap:
+            break
+        if c + 1 < s.n_heap and ev_less(s, s.heap[c + 1], s.heap[c]):
+            c += 1
+        if not ev_less(s, s.heap[c], ev):
+            break
+        heap_set(s, k, s.heap[c])
+        k = c
+    heap_set(s, k, ev)
+
+
+cdef void heap_push(Sweep* s, int ev) noexcept nogil:
+    s.heap[s.n_heap] = ev
+    s.ev_pos[ev] = s.n_heap
+    s.n_heap += 1
+    sift_up(s, s.n_heap - 1)
+
+
+cdef void heap_remove(Sweep* s, int ev) noexcept nogil:
+    """Take event ev out of the heap and free its slot."""
+    cdef int k = s.ev_pos[ev]
+    s.n_heap -= 1
+    if k < s.n_heap:
+        heap_set(s, k, s.heap[s.n_heap])
+        if k > 0 and ev_less(s, s.heap[k], s.heap[(k - 1) // 2]):
+            sift_up(s, k)
+        else:
+            sift_down(s, k)
+    s.free_events[s.n_free_ev] = ev
+    s.n_free_ev += 1
+
+
+cdef inline void cancel_event(Sweep* s, int arc) noexcept nogil:
+    if s.arc_event[arc] != NONE:
+        heap_remove(s, s.arc_event[arc])
+        s.arc_event[arc] = NONE
+
+
+cdef void check_circle(Sweep* s, int arc) noexcept nogil:
+    """Schedule the circle event of arc if its two breakpoints converge."""
+    cdef int l = s.arc_prev[arc], r = s.arc_next[arc], a, b, c, ev
+    cdef double bx, by, cx, cy, det, bb, cc, ux, uy
+    if l == NONE or r == NONE:
+        return
+    a = s.arc_site[l]
+    b = s.arc_site[arc]
+    c = s.arc_site[r]
+    if a == c or orient2d(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c]) <= 0:
+        return
+    # the circumcentre, relative to a; the event is where the sweep line touches the circle's top
+    bx = s.x[b] - s.x[a]; by = s.y[b] - s.y[a]
+    cx = s.x[c] - s.x[a]; cy = s.y[c] - s.y[a]
+    det = 2.0 * (bx * cy - by * cx)
+    bb = bx * bx + by * by
+    cc = cx * cx + cy * cy
+    ux = (cy * bb - by * cc) / det
+    uy = (bx * cc - cx * bb) / det
+    if s.n_free_ev > 0:
+        s.n_free_ev -= 1
+        ev = s.free_events[s.n_free_ev]
+    else:
+        ev = s.n_events
+        s.n_events += 1
+    s.ev_x[ev] = s.x[a] + ux
+    s.ev_cy[ev] = s.y[a] + uy
+    s.ev_y[ev] = s.ev_cy[ev] + sqrt(ux * ux + uy * uy)
+    s.ev_arc[ev] = arc
+    s.arc_event[arc] = ev
+    heap_push(s, ev)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# edge records and triangles
+
+cdef int new_record(Sweep* s, int a, int b, double x, double y) noexcept nogil:
+    cdef int r = s.n_recs
+    s.n_recs += 1
+    s.rec_a[r] = a
+    s.rec_b[r] = b
+    s.rec_e0[r] = NONE
+    s.rec_e1[r] = NONE
+    s.rec_x[r] = x
+    s.rec_y[r] = y
+    return r
+
+
+cdef inline void attach(Sweep* s, int r, int e) noexcept nogil:
+    """Half-edge e of a new triangle lies on the edge of record r: pair it with the other side."""
+    if s.rec_e0[r] == NONE:
+        s.rec_e0[r] = e
+    else:
+        s.rec_e1[r] = e
+        s.opp[e] = s.rec_e0[r]
+        s.opp[s.rec_e0[r]] = e
+
+
+cdef void site_event(Sweep* s, int i) noexcept nogil:
+    cdef double px = s.x[i], py = s.y[i]
+    cdef int b, p, b2, r, site_b
+    cdef double dy
+    s.sweep_y = py
+    s.last_site = i
+    s.last_kind = EVENT_SITE
+    if s.root == NONE:
+        b = new_arc(s, i)
+        s.root = b
+        s.first_arc = b
+        s.row_mode = True
+        s.row_last = b
+        return
+    if s.row_mode and py == s.y[s.arc_site[s.row_last]]:
+        # degenerate case: the first row of sites (equal y); their breakpoints are
+        # vertical lines coming up from infinity, in order of x
+        b = s.row_last
+        p = new_arc(s, i)
+        insert_after(s, b, p)
+        s.arc_edge[b] = new_record(s, s.arc_site[b], i, 0.5 * (s.x[s.arc_site[b]] + px), -INFINITY)
+        s.row_last = p
+        return
+    s.row_mode = False
+    b = locate_arc(s, px, py)
+    site_b = s.arc_site[b]
+    cancel_event(s, b)
+    # split b into b, p, b2; the new edge starts on b's parabola right above p
+    dy = s.y[site_b] - py
+    r = new_record(s, site_b, i, px,
+                   py + ((s.x[site_b] - px) * (s.x[site_b] - px) + dy * dy) / (2.0 * dy) if dy != 0.0 else py)
+    p = new_arc(s, i)
+    b2 = new_arc(s, site_b)
+    insert_after(s, b, p)
+    insert_after(s, p, b2)
+    s.arc_edge[b2] = s.arc_edge[b]
+    s.arc_edge[b] = r
+    s.arc_edge[p] = r
+    check_circle(s, b)
+    check_circle(s, b2)
+
+
+cdef void circle_event(Sweep* s, int ev) noexcept nogil:
+    cdef int arc = s.ev_arc[ev], l = s.arc_prev[arc], r = s.arc_next[arc]
+    cdef int a = s.arc_site[l], b = s.arc_site[arc], c = s.arc_site[r], t, rec
+    s.sweep_y = s.ev_y[ev]
+    # the Voronoi vertex: triangle (a, b, c), counter-clockwise
+    t = s.n_tri
+    s.n_tri += 1
+    s.tv[3 * t] = a
+    s.tv[3 * t + 1] = b
+    s.tv[3 * t + 2] = c
+    s.opp[3 * t] = NONE
+    s.opp[3 * t + 1] = NONE
+    s.opp[3 * t + 2] = NONE
+    attach(s, s.arc_edge[l], 3 * t)          # edge a-b ends here
+    attach(s, s.arc_edge[arc], 3 * t + 1)    # edge b-c ends here
+    rec = new_record(s, a, c, s.ev_x[ev], s.ev_cy[ev])
+    attach(s, rec, 3 * t + 2)                # edge a-c begins here
+    s.last_kind = EVENT_CIRCLE
+    s.last_site = b
+    s.last_tri = t
+    cancel_event(s, arc)            # the event itself leaves the heap
+    cancel_event(s, l)
+    cancel_event(s, r)
+    remove_arc(s, arc)
+    s.arc_edge[l] = rec
+    check_circle(s, l)
+    check_circle(s, r)
+
+
+cdef int step(Sweep* s, int* next_site) noexcept nogil:
+    """Process the next event; 0 when there is none left."""
+    cdef int i, ev
+    i = next_site[0]
+    if i < s.n and (s.n_heap == 0 or s.y[i] <= s.ev_y[s.heap[0]]):
+        # sites come before circle events at the same position
+        next_site[0] = i + 1
+        if i > 0 and s.x[i] == s.x[i - 1] and s.y[i] == s.y[i - 1]:
+            # degenerate case: a repeated point, sorted next to its first copy
+            s.dup[i] = s.dup[i - 1] if s.dup[i - 1] != NONE else i - 1
+            s.last_kind = EVENT_REPEAT
+            s.last_site = i
+            return 1
+        site_event(s, i)
+        return 1
+    if s.n_heap == 0:
+        return 0
+    circle_event(s, s.heap[0])
+    return 1
+
+
+# ---------------------------------------------------------------------------------------------------------
+# closing the hull, and the exact repair
+
+cdef void close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
+    """An infinite triangle beyond each edge that has a triangle on one side only."""
+    cdef int r, e, u, w, t, first = s.n_tri
+    for r in range(s.n_recs):
+        e = s.rec_e0[r]
+        if e == NONE or s.rec_e1[r] != NONE:
+            continue
+        # the finite side has half-edge u->w; beyond it lies (w, u, inf)
+        u = s.tv[e]
+        w = s.tv[nxt(e)]
+        t = s.n_tri
+        s.n_tri += 1
+        s.tv[3 * t] = w
+        s.tv[3 * t + 1] = u
+        s.tv[3 * t + 2] = s.n
+        s.opp[3 * t] = e
+        s.opp[e] = 3 * t
+        vmap[w] = t
+    for t in range(first, s.n_tri):
+        # (w, u, inf): its edge u->inf is the twin of inf->u in the triangle that starts at u
+        u = s.tv[3 * t + 1]
+        s.opp[3 * t + 1] = 3 * vmap[u] + 2
+        s.opp[3 * vmap[u] + 2] = 3 * t + 1
+
+
+cdef bint is_infinite(Sweep* s, int t) noexcept nogil:
+    return s.tv[3 * t] == s.n or s.tv[3 * t + 1] == s.n or s.tv[3 * t + 2] == s.n
+
+
+cdef int repair(Sweep* s, int32_t* stack, int8_t* queued) noexcept nogil:
+    """Lawson flips until every edge is locally Delaunay (exact incircle). Returns the flip count."""
+    cdef int n_he = 3 * s.n_tri, top = 0, e, o, e1, e2, o1, o2, a, b, c, d, A, B, flips = 0, k
+    cdef int quad[4]
+    for e in range(n_he):
+        if s.opp[e] > e:
+            stack[top] = e
+            top += 1
+            queued[e] = 1
+    while top > 0:
+        top -= 1
+        e = stack[top]
+        queued[e] = 0
+        o = s.opp[e]
+        if is_infinite(s, e // 3) or is_infinite(s, o // 3):
+            continue
+        e1 = nxt(e); e2 = prv(e); o1 = nxt(o); o2 = prv(o)
+        a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
+        if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
+            continue
+        # flip a-b to c-d: (a, b, c) + (b, a, d) become (d, b, c) + (c, a, d)
+        A = s.opp[e2]
+        B = s.opp[o2]
+        s.tv[e] = d
+        s.tv[o] = c
+        s.opp[e] = B; s.opp[B] = e
+        s.opp[o] = A; s.opp[A] = o
+        s.opp[e2] = o2; s.opp[o2] = e2
+        flips += 1
+        quad[0] = e; quad[1] = e1; quad[2] = o; quad[3] = o1
+        for k in range(4):
+            if not queued[quad[k]] and not queued[s.opp[quad[k]]]:
+                stack[top] = quad[k]
+                top += 1
+                queued[quad[k]] = 1
+    return flips
+
+
+def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
+    """Fortune's sweep over sites sorted by (y, x).
+
+    Parameters
+    ----------
+    xs, ys : (n,) float64
+        Site coordinates in event order (sorted by y, then x).
+    stop_after : int
+        Stop after this many events (site, repeat and circle events count
+        one each) and return the sweep's state; -1 runs to the end.
+
+    Returns
+    -------
+    dict: ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation (vertex n
+    at infinity; only when the sweep finished and some triangle exists),
+    ``dup`` (n,) int32, ``steps`` (events processed), ``flips`` (exact
+    repairs), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
+    circle events: arc index in ``beach``, centre x, centre y, top y),
+    ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
+    so far, ``sweep_y``, ``last`` (kind, site, triangle).
+    """
+    cdef int n = xs.shape[0]
+    cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
+    arrays = {
+        "arc_site": np.empty(cap_arcs, np.int32), "arc_prev": np.empty(cap_arcs, np.int32),
+        "arc_next": np.empty(cap_arcs, np.int32), "left": np.empty(cap_arcs, np.int32),
+        "right": np.empty(cap_arcs, np.int32), "parent": np.empty(cap_arcs, np.int32),
+        "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
+        "arc_edge": np.empty(cap_arcs, np.int32),
+        "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
+        "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
+        "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
+        "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
+        "rec_a": np.empty(cap_rec, np.int32), "rec_b": np.empty(cap_rec, np.int32),
+        "rec_e0": np.empty(cap_rec, np.int32), "rec_e1": np.empty(cap_rec, np.int32),
+        "rec_x": np.empty(cap_rec, np.float64), "rec_y": np.empty(cap_rec, np.float64),
+        "tv": np.empty(3 * cap_tri, np.int32), "opp": np.empty(3 * cap_tri, np.int32),
+        "dup": np.full(n, -1, np.int32),
+    }
+    cdef int32_t[::1] arc_site = arrays["arc_site"], arc_prev = arrays["arc_prev"], arc_next = arrays["arc_next"]
+    cdef int32_t[::1] left = arrays["left"], right = arrays["right"], parent = arrays["parent"]
+    cdef int8_t[::1] height = arrays["height"]
+    cdef int32_t[::1] ev_pos = arrays["ev_pos"], free_events = arrays["free_events"]
+    cdef int32_t[::1] free_arcs = arrays["free_arcs"]
+    cdef int32_t[::1] arc_event = arrays["arc_event"], arc_edge = arrays["arc_edge"]
+    cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
+    cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
+    cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
+    cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
+    cdef double[::1] rec_x = arrays["rec_x"], rec_y = arrays["rec_y"]
+    cdef int32_t[::1] tv = arrays["tv"], opp = arrays["opp"], dup = arrays["dup"]
+    cdef Sweep s
+    s.x = &xs[0] if n else NULL
+    s.y = &ys[0] if n else NULL
+    s.n = n
+    s.arc_site = &arc_site[0]; s.arc_prev = &arc_prev[0]; s.arc_next = &arc_next[0]
+    s.left = &left[0]; s.right = &right[0]; s.parent = &parent[0]; s.height = &height[0]
+    s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
+    s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
+    s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
+    s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
+    s.free_events = &free_events[0]; s.n_free_ev = 0
+    s.free_arcs = &free_arcs[0]; s.n_free = 0
+    s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]; s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
+    s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]; s.n_recs = 0
+    s.tv = &tv[0]; s.opp = &opp[0]; s.n_tri = 0
+    s.dup = &dup[0] if n else NULL
+    s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
+    s.row_mode = False; s.row_last = NONE
+    cdef int next_site = 0, flips = 0
+    cdef long steps = 0
+    with nogil:
+        while stop_after < 0 or steps < stop_after:
+            if not step(&s, &next_site):
+                break
+            steps += 1
+    out = {"dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
+           "last": (s.last_kind, s.last_site, s.last_tri)}
+    cdef bint finished = next_site == n and s.n_heap == 0
+    if not finished or stop_after >= 0:
+        out.update(_state(&s, arrays))
+    if not finished:
+        return out
+    cdef int32_t[::1] vmap
+    cdef int32_t[::1] stack
+    cdef int8_t[::1] queued
+    if s.n_tri > 0:
+        vmap = np.empty(n + 1, np.int32)
+        with nogil:
+            close_hull(&s, &vmap[0])
+        stack = np.empty(3 * s.n_tri, np.int32)
+        queued = np.zeros(3 * s.n_tri, np.int8)
+        with nogil:
+            flips = repair(&s, &stack[0], &queued[0])
+        out["tv"] = arrays["tv"][:3 * s.n_tri]
+        out["opp"] = arrays["opp"][:3 * s.n_tri]
+    out["flips"] = flips
+    return out
+
+
+cdef dict _state(Sweep* s, dict arrays):
+    """The beach line, pending events and records, as arrays for the step trace."""
+    cdef int a = s.first_arc, k = 0, ev
+    beach, edges, index = [], [], {}
+    while a != NONE:
+        index[a] = k
+        beach.append(s.arc_site[a])
+        edges.append(s.arc_edge[a])
+        a = s.arc_next[a]
+        k += 1
+    events = []
+    for k in range(s.n_heap):
+        ev = s.heap[k]
+        events.append((index[s.ev_arc[ev]], s.ev_x[ev], s.ev_cy[ev], s.ev_y[ev]))
+    events.sort(key=lambda row: (row[3], row[1]))
+    r = s.n_recs
+    return {
+        "beach": np.asarray(beach, np.int32),
+        "beach_edges": np.asarray(edges[:len(edges) - 1], np.int32) if edges else np.empty(0, np.int32),
+        "events": np.asarray(events, np.float64).reshape(-1, 4),
+        "records": {
+            "a": arrays["rec_a"][:r].copy(), "b": arrays["rec_b"][:r].copy(),
+            "e0": arrays["rec_e0"][:r].copy(), "e1": arrays["rec_e1"][:r].copy(),
+            "x": arrays["rec_x"][:r].copy(), "y": arrays["rec_y"][:r].copy(),
+        },
+        "triangles": arrays["tv"][:3 * s.n_tri].reshape(-1, 3).copy(),
+    }
