@@ -1,0 +1,773 @@
+"""Point files in: every format, the column choices, and every bad input named precisely."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tvoronoi import readers
+from tvoronoi.errors import InputFileError, TvoronoiError
+from tvoronoi.readers import PointSet, read_points
+
+
+def write(tmp_path: Path, name: str, content: str | bytes) -> str:
+    """Write ``content`` to ``tmp_path / name`` and return the path as a str."""
+    path = tmp_path / name
+    if isinstance(content, str):
+        path.write_text(content, encoding="utf-8", newline="")
+    else:
+        path.write_bytes(content)
+    return str(path)
+
+
+def read(tmp_path: Path, name: str, content: str | bytes, **kwargs) -> PointSet:
+    return read_points(write(tmp_path, name, content), **kwargs)
+
+
+def error(tmp_path: Path, name: str, content: str | bytes, **kwargs) -> str:
+    """The message of the InputFileError that reading ``content`` raises."""
+    with pytest.raises(InputFileError) as info:
+        read(tmp_path, name, content, **kwargs)
+    return str(info.value)
+
+
+class FakeStdin:
+    def __init__(self, data: bytes):
+        self.buffer = io.BytesIO(data)
+
+
+def npy_bytes(array: np.ndarray) -> bytes:
+    out = io.BytesIO()
+    np.save(out, array, allow_pickle=True)
+    return out.getvalue()
+
+
+def feature(geometry, properties=None) -> dict:
+    return {"type": "Feature", "geometry": geometry, "properties": properties}
+
+
+def collection(*features) -> str:
+    return json.dumps({"type": "FeatureCollection", "features": list(features)})
+
+
+# ---------------------------------------------------------------------------
+# CSV
+
+
+def test_csv_with_header_reads_exact_values(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y\n0.1,0.2\n3,-4.5e-3\n1e9,7\n")
+    assert points.xy.dtype == np.float64 and points.xy.flags.c_contiguous
+    np.testing.assert_array_equal(points.xy, [[0.1, 0.2], [3.0, -4.5e-3], [1e9, 7.0]])
+    assert points.source.endswith("p.csv")
+    assert points.properties(0) == {} and points.property_names == []
+    assert len(points) == 3
+
+
+def test_csv_source_is_the_name_as_given(tmp_path, monkeypatch):
+    write(tmp_path, "p.csv", "x,y\n1,2\n")
+    monkeypatch.chdir(tmp_path)
+    assert read_points("p.csv").source == "p.csv"
+    assert read_points(Path("p.csv")).source == "p.csv"
+
+
+@pytest.mark.parametrize(
+    "header, expected",
+    [
+        ("X,Y", [[1, 2], [3, 4]]),
+        ("Lon,Lat", [[1, 2], [3, 4]]),
+        ("LATITUDE,longitude", [[2, 1], [4, 3]]),
+        ("lat,lng", [[2, 1], [4, 3]]),
+        ("y,x", [[2, 1], [4, 3]]),
+        ("Long,Latitude", [[1, 2], [3, 4]]),
+    ],
+)
+def test_csv_columns_found_by_name_in_any_case(tmp_path, header, expected):
+    points = read(tmp_path, "p.csv", f"{header}\n1,2\n3,4\n")
+    np.testing.assert_array_equal(points.xy, expected)
+    assert points.property_names == []
+
+
+def test_csv_exact_x_y_win_over_lon_lat(tmp_path):
+    points = read(tmp_path, "p.csv", "lon,lat,x,y\n10,20,1,2\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2]])
+    assert points.properties(0) == {"lon": 10, "lat": 20}
+
+
+def test_csv_header_without_coordinate_names_uses_first_two_numeric_columns(tmp_path):
+    points = read(tmp_path, "p.csv", "name,east,north,h\na,1.5,2.5,9\nb,3.5,4.5,8\n")
+    np.testing.assert_array_equal(points.xy, [[1.5, 2.5], [3.5, 4.5]])
+    assert points.properties(1) == {"name": "b", "h": 8}
+
+
+def test_csv_without_header(tmp_path):
+    points = read(tmp_path, "p.csv", "1,2,7,a\n3,4,8.5,\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.property_names == ["col3", "col4"]
+    assert points.properties(0) == {"col3": 7, "col4": "a"}
+    assert points.properties(1) == {"col3": 8.5, "col4": None}
+
+
+def test_csv_without_header_skips_a_leading_text_column(tmp_path):
+    points = read(tmp_path, "p.csv", "a,1,2\nb,3,4\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert [points.properties(i) for i in range(2)] == [{"col1": "a"}, {"col1": "b"}]
+
+
+@pytest.mark.parametrize(
+    "x, y",
+    [("East", "NORTH"), (1, 2), ("1", "2"), ("col2", "col3"), ("east", 2)],
+)
+def test_csv_x_y_chosen_by_name_or_index(tmp_path, x, y):
+    points = read(tmp_path, "p.csv", "id,east,north\n1,10,20\n2,30,40\n", x=x, y=y)
+    np.testing.assert_array_equal(points.xy, [[10, 20], [30, 40]])
+    assert points.properties(1) == {"id": 2}
+
+
+def test_csv_x_y_chosen_override_names(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,u,v\n1,2,3,4\n", x="v", y="u")
+    np.testing.assert_array_equal(points.xy, [[4, 3]])
+    assert points.properties(0) == {"x": 1, "y": 2}
+
+
+def test_csv_x_y_by_index_without_header(tmp_path):
+    points = read(tmp_path, "p.csv", "5,1,2\n6,3,4\n", x=2, y=1)
+    np.testing.assert_array_equal(points.xy, [[2, 1], [4, 3]])
+    assert points.properties(0) == {"col1": 5}
+
+
+@pytest.mark.parametrize(
+    "content, n_sites, names",
+    [
+        ("1,2,lat\n3,4,lon\n", 2, ["col3"]),  # a coordinate name as a value
+        ("a,b\n1,2\n", 1, []),  # names that are not coordinate names
+        ("x,y,2019,2020\n1,2,7,8\n", 1, ["2019", "2020"]),  # a header with numeric names
+        ("1,2\n3,4\n", 2, []),
+        ("lon,lat\n", None, None),  # only a header
+    ],
+)
+def test_header_detection(tmp_path, content, n_sites, names):
+    if n_sites is None:
+        assert "no points found" in error(tmp_path, "p.csv", content)
+        return
+    points = read(tmp_path, "p.csv", content)
+    assert len(points) == n_sites and points.property_names == names
+
+
+def test_header_detected_by_a_chosen_column(tmp_path):
+    points = read(tmp_path, "p.csv", "1,2,u\n3,4,5\n", y="u")
+    np.testing.assert_array_equal(points.xy, [[3, 5]])
+    points = read(tmp_path, "q.csv", "1,2,a\n3,4,5\n", x=0, y=2)
+    np.testing.assert_array_equal(points.xy, [[3, 5]])
+
+
+def test_csv_only_one_column_named_takes_the_next_numeric_for_the_other(tmp_path):
+    points = read(tmp_path, "p.csv", "x,north\n1,2\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2]])
+
+
+def test_csv_quoted_fields_with_commas(tmp_path):
+    content = 'x,y,name,note\n1,2,"Smith, J","said ""hi"""\n"3.5","4",plain,"a,b,c"\n'
+    points = read(tmp_path, "p.csv", content)
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3.5, 4]])
+    assert points.properties(0) == {"name": "Smith, J", "note": 'said "hi"'}
+    assert points.properties(1) == {"name": "plain", "note": "a,b,c"}
+
+
+def test_csv_two_quoted_columns(tmp_path):
+    points = read(tmp_path, "p.csv", 'x,y\n"1","2"\n"3",4\n')
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+def test_csv_extra_columns_are_converted(tmp_path):
+    content = (
+        "x,y,i,f,mixed,s,e,big,nan\n"
+        "0,0,1,1.5,1,abc,,123456789012345678901234567890,nan\n"
+        "1,1,-2,2,2.5,x y,,1,inf\n"
+        "2,2,+3,-1e3,hello, ,,2,3\n"
+    )
+    points = read(tmp_path, "p.csv", content)
+    assert points.properties(0) == {
+        "i": 1, "f": 1.5, "mixed": 1, "s": "abc", "e": None,
+        "big": "123456789012345678901234567890", "nan": None,
+    }
+    row1 = points.properties(1)
+    assert row1["i"] == -2 and type(row1["i"]) is int
+    assert row1["f"] == 2 and type(row1["f"]) is int
+    assert row1["mixed"] == 2.5 and row1["s"] == "x y" and row1["nan"] is None
+    row2 = points.properties(2)
+    # a blank (whitespace-only) field is empty too
+    assert row2 == {"i": 3, "f": -1000.0, "mixed": "hello", "s": None, "e": None, "big": 2, "nan": 3}
+    assert type(row2["f"]) is float
+
+
+def test_csv_int_column_stays_int_and_float_column_keeps_int_literals(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,a,b\n0,0,7,0.5\n1,1,8,2\n2,2,9,1e-3\n")
+    a = [points.properties(i)["a"] for i in range(3)]
+    b = [points.properties(i)["b"] for i in range(3)]
+    assert a == [7, 8, 9] and all(type(v) is int for v in a)
+    assert b == [0.5, 2, 0.001] and [type(v) for v in b] == [float, int, float]
+
+
+def test_csv_properties_are_json_ready(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,a,b,c\n0,0,nan,1e999,\n1,1,2,x,7\n")
+    text = json.dumps([points.properties(i) for i in range(2)], allow_nan=False)
+    assert json.loads(text) == [{"a": None, "b": None, "c": None}, {"a": 2, "b": "x", "c": 7}]
+
+
+def test_csv_blank_lines_crlf_bom_and_spaces(tmp_path):
+    content = "\ufeff\r\n x , y ,label\r\n\r\n1, 2,a\r\n   \r\n3 ,4, b\r\n\r\n"
+    points = read(tmp_path, "p.csv", content)
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(1) == {"label": " b"}
+
+
+def test_csv_two_columns_with_blank_and_whitespace_lines(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y\n\n1,2\n  \n3,4\n\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+def test_csv_duplicate_and_empty_header_names(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,a,a,\n1,2,3,4,5\n")
+    assert points.properties(0) == {"a": 3, "a_2": 4, "col5": 5}
+
+
+def test_csv_old_mac_line_endings(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y\r1,2\r3,4\r")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+def test_csv_utf16_with_bom(tmp_path):
+    data = "x,y,name\n1,2,Zürich\n".encode("utf-16")
+    points = read(tmp_path, "p.csv", data)
+    np.testing.assert_array_equal(points.xy, [[1, 2]])
+    assert points.properties(0) == {"name": "Zürich"}
+
+
+def test_csv_large_table_matches_what_was_written(tmp_path):
+    rng = np.random.default_rng(5)
+    xy = rng.normal(size=(5000, 2)) * 1e3
+    lines = ["id,x,y,tag"] + [f"{i},{a!r},{b!r},t{i % 7}" for i, (a, b) in enumerate(xy.tolist())]
+    points = read(tmp_path, "p.csv", "\n".join(lines) + "\n")
+    np.testing.assert_array_equal(points.xy, xy)
+    assert points.columns["id"] == list(range(5000))
+    assert points.properties(4999) == {"id": 4999, "tag": f"t{4999 % 7}"}
+
+
+def test_csv_data_far_below_the_header(tmp_path):
+    # the first data row lies beyond the stretch read to find the header
+    gap = "\n" * 70_000
+    points = read(tmp_path, "p.csv", "x,y,a\n" + gap + "1,2,3\n4,5,6\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [4, 5]])
+    assert points.columns == {"a": [3, 6]}
+    message = error(tmp_path, "q.csv", "x,y\n" + gap + "1,2\n3,abc\n")
+    assert 'q.csv, line 70003: "abc" in column "y" is not a number' in message
+
+
+# ---------------------------------------------------------------------------
+# whitespace text
+
+
+def test_text_rows_comments_and_blank_lines(tmp_path):
+    content = "# sites\n1 2\n\n  3\t4   # inline comment\n# 9 9\n5.5 -6e2\n"
+    points = read(tmp_path, "p.txt", content)
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4], [5.5, -600]])
+    assert points.property_names == []
+
+
+def test_text_line_endings(tmp_path):
+    points = read(tmp_path, "a.txt", "1 2 a\r\n3 4 b\r\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.columns == {"col3": ["a", "b"]}
+    points = read(tmp_path, "b.txt", "1 2 a\r3 4 b\r")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    # a lone CR ends a line: the second row has two fields, not four
+    assert "c.txt, line 2: 2 fields" in error(tmp_path, "c.txt", "1 2 3 4\n5 6\r7 8\n")
+
+
+@pytest.mark.parametrize("suffix", [".xy", ".dat", ".pts", ".TXT"])
+def test_text_extensions(tmp_path, suffix):
+    points = read(tmp_path, "p" + suffix, "1 2\n3 4\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+def test_text_extra_columns(tmp_path):
+    points = read(tmp_path, "p.txt", "1 2 a 7\n3 4 b 8.5  # c\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(0) == {"col3": "a", "col4": 7}
+    assert points.properties(1) == {"col3": "b", "col4": 8.5}
+
+
+def test_text_with_header_and_chosen_columns(tmp_path):
+    points = read(tmp_path, "p.txt", "id lat lon\n1 10 20\n2 30 40\n")
+    np.testing.assert_array_equal(points.xy, [[20, 10], [40, 30]])
+    assert points.properties(0) == {"id": 1}
+    points = read(tmp_path, "q.txt", "1 10 20\n2 30 40\n", x="col1", y=2)
+    np.testing.assert_array_equal(points.xy, [[1, 20], [2, 40]])
+    assert points.properties(1) == {"col2": 30}
+
+
+def test_text_large_file_with_and_without_extras(tmp_path):
+    rng = np.random.default_rng(2)
+    xy = rng.random((3000, 2))
+    plain = "\n".join(f"{a!r} {b!r}" for a, b in xy.tolist())
+    np.testing.assert_array_equal(read(tmp_path, "a.txt", plain).xy, xy)
+    extra = "\n".join(f"{a!r} {b!r} {i}" for i, (a, b) in enumerate(xy.tolist()))
+    points = read(tmp_path, "b.txt", extra)
+    np.testing.assert_array_equal(points.xy, xy)
+    assert points.columns["col3"] == list(range(3000))
+
+
+# ---------------------------------------------------------------------------
+# GeoJSON
+
+
+def test_geojson_points_and_properties(tmp_path):
+    content = collection(
+        feature({"type": "Point", "coordinates": [1.5, 2.5]}, {"name": "a", "n": 1, "tags": [1, 2]}),
+        feature({"type": "Point", "coordinates": [3, 4, 100]}, None),
+    )
+    points = read(tmp_path, "p.geojson", content)
+    np.testing.assert_array_equal(points.xy, [[1.5, 2.5], [3, 4]])
+    assert points.properties(0) == {"name": "a", "n": 1, "tags": [1, 2]}
+    assert points.properties(1) == {}
+    assert points.property_names == ["name", "n", "tags"]
+
+
+def test_geojson_properties_are_copies(tmp_path):
+    content = collection(feature({"type": "Point", "coordinates": [1, 2]}, {"a": 1}))
+    points = read(tmp_path, "p.geojson", content)
+    points.properties(0)["a"] = 99
+    assert points.properties(0) == {"a": 1}
+
+
+def test_geojson_multipoint_gives_one_site_per_point(tmp_path):
+    content = collection(
+        feature({"type": "Point", "coordinates": [0, 0]}, {"k": "p"}),
+        feature({"type": "MultiPoint", "coordinates": [[1, 1], [2, 2], [3, 3]]}, {"k": "m"}),
+        feature({"type": "MultiPoint", "coordinates": []}, {"k": "empty"}),
+    )
+    points = read(tmp_path, "p.json", content)
+    np.testing.assert_array_equal(points.xy, [[0, 0], [1, 1], [2, 2], [3, 3]])
+    assert [points.properties(i) for i in range(4)] == [
+        {"k": "p"},
+        {"k": "m", "part": 0},
+        {"k": "m", "part": 1},
+        {"k": "m", "part": 2},
+    ]
+
+
+def test_geojson_single_feature_and_bare_geometries(tmp_path):
+    one = json.dumps(feature({"type": "Point", "coordinates": [5, 6]}, {"a": 1}))
+    points = read(tmp_path, "a.geojson", one)
+    np.testing.assert_array_equal(points.xy, [[5, 6]])
+    assert points.properties(0) == {"a": 1}
+    bare = json.dumps({"type": "Point", "coordinates": [7, 8]})
+    np.testing.assert_array_equal(read(tmp_path, "b.geojson", bare).xy, [[7, 8]])
+    multi = json.dumps({"type": "MultiPoint", "coordinates": [[1, 2], [3, 4]]})
+    points = read(tmp_path, "c.geojson", multi)
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(1) == {"part": 1}
+
+
+# ---------------------------------------------------------------------------
+# .npy
+
+
+def test_npy_float_and_int_arrays(tmp_path):
+    xy = np.array([[0.5, 1.5], [2.5, 3.5]])
+    points = read(tmp_path, "p.npy", npy_bytes(xy))
+    np.testing.assert_array_equal(points.xy, xy)
+    assert points.property_names == []
+    ints = read(tmp_path, "q.npy", npy_bytes(np.array([[1, 2], [3, 4]], dtype=np.int32)))
+    assert ints.xy.dtype == np.float64 and ints.xy.flags.c_contiguous
+    np.testing.assert_array_equal(ints.xy, [[1, 2], [3, 4]])
+
+
+def test_npy_fortran_order_is_made_c_contiguous(tmp_path):
+    xy = np.asfortranarray(np.arange(10.0).reshape(5, 2))
+    points = read(tmp_path, "p.npy", npy_bytes(xy))
+    assert points.xy.flags.c_contiguous
+    np.testing.assert_array_equal(points.xy, xy)
+
+
+def test_npy_extra_columns_and_choice(tmp_path):
+    array = np.array([[1.0, 2.0, 7.0, np.nan], [3.0, 4.0, 8.0, 0.5]])
+    points = read(tmp_path, "p.npy", npy_bytes(array))
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(0) == {"col3": 7.0, "col4": None}
+    assert points.properties(1) == {"col3": 8.0, "col4": 0.5}
+    chosen = read(tmp_path, "q.npy", npy_bytes(array), x=2, y="col1")
+    np.testing.assert_array_equal(chosen.xy, [[7, 1], [8, 3]])
+    assert chosen.property_names == ["col2", "col4"]
+
+
+def test_npy_structured_array(tmp_path):
+    dtype = [("id", "i4"), ("Lat", "f8"), ("Lon", "f4"), ("name", "U8"), ("code", "S3")]
+    array = np.array([(1, 10.0, 20.0, "a", b"xy"), (2, 30.0, 40.0, "b", b"z")], dtype=dtype)
+    points = read(tmp_path, "p.npy", npy_bytes(array))
+    np.testing.assert_array_equal(points.xy, [[20, 10], [40, 30]])
+    assert points.properties(0) == {"id": 1, "name": "a", "code": "xy"}
+    chosen = read(tmp_path, "q.npy", npy_bytes(array), x="id", y="lon")
+    np.testing.assert_array_equal(chosen.xy, [[1, 20], [2, 40]])
+
+
+def test_npy_structured_without_names_takes_first_numeric_fields(tmp_path):
+    array = np.array([("a", 1.0, 2.0)], dtype=[("s", "U2"), ("e", "f8"), ("n", "f8")])
+    points = read(tmp_path, "p.npy", npy_bytes(array))
+    np.testing.assert_array_equal(points.xy, [[1, 2]])
+    assert points.properties(0) == {"s": "a"}
+
+
+# ---------------------------------------------------------------------------
+# standard input and format detection
+
+
+@pytest.mark.parametrize(
+    "data, expected",
+    [
+        (b"x,y\n1,2\n3,4\n", [[1, 2], [3, 4]]),
+        (b"# comment, with a comma\n1 2\n3 4\n", [[1, 2], [3, 4]]),
+        (b"\n\n  1,2\n", [[1, 2]]),
+        (b"  " + collection(feature({"type": "Point", "coordinates": [1, 2]})).encode(), [[1, 2]]),
+        (npy_bytes(np.array([[1.0, 2.0]])), [[1, 2]]),
+    ],
+)
+def test_stdin_detects_the_format(monkeypatch, data, expected):
+    monkeypatch.setattr(sys, "stdin", FakeStdin(data))
+    points = read_points("-")
+    assert points.source == "<stdin>"
+    np.testing.assert_array_equal(points.xy, expected)
+
+
+def test_stdin_with_explicit_format(monkeypatch):
+    monkeypatch.setattr(sys, "stdin", FakeStdin(b"1,2\n3,4\n"))
+    # as text, "1,2" is one field that is not a number: line 1 reads as a header
+    with pytest.raises(InputFileError, match=r"<stdin>, line 2: cannot find the x and y columns"):
+        read_points("-", fmt="text")
+    monkeypatch.setattr(sys, "stdin", FakeStdin(b"1,2\n3,4\n"))
+    np.testing.assert_array_equal(read_points("-", fmt="csv").xy, [[1, 2], [3, 4]])
+
+
+@pytest.mark.parametrize(
+    "name, content, fmt, expected",
+    [
+        ("p.in", "1,2\n", None, [[1, 2]]),
+        ("p.in", "1 2\n", None, [[1, 2]]),
+        ("p", '{"type": "Point", "coordinates": [1, 2]}', None, [[1, 2]]),
+        ("p.txt", "x,y\n1,2\n", "csv", [[1, 2]]),
+        ("p.csv", "1 2\n", "text", [[1, 2]]),
+    ],
+)
+def test_format_detection_and_override(tmp_path, name, content, fmt, expected):
+    np.testing.assert_array_equal(read(tmp_path, name, content, fmt=fmt).xy, expected)
+
+
+def test_npy_detected_by_content(tmp_path):
+    points = read(tmp_path, "points.bin", npy_bytes(np.array([[1.0, 2.0]])))
+    np.testing.assert_array_equal(points.xy, [[1, 2]])
+
+
+def test_properties_index_range(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,a\n1,2,3\n4,5,6\n")
+    assert points.properties(-1) == {"a": 6}
+    with pytest.raises(IndexError, match="site 2 out of range for 2 sites"):
+        points.properties(2)
+
+
+# ---------------------------------------------------------------------------
+# the fast bulk path and the slow line-by-line path agree
+
+
+CELL_TEXT = st.text(alphabet="abcXY01-.e ", min_size=1, max_size=6).filter(
+    # a coordinate name as a value of the first row makes it a header (see test_header_detection)
+    lambda s: s.strip() and s.strip().lower() not in readers.X_NAMES + readers.Y_NAMES
+)
+FLOATS = st.floats(allow_nan=False, allow_infinity=False, width=64)
+CELLS = st.one_of(
+    st.integers(-(10**20), 10**20).map(str),
+    FLOATS.map(repr),
+    CELL_TEXT,
+    st.sampled_from(["", "nan", "inf", "1_000", "007", "+5", "1e5", ".5", "5."]),
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    kind=st.sampled_from(["csv", "text"]),
+    header=st.booleans(),
+    xy=st.lists(st.tuples(FLOATS, FLOATS), min_size=1, max_size=12),
+    n_extra=st.integers(0, 3),
+    data=st.data(),
+)
+def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
+    extras = [
+        [data.draw(CELLS) for _ in range(n_extra)] for _ in xy
+    ]
+    if kind == "text":
+        # text fields cannot be empty or hold spaces
+        extras = [[c.replace(" ", "_") or "-" for c in row] for row in extras]
+    rows = [[repr(a), repr(b), *row] for (a, b), row in zip(xy, extras)]
+    names = ["x", "y"] + [f"e{j}" for j in range(n_extra)]
+    if kind == "csv":
+        out = io.StringIO()
+        csv.writer(out, lineterminator="\n").writerows(([names] if header else []) + rows)
+        text = out.getvalue()
+    else:
+        text = "\n".join(" ".join(r) for r in ([names] if header else []) + rows) + "\n"
+    layout = readers._table_layout(text, "t", kind, None, None)
+    slow = readers._slow_table(text, "t", kind, layout)
+    np.testing.assert_array_equal(slow.xy, np.array(xy, dtype=np.float64).reshape(-1, 2))
+    body = text[readers._line_offset(text, layout.header_lines):]
+    fast = readers._fast_table(body, kind, layout)
+    assert fast is not None
+    np.testing.assert_array_equal(fast[0], slow.xy)
+    assert fast[1] == slow.columns
+    # the public entry gives the same
+    points = readers._read_table(text, "t", kind, None, None)
+    np.testing.assert_array_equal(points.xy, slow.xy)
+    assert points.columns == slow.columns
+    for column in slow.columns.values():
+        for value in column:
+            assert value is None or type(value) in (int, float, str)
+            assert not (type(value) is float and not math.isfinite(value))
+
+
+# ---------------------------------------------------------------------------
+# errors: each names the file, the place and the fix
+
+
+def test_missing_file(tmp_path):
+    path = tmp_path / "nope.csv"
+    with pytest.raises(InputFileError, match=r"nope\.csv: no such file"):
+        read_points(path)
+
+
+def test_directory(tmp_path):
+    with pytest.raises(InputFileError, match=r"is a directory, not a point file"):
+        read_points(tmp_path)
+
+
+def test_unreadable_file(tmp_path, monkeypatch):
+    path = write(tmp_path, "locked.csv", "x,y\n1,2\n")
+
+    def refuse(self):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "read_bytes", refuse)
+    with pytest.raises(InputFileError, match=r"locked\.csv: permission denied"):
+        read_points(path)
+
+
+@pytest.mark.parametrize(
+    "name, content, expected",
+    [
+        ("empty.csv", "", r"empty\.csv: no points found \(the file is empty\)"),
+        ("blank.csv", "\n  \n\n", r"blank\.csv: no points found"),
+        ("header.csv", "x,y\n\n", r"header\.csv: no points found \(the file has only a header, line 1\)"),
+        ("comments.txt", "# nothing\n\n# here\n", r"comments\.txt: no points found"),
+        ("empty.geojson", "", r"empty\.geojson: no points found"),
+        ("empty.npy", b"", r"empty\.npy: no points found"),
+    ],
+)
+def test_no_points(tmp_path, name, content, expected):
+    with pytest.raises(InputFileError, match=expected):
+        read(tmp_path, name, content)
+
+
+def test_geojson_without_point_features(tmp_path):
+    message = error(tmp_path, "p.geojson", collection())
+    assert "p.geojson: no points found" in message
+
+
+def test_npy_with_zero_rows(tmp_path):
+    assert "no points found" in error(tmp_path, "p.npy", npy_bytes(np.zeros((0, 2))))
+
+
+@pytest.mark.parametrize(
+    "content, expected",
+    [
+        ("x,y\n1,2\n3,4\n5,nan\n", "points.csv, line 4: y is nan; tvoronoi needs finite coordinates"),
+        ("x,y\n1,2\n-inf,4\n", "points.csv, line 3: x is -inf; tvoronoi needs finite coordinates"),
+        ("x,y,a\n1,2,3\n1e999,4,5\n", "points.csv, line 3: x is 1e999 (it overflows to infinity)"),
+        ("lat,lon\n1,2\nNaN,4\n", 'points.csv, line 3: y (column "lat") is NaN'),
+    ],
+)
+def test_non_finite_coordinates(tmp_path, content, expected):
+    assert expected in error(tmp_path, "points.csv", content)
+
+
+def test_non_finite_in_text_npy_and_geojson(tmp_path):
+    assert "p.txt, line 2: y is inf" in error(tmp_path, "p.txt", "# c\n1 inf\n")
+    array = np.array([[1.0, 2.0], [3.0, 4.0], [np.nan, 5.0]])
+    assert "p.npy, row 2 (0-based): x is nan" in error(tmp_path, "p.npy", npy_bytes(array))
+    nan_json = '{"type": "FeatureCollection", "features": [\n' + json.dumps(
+        feature({"type": "Point", "coordinates": [1, 2]})
+    ) + ',\n{"type": "Feature", "geometry": {"type": "Point", "coordinates": [NaN, 1]}}]}'
+    message = error(tmp_path, "p.geojson", nan_json)
+    # orjson refuses NaN while parsing (line 3); the json module parses it and the
+    # finiteness check names the feature
+    assert "p.geojson" in message
+    assert "line 3" in message or "features[1]: x is nan" in message
+
+
+def test_non_finite_geojson_from_the_json_module(monkeypatch):
+    doc = {"type": "FeatureCollection", "features": [
+        feature({"type": "Point", "coordinates": [1, 2]}),
+        feature({"type": "MultiPoint", "coordinates": [[1, 2], [3, float("inf")]]}),
+    ]}
+    monkeypatch.setattr(readers, "_loads_json", lambda data, source: doc)
+    monkeypatch.setattr(sys, "stdin", FakeStdin(b"{}"))
+    with pytest.raises(InputFileError, match=r"<stdin>, features\[1\], point 1: y is inf; tvoronoi needs finite"):
+        read_points("-")
+
+
+@pytest.mark.parametrize(
+    "name, content, expected",
+    [
+        ("r.csv", "x,y,z\n1,2,3\n4,5\n", "r.csv, line 3: 2 fields, but the header has 3 (x, y, z)"),
+        ("r.csv", "x,y\n1,2\n4,5,6\n", "r.csv, line 3: 3 fields, but the header has 2 (x, y)"),
+        ("r.csv", "1,2,3\n\n4,5\n", "r.csv, line 3: 2 fields, but the first row (line 1) has 3"),
+        ("r.txt", "1 2\n# c\n3\n", "r.txt, line 3: 1 field, but the first row (line 1) has 2"),
+        ("r.txt", "1 2 a\n3 4 b c\n", "r.txt, line 2: 4 fields, but the first row (line 1) has 3"),
+    ],
+)
+def test_ragged_rows(tmp_path, name, content, expected):
+    assert expected in error(tmp_path, name, content)
+
+
+@pytest.mark.parametrize(
+    "name, content, expected",
+    [
+        ("points.csv", "x,y\n1,2\n3,4\n5,6\n7,8\n9,10\n11,abc\n",
+         'points.csv, line 7: "abc" in column "y" is not a number'),
+        ("points.csv", "id,lon,lat,name\n1,2,3,a\n2,,3,b\n",
+         'points.csv, line 3: "" in column "lon" (x) is not a number'),
+        ("points.txt", "1 2\n3 4\n\n5 six\n", 'points.txt, line 4: "six" in column "col2" (y) is not a number'),
+        ("points.csv", 'x,y\n"1,5",2\n', 'points.csv, line 2: "1,5" in column "x" is not a number'),
+    ],
+)
+def test_text_where_a_number_belongs(tmp_path, name, content, expected):
+    message = error(tmp_path, name, content)
+    assert expected in message
+    assert "--x/--y" in message
+
+
+def test_chosen_column_that_does_not_exist(tmp_path):
+    message = error(tmp_path, "p.csv", "id,east,north\n1,2,3\n", x="lon", y="north")
+    assert 'p.csv: no column "lon" for x' in message
+    assert "0:id, 1:east, 2:north" in message
+    message = error(tmp_path, "p.csv", "1,2,3\n", y=5)
+    assert "p.csv: no column 5 for y; the file has 3 columns" in message
+    assert "0:col1, 1:col2, 2:col3" in message
+    message = error(tmp_path, "p.npy", npy_bytes(np.zeros((2, 2))), x="x")
+    assert 'p.npy: no column "x" for x' in message
+
+
+def test_same_column_for_x_and_y(tmp_path):
+    with pytest.raises(TvoronoiError, match=r'x and y are the same column "b"'):
+        read(tmp_path, "p.csv", "a,b\n1,2\n", x="b", y=1)
+
+
+def test_too_few_numeric_columns(tmp_path):
+    message = error(tmp_path, "p.csv", "name,value\na,1\n")
+    assert "p.csv, line 2: cannot find the y column" in message
+    assert "choose them with --x/--y" in message
+
+
+def test_not_utf8(tmp_path):
+    message = error(tmp_path, "p.csv", b"x,y,name\n1,2,a\n3,4,Z\xfcrich\n")
+    assert "p.csv, line 3: byte 0xfc is not valid UTF-8; save the file as UTF-8" in message
+
+
+def test_broken_json_names_line_and_column(tmp_path):
+    message = error(tmp_path, "p.geojson", '{"type": "FeatureCollection",\n  "features": [,]}')
+    assert "p.geojson, line 2, column 16: broken JSON" in message
+
+
+@pytest.mark.parametrize(
+    "content, expected",
+    [
+        (collection(feature({"type": "Point", "coordinates": [0, 0]}),
+                    feature({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [0, 1], [0, 0]]]})),
+         'p.geojson, features[1]: geometry type "Polygon" is not a point'),
+        (collection(feature(None)), "p.geojson, features[0]: the geometry is null"),
+        (collection(feature({"type": "Point", "coordinates": [1]})),
+         "p.geojson, features[0]: coordinates [1] are not a position"),
+        (collection(feature({"type": "Point", "coordinates": ["1", 2]})),
+         "p.geojson, features[0]: coordinates ['1', 2] are not a position"),
+        (collection(feature({"type": "MultiPoint", "coordinates": [[1, 2], [True, 3]]})),
+         "p.geojson, features[0], point 1: coordinates [True, 3] are not a position"),
+        (collection(feature({"type": "Point", "coordinates": [1, 2]}, [1])),
+         'p.geojson, features[0]: "properties" is a list'),
+        (collection(5), "p.geojson, features[0]: not a Feature object but a number"),
+        ('{"type": "FeatureCollection"}', 'p.geojson: the FeatureCollection has no "features" list'),
+        ("[[1, 2]]", "p.geojson: not GeoJSON: expected a FeatureCollection"),
+        ('{"type": "LineString", "coordinates": [[0, 0], [1, 1]]}',
+         "p.geojson: the file is a single LineString geometry"),
+        (json.dumps(feature({"type": "GeometryCollection", "geometries": []})),
+         'p.geojson, the feature: geometry type "GeometryCollection" is not a point'),
+    ],
+)
+def test_geojson_errors(tmp_path, content, expected):
+    assert expected in error(tmp_path, "p.geojson", content)
+
+
+def test_geojson_rejects_column_choice(tmp_path):
+    path = write(tmp_path, "p.geojson", json.dumps({"type": "Point", "coordinates": [1, 2]}))
+    with pytest.raises(TvoronoiError, match=r"--x/--y choose table columns"):
+        read_points(path, x="lon")
+
+
+@pytest.mark.parametrize(
+    "array, expected",
+    [
+        (np.zeros(4), r"shape \(4,\); tvoronoi needs \(n, 2\)"),
+        (np.zeros((3, 1)), r"shape \(3, 1\)"),
+        (np.zeros((2, 2, 2)), r"shape \(2, 2, 2\)"),
+        (np.zeros((3, 2), dtype=complex), r"dtype complex128 is not a number type"),
+        (np.zeros((3, 2), dtype=bool), r"dtype bool is not a number type"),
+        (np.array([["a", "b"]]), r"dtype <U1 is not a number type"),
+        (np.array([[1, None]], dtype=object), r"holds Python objects \(dtype object\)"),
+        (np.zeros(2, dtype=[("s", "U2"), ("t", "U2")]), r"cannot find the x and y fields among s, t"),
+        (np.zeros((2, 2), dtype=[("x", "f8"), ("y", "f8")]), r"a structured array of shape \(2, 2\)"),
+    ],
+)
+def test_npy_wrong_shape_or_dtype(tmp_path, array, expected):
+    with pytest.raises(InputFileError, match=r"p\.npy: .*" + expected):
+        read(tmp_path, "p.npy", npy_bytes(array))
+
+
+def test_npy_structured_text_field_chosen(tmp_path):
+    array = np.zeros(2, dtype=[("x", "f8"), ("y", "U3")])
+    assert 'field "y" has dtype <U3, not a number' in error(tmp_path, "p.npy", npy_bytes(array))
+
+
+def test_npy_that_is_not_npy(tmp_path):
+    assert "p.npy: not a .npy file" in error(tmp_path, "p.npy", b"x,y\n1,2\n")
+    truncated = npy_bytes(np.zeros((100, 2)))[:-40]
+    assert "p.npy: broken .npy file" in error(tmp_path, "p.npy", truncated)
+
+
+def test_unknown_format():
+    with pytest.raises(TvoronoiError, match=r"unknown format 'xlsx'; choose one of: csv, text, geojson, npy"):
+        read_points("p.xlsx", fmt="xlsx")
+
+
+def test_unterminated_quote(tmp_path):
+    # the quote swallows the rest of the file into one field of the row on line 3
+    message = error(tmp_path, "q.csv", 'x,y\n1,2\n"3,4\n5,6\n')
+    assert "q.csv, line 3: 1 field (a quote opened here is not closed), but the header has 2" in message
+
+
+def test_control_characters_are_shown_escaped(tmp_path):
+    message = error(tmp_path, "p.csv", "x,y\n1,2\n3,4\x00\n")
+    assert 'p.csv, line 3: "4\\u0000" in column "y" is not a number' in message
