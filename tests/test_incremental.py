@@ -160,3 +160,13 @@ def test_property_degenerate_integer_sets(points, insertion):
     d = tvoronoi.voronoi(pts, insertion=insertion)
     validate(d)
     assert_matches_oracle(d)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_vertex_on_the_box_edge_leaves_no_spike(engine):
+    """The vertex of (0,0), (0,1), (0.4,0.6) is exactly (-0.1, 0.5), on the default box's
+    left side, and computes to -0.09999999999999995: the cell must stay simple."""
+    pts = np.array([[0, 0], [1, 0], [0, 1], [1, 1], [1, 1], [0.4, 0.6]], float)
+    d = tvoronoi.voronoi(pts, engine=engine)
+    validate(d)
+    assert_matches_oracle(d)

@@ -100,22 +100,34 @@ def fortune_dcel(xs: np.ndarray, ys: np.ndarray):
 
 def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int) -> Diagram:
     """Build the Diagram of checked points (n, 2) in the checked box."""
-    n = len(pts)
     e = power_of_two_scale(pts, box)
     xs = np.ldexp(pts[:, 0], -e)
     ys = np.ldexp(pts[:, 1], -e)
-    sbox = tuple(math.ldexp(v, -e) for v in box)
-
     if engine == "incremental":
         perm, exs, eys, out = incremental_dcel(xs, ys, insertion=insertion, seed=seed)
     else:
         perm, exs, eys, out = fortune_dcel(xs, ys)
+    return assemble(pts, box, e, perm, exs, eys, out, engine=engine)
 
+
+def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None) -> Diagram:
+    """Clip an engine's DCEL and map it back to input rows.
+
+    Parameters
+    ----------
+    pts : (n, 2) the input points; box : the box, unscaled; e : the scale exponent
+    perm : (n,) engine site k is input row perm[k]; exs, eys : scaled sites in engine order
+    out : the engine's DCEL dict (with ``dup``)
+    present : (n,) bool in engine order, optional -- sites already in the
+        diagram (the step trace shows diagrams of the first sites only)
+    """
+    n = len(pts)
+    sbox = tuple(math.ldexp(v, -e) for v in box)
     dup = out["dup"]
-    active = (dup < 0).astype(np.int8)
+    first = dup < 0 if present is None else (dup < 0) & present
     points, offsets, ring = clip.clip_cells(
         exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"],
-        out["he_face"], out["face_edge"], active, sbox,
+        out["he_face"], out["face_edge"], first.astype(np.int8), sbox,
     )
 
     # the cell of a repeated point belongs to the first input row at that place
@@ -129,7 +141,7 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     # cells to input rows (CSR gather)
     lengths = np.diff(offsets)
     cell_of_row = np.full(n, -1, np.int64)           # engine site whose cell row r shows
-    firsts = np.flatnonzero(active)
+    firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
     row_len = np.where(cell_of_row >= 0, lengths[np.maximum(cell_of_row, 0)], 0)
     cell_offsets = np.zeros(n + 1, np.int64)

@@ -3,7 +3,7 @@
 import numpy as np
 
 from libc.stdint cimport int32_t, int64_t
-from libc.math cimport atan2, fabs, INFINITY
+from libc.math cimport atan2, fabs, sqrt, INFINITY
 
 # A clipped point closer than this fraction of the box size to a box corner
 # becomes that corner, so that the corner is not emitted twice by rounding.
@@ -43,7 +43,7 @@ cdef inline bint clip_param(double p, double q, double* t0, double* t1) noexcept
 
 
 cdef inline void on_box(Box* box, double* x, double* y) noexcept nogil:
-    """Put a clipped point exactly on the box: clamp, then snap to a near corner."""
+    """Put a point exactly on or in the box: clamp, then snap each coordinate within rounding of a side onto it."""
     if x[0] < box.xmin: x[0] = box.xmin
     if x[0] > box.xmax: x[0] = box.xmax
     if y[0] < box.ymin: y[0] = box.ymin
@@ -101,10 +101,16 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
 
     with nogil:
         for v in range(m):
-            pts[v, 0] = vertices[v, 0]
-            pts[v, 1] = vertices[v, 1]
-            inside[v] = (box.xmin <= vertices[v, 0] <= box.xmax
-                         and box.ymin <= vertices[v, 1] <= box.ymax)
+            # a vertex within rounding of the box counts as inside, put exactly on its edge,
+            # so that no sliver of an edge (or a near-copy of the vertex) is left on the boundary
+            x = vertices[v, 0]
+            y = vertices[v, 1]
+            inside[v] = (box.xmin - box.snap <= x <= box.xmax + box.snap
+                         and box.ymin - box.snap <= y <= box.ymax + box.snap)
+            if inside[v]:
+                on_box(&box, &x, &y)
+            pts[v, 0] = x
+            pts[v, 1] = y
 
         # clip each edge once, along the half-edge of smaller index
         for h in range(n_he):
@@ -131,9 +137,9 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             lo = -INFINITY
             hi = INFINITY
             if o >= 0:
-                lo = ((vertices[o, 0] - bx) * dx + (vertices[o, 1] - by) * dy) / (dx * dx + dy * dy)
+                lo = ((pts[o, 0] - bx) * dx + (pts[o, 1] - by) * dy) / (dx * dx + dy * dy)
             if d >= 0:
-                hi = ((vertices[d, 0] - bx) * dx + (vertices[d, 1] - by) * dy) / (dx * dx + dy * dy)
+                hi = ((pts[d, 0] - bx) * dx + (pts[d, 1] - by) * dy) / (dx * dx + dy * dy)
             t0 = lo
             t1 = hi
             if not (clip_param(-dx, bx - box.xmin, &t0, &t1)
@@ -141,8 +147,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                     and clip_param(-dy, by - box.ymin, &t0, &t1)
                     and clip_param(dy, box.ymax - by, &t0, &t1)):
                 continue
-            if not t0 < t1:
-                continue          # the edge only touches the box
+            if (t1 - t0) * sqrt(dx * dx + dy * dy) <= box.snap:
+                continue          # the edge only touches the box (up to rounding)
             # an end inside the box is the vertex itself, shared with its other edges
             if o >= 0 and inside[o]:
                 seg_start[h] = o

@@ -51,6 +51,10 @@ cdef struct Mesh:
     int32_t* next_site  #   and the next one in the same list
     int32_t* where      #   and the triangle each waiting site is listed under (-1 once inserted)
     int32_t* dup        # per site: the earlier site at the same place, or -1
+    int32_t* trace_cav  # step trace only (else NULL): the last cavity's triangles, as vertex triples
+    int trace_n_cav
+    int32_t* trace_new  #   and the slots of the triangles that replaced them
+    int trace_n_new
     int n
     int inf
     int n_tri
@@ -187,6 +191,15 @@ cdef void insert_site(Mesh* m, int i, int t0) noexcept nogil:
             m.head[t] = -1
         m.where[i] = -1
 
+    if m.trace_cav != NULL:
+        for q in range(n_cav):
+            t = m.cavity[q]
+            m.trace_cav[3 * q] = m.tv[3 * t]
+            m.trace_cav[3 * q + 1] = m.tv[3 * t + 1]
+            m.trace_cav[3 * q + 2] = m.tv[3 * t + 2]
+        m.trace_n_cav = n_cav
+        m.trace_n_new = n_bnd
+
     # fan the boundary to i, reusing the cavity's slots first
     for q in range(n_bnd):
         if q < n_cav:
@@ -204,6 +217,8 @@ cdef void insert_site(Mesh* m, int i, int t0) noexcept nogil:
         m.opp[o] = 3 * T
         m.vmap[a] = T
         m.bnd_twin[q] = T           # remember the slot for the linking pass
+        if m.trace_new != NULL:
+            m.trace_new[q] = T
         if a != m.inf and b != m.inf:
             m.last = T
     # link the fan: edge b->i of one new triangle is the twin of i->b of the next
@@ -220,10 +235,12 @@ cdef void insert_site(Mesh* m, int i, int t0) noexcept nogil:
         pending = s_next
 
 
-cdef int build(Mesh* m, int32_t* order) noexcept nogil:
+cdef int build(Mesh* m, int32_t* order, int stop_after) noexcept nogil:
     """Triangulate the sites in the given insertion order (modified: the first
-    three become a non-degenerate triangle). Returns a status code."""
-    cdef int n = m.n, k = 1, a, b, c, tmp, q, t, s
+    three become a non-degenerate triangle), stopping after stop_after sites
+    when it is not negative. Returns a status code."""
+    cdef int n = m.n, k = 1, a, b, c, tmp, q, t, s, end
+    end = n if stop_after < 0 or stop_after > n else stop_after
     a = order[0]
     # degenerate case: leading repeats of the first site
     while k < n and m.x[order[k]] == m.x[a] and m.y[order[k]] == m.y[a]:
@@ -270,17 +287,18 @@ cdef int build(Mesh* m, int32_t* order) noexcept nogil:
         for q in range(3, n):
             s = order[q]
             list_site(m, locate(m, 0, m.x[s], m.y[s]), s)
-        for q in range(3, n):
+        for q in range(3, end):
             s = order[q]
             insert_site(m, s, m.where[s])
     else:
-        for q in range(3, n):
+        for q in range(3, end):
             s = order[q]
             insert_site(m, s, locate(m, m.last, m.x[s], m.y[s]))
     return OK
 
 
-def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=False):
+def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=False,
+                int stop_after=-1):
     """Delaunay triangulation of sites inserted in their given order.
 
     Give the sites in insertion order: numbering them that way keeps a walk's
@@ -293,6 +311,11 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     conflict_lists : bool
         Locate each site through conflict lists (the textbook variant, for a
         fully random order) instead of walking from the last new triangle.
+    stop_after : int
+        For the step trace: stop once this many sites are processed (-1: all).
+        The result then also has a dict ``trace``: ``order`` (the insertion
+        order used), ``cavity`` (the vertex triples of the triangles the last
+        site destroyed) and ``fan`` (the triangles that replaced them).
 
     Returns
     -------
@@ -341,16 +364,34 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
         m.next_site = &next_site[0]
         m.where = &where[0]
     m.dup = &dup[0]
+    m.trace_cav = NULL
+    m.trace_new = NULL
+    m.trace_n_cav = 0
+    m.trace_n_new = 0
+    cdef int32_t[::1] trace_cav, trace_new
+    if stop_after >= 0:
+        trace_cav = np.empty(3 * max_tri, np.int32)
+        trace_new = np.empty(max_tri + 2, np.int32)
+        m.trace_cav = &trace_cav[0]
+        m.trace_new = &trace_new[0]
     m.n = n
     m.inf = n
     m.n_tri = 0
     m.last = 0
     cdef int status
     with nogil:
-        status = build(&m, &order[0])
+        status = build(&m, &order[0], stop_after)
     if status != STATUS_OK:
         return status, np.empty(0, np.int32), np.empty(0, np.int32), np.asarray(dup)
-    return status, np.asarray(tv)[:3 * m.n_tri], np.asarray(opp)[:3 * m.n_tri], np.asarray(dup)
+    result = (status, np.asarray(tv)[:3 * m.n_tri], np.asarray(opp)[:3 * m.n_tri], np.asarray(dup))
+    if stop_after >= 0:
+        trace = {
+            "order": np.asarray(order),
+            "cavity": np.asarray(trace_cav)[:3 * m.trace_n_cav].reshape(-1, 3).copy(),
+            "fan": np.asarray(trace_new)[:m.trace_n_new].copy(),
+        }
+        return result + (trace,)
+    return result
 
 
 cdef inline uint32_t hilbert_key(uint32_t x, uint32_t y, int bits) noexcept nogil:

@@ -1,0 +1,346 @@
+"""The console script: `tvoronoi` starts the terminal UI, `tvoronoi batch` writes GeoJSON cells."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import sys
+from contextlib import contextmanager
+
+from tvoronoi import __version__
+from tvoronoi.api import ENGINES, INSERTION_ORDERS
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.readers import FORMATS
+
+PROG = "tvoronoi"
+STDIO = "-"
+# inputs this large show a progress display (on a terminal, without -q)
+PROGRESS_MIN_POINTS = 200_000
+PROGRESS_MIN_BYTES = 4 << 20  # a CSV of about 200,000 points
+EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+BATCH_EPILOG = """\
+output:
+  OUTPUT is an RFC 7946 FeatureCollection: one Polygon per distinct site, in
+  input order, with properties {"site": ROW, ...the row's other columns} and
+  "duplicates": [ROWS] where later rows repeat the site. A cell that misses
+  a --bbox leaving its site outside has "geometry": null.
+
+  An existing OUTPUT or --delaunay FILE is not replaced unless --force is
+  given, and then only by renaming a complete new file over it: a failed run
+  leaves every existing file as it was, and no half-written file behind.
+
+  A progress display appears on stderr for inputs of 200,000 points or more
+  when stderr is a terminal and -q is not given.
+
+exit status:
+  0    success (warnings may have been printed)
+  1    an output could not be written (disk full, permission denied, ...)
+  2    bad input or options: unreadable or malformed point file, bad --bbox,
+       unknown or unavailable engine, an existing output without --force
+  130  interrupted
+"""
+
+
+class OutputError(Exception):
+    """An output that could not be written; the message names it."""
+
+
+def parse_bbox(text: str) -> tuple[float, float, float, float]:
+    """Parse ``--bbox XMIN,YMIN,XMAX,YMAX``; errors name the value given.
+
+    >>> parse_bbox("-1,0,2.5,1e3")
+    (-1.0, 0.0, 2.5, 1000.0)
+    """
+    parts = [part.strip() for part in text.split(",")]
+    if len(parts) != 4:
+        raise TvoronoiError(
+            f"--bbox {text!r}: expected four numbers XMIN,YMIN,XMAX,YMAX separated by commas, got {len(parts)}"
+        )
+    values = []
+    for part in parts:
+        try:
+            value = float(part)
+        except ValueError:
+            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a number; expected XMIN,YMIN,XMAX,YMAX") from None
+        if not math.isfinite(value):
+            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a finite number")
+        values.append(value)
+    xmin, ymin, xmax, ymax = values
+    if not (xmin < xmax and ymin < ymax):
+        raise TvoronoiError(f"--bbox {text!r}: the box is empty; it needs XMIN < XMAX and YMIN < YMAX")
+    return xmin, ymin, xmax, ymax
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="Exact, fast 2D Voronoi diagrams. Without a command, tvoronoi starts the terminal UI.",
+    )
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    batch = commands.add_parser(
+        "batch",
+        help="write the Voronoi cells of a point file as GeoJSON",
+        description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON.",
+        epilog=BATCH_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    batch.add_argument("input", metavar="INPUT", help='point file (CSV, text, GeoJSON or .npy), or "-" for stdin')
+    batch.add_argument("-o", "--output", required=True, metavar="OUTPUT",
+                       help='GeoJSON file of the cells, or "-" for stdout')
+    batch.add_argument("--engine", choices=ENGINES, default="incremental", help="default: %(default)s")
+    batch.add_argument("--bbox", metavar="XMIN,YMIN,XMAX,YMAX",
+                       help="the box bounding the cells; default: the points' bounding box grown by 10%% "
+                            "of its larger side on every side")
+    batch.add_argument("--delaunay", metavar="FILE",
+                       help='also write the Delaunay triangles as GeoJSON ("-" for stdout)')
+    batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
+    batch.add_argument("--y", metavar="COL", help="y column of a table: a name, a 0-based index or colN")
+    batch.add_argument("--format", choices=FORMATS, help="input format; default: from the extension, else the content")
+    batch.add_argument("--insertion", choices=INSERTION_ORDERS, default="brio",
+                       help="incremental engine: insertion order (default: %(default)s)")
+    batch.add_argument("--seed", type=int, default=0, help="seed of the insertion order (default: %(default)s)")
+    batch.add_argument("-q", "--quiet", action="store_true", help="no progress display and no warnings")
+    batch.add_argument("--force", action="store_true", help="replace an existing OUTPUT or --delaunay FILE")
+    return parser
+
+
+def _join_bbox(argv: list[str]) -> list[str]:
+    """Turn "--bbox VALUE" into "--bbox=VALUE", so that a negative XMIN is not taken for an option."""
+    out: list[str] = []
+    tokens = iter(argv)
+    for token in tokens:
+        if token == "--":
+            out.append(token)
+            out.extend(tokens)
+            break
+        if token == "--bbox":
+            value = next(tokens, None)
+            out.append(token if value is None else f"--bbox={value}")
+        else:
+            out.append(token)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the console script with ``argv`` (default: ``sys.argv[1:]``) and return the exit status."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        args = build_parser().parse_args(_join_bbox(argv))
+    except SystemExit as e:  # --help, --version, usage errors
+        return e.code if isinstance(e.code, int) else EXIT_USAGE
+    if args.command is None:
+        return run_tui()
+    return run_batch(args)
+
+
+def run_tui() -> int:
+    try:
+        from tvoronoi.tui.app import main as tui_main
+    except ImportError as e:
+        print(f"{PROG}: error: the terminal UI cannot start: {e}", file=sys.stderr)
+        return EXIT_FAILURE
+    status = tui_main()
+    return status if isinstance(status, int) else EXIT_OK
+
+
+def run_batch(args) -> int:
+    """Read, build and write; map every expected failure to a one-line message and an exit status."""
+    phases = Phases(enabled=not args.quiet and sys.stderr.isatty())
+    try:
+        with _terminate_as_exit(), phases:
+            return _batch(args, phases)
+    except TvoronoiError as e:
+        _error(str(e))
+        return EXIT_USAGE
+    except OutputError as e:
+        if str(e):
+            _error(str(e))
+        return EXIT_FAILURE
+    except MemoryError:
+        _error("out of memory; try fewer points or a machine with more memory")
+        return EXIT_FAILURE
+    except KeyboardInterrupt:
+        _error("interrupted")
+        return EXIT_INTERRUPTED
+
+
+def _batch(args, phases: Phases) -> int:
+    import numpy as np
+
+    from tvoronoi import geojson
+    from tvoronoi.api import voronoi
+    from tvoronoi.readers import read_points
+
+    bbox = None if args.bbox is None else parse_bbox(args.bbox)
+    names = [name for name in (args.output, args.delaunay) if name is not None]
+    if names.count(STDIO) > 1:
+        raise TvoronoiError('-o and --delaunay cannot both be "-": stdout takes one of them')
+    if len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1]):
+        raise TvoronoiError(f"-o and --delaunay name the same file {names[0]}; choose two names")
+    options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
+    # the engine and its options pass the API's own checks before a large file is read
+    voronoi(np.empty((0, 2)), **options)
+
+    outputs = {}
+    try:
+        # creating the temporary files now shows that they can be written, before any work
+        for name in names:
+            with _writing(name):
+                outputs[name] = geojson.output_file(name, overwrite=args.force)
+        if args.input != STDIO and _size(args.input) >= PROGRESS_MIN_BYTES:
+            phases.show()
+        with phases.phase("read") as done:
+            points = read_points(args.input, x=args.x, y=args.y, fmt=args.format)
+            done(f"{len(points):,} points")
+        if len(points) >= PROGRESS_MIN_POINTS:
+            phases.show()
+        with phases.phase("build") as done:
+            diagram = voronoi(points.xy, **options)
+            done(f"{len(diagram.triangles):,} triangles")
+
+        repeats = diagram.n_sites - int(np.count_nonzero(diagram.site_of == np.arange(diagram.n_sites)))
+        if repeats and not args.quiet:
+            phases.warn(
+                f"{repeats} repeated point{'s share' if repeats > 1 else ' shares'} the cell of an earlier "
+                f'point (see "duplicates" in the output)'
+            )
+        missing = len(geojson.missing_cells(diagram))
+        if missing and not args.quiet:
+            which = "cells miss the box (their sites lie" if missing > 1 else "cell misses the box (its site lies"
+            phases.warn(f'{missing} {which} outside --bbox): written with "geometry": null')
+
+        with phases.counter("write cells") as progress, _writing(args.output):
+            geojson.write_cells(diagram, points, outputs[args.output].file, progress=progress)
+        if args.delaunay is not None:
+            with phases.counter("write triangles") as progress, _writing(args.delaunay):
+                geojson.write_delaunay(diagram, outputs[args.delaunay].file, progress=progress)
+        for name, output in outputs.items():
+            with _writing(name):
+                output.commit()
+    except BaseException:
+        for output in outputs.values():
+            output.discard()
+        raise
+    return EXIT_OK
+
+
+def _size(path: str) -> int:
+    try:
+        return os.path.getsize(path)
+    except OSError:
+        return 0
+
+
+@contextmanager
+def _writing(name: str):
+    """Tell an OSError while creating, writing or renaming ``name`` as an OutputError naming it."""
+    try:
+        yield
+    except FileExistsError:
+        raise TvoronoiError(f"{name} exists: add --force to replace it, or choose another name") from None
+    except BrokenPipeError:
+        # the reader of stdout went away (e.g. `| head`): stop quietly, and keep Python
+        # from failing again when it flushes stdout at exit
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+        raise OutputError("") from None
+    except OSError as e:
+        where = "standard output" if name == STDIO else name
+        raise OutputError(f"cannot write {where}: {e.strerror or e}") from None
+
+
+@contextmanager
+def _terminate_as_exit():
+    """Turn SIGTERM into SystemExit while the batch runs, so that temporary files are removed."""
+
+    def terminate(signum, frame):
+        raise SystemExit(128 + signum)
+
+    try:
+        previous = signal.signal(signal.SIGTERM, terminate)
+    except ValueError:  # not the main thread: leave signals alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _error(message: str) -> None:
+    print(f"{PROG}: error: {message}", file=sys.stderr)
+
+
+class Phases:
+    """The phases read, build and write as a rich progress display on stderr, or nothing.
+
+    The display starts on :meth:`show` (when the input turns out to be large)
+    and only if it is enabled; until then phases run silently.
+    """
+
+    def __init__(self, *, enabled: bool):
+        self.enabled = enabled
+        self.progress = None
+
+    def __enter__(self) -> Phases:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.progress is not None:
+            self.progress.stop()
+
+    def show(self) -> None:
+        if not self.enabled or self.progress is not None:
+            return
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        self.progress = Progress(
+            SpinnerColumn(finished_text="[green]done"),
+            TextColumn("{task.description:<16}"),
+            BarColumn(),
+            TextColumn("{task.fields[detail]}"),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+        )
+        self.progress.start()
+
+    @contextmanager
+    def phase(self, label: str):
+        """A phase of unknown length; the block calls the yielded function with a summary."""
+        if self.progress is None:
+            yield lambda detail: None
+            return
+        task = self.progress.add_task(label, total=None, detail="")
+        yield lambda detail: self.progress.update(task, detail=detail)
+        self.progress.update(task, total=1, completed=1)
+
+    @contextmanager
+    def counter(self, label: str):
+        """A phase that counts; the block passes the yielded function as a progress(done, total) callback."""
+        if self.progress is None:
+            yield None
+            return
+        task = self.progress.add_task(label, total=None, detail="")
+
+        def progress(done: int, total: int) -> None:
+            self.progress.update(task, completed=done, total=total, detail=f"{done:,}/{total:,}")
+
+        yield progress
+        self.progress.update(task, total=1, completed=1)
+
+    def warn(self, message: str) -> None:
+        line = f"{PROG}: warning: {message}"
+        if self.progress is not None:
+            self.progress.console.print(line, markup=False, highlight=False)
+        else:
+            print(line, file=sys.stderr)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,438 @@
+"""GeoJSON out: Voronoi cells and Delaunay triangles, streamed in chunks and written atomically."""
+
+from __future__ import annotations
+
+import errno
+import gc
+import os
+import secrets
+import stat
+import sys
+from contextlib import contextmanager
+from typing import BinaryIO, Callable, Iterator
+
+import numpy as np
+import orjson
+
+from tvoronoi.errors import TvoronoiError
+
+__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT"]
+
+STDOUT = "-"
+# features serialized per orjson call: large enough to amortise numpy and orjson
+# calls, small enough that a chunk of text stays a few megabytes
+CHUNK_FEATURES = 10_000
+# a ring with fewer distinct points has no area; such a cell is written as null
+MIN_RING_POINTS = 3
+# property names tvoronoi writes itself; a site property of the same name is renamed
+RESERVED = ("site", "duplicates")
+TEMP_SUFFIX = ".tmp"
+NEW_FILE_MODE = 0o666  # before the umask, as open() would create it
+WRITE_BUFFER = 1 << 20
+
+ProgressCallback = Callable[[int, int], None]
+
+_OPT_NUMPY = orjson.OPT_SERIALIZE_NUMPY
+_CLOSE_BRACKET = ord("]")
+# one feature per line; %b are the ring's positions "[x,y],...,[x,y]" and the properties object
+_POLYGON = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":%b}'
+_NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
+_TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
+_SEPARATOR = b",\n"
+
+
+# ---------------------------------------------------------------------------
+# output files
+
+
+class AtomicFile:
+    """A binary file written under a temporary name beside its target, renamed into place on commit.
+
+    The temporary file ``.NAME.tvoronoi-XXXXXXXX.tmp`` lives in the target's
+    directory, so that ``os.replace`` is a rename within one file system: the
+    target either keeps its old content or gets the complete new one.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The target. A symbolic link is followed: the file it points to is replaced.
+    overwrite : bool
+        Replace an existing target; if False, ``FileExistsError`` is raised when the
+        target exists, on opening and again just before the rename.
+
+    Raises
+    ------
+    FileExistsError
+        The target exists and ``overwrite`` is False.
+    OSError
+        The directory is missing or not writable, or the target is a directory.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, overwrite: bool = True):
+        self.path = os.fspath(path)
+        self.target = os.path.realpath(self.path) if os.path.islink(self.path) else self.path
+        self.overwrite = overwrite
+        self.done = False
+        self._check_target()
+        directory, name = os.path.split(os.path.abspath(self.target))
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+        while True:
+            self.temp = os.path.join(directory, f".{name}.tvoronoi-{secrets.token_hex(4)}{TEMP_SUFFIX}")
+            try:
+                fd = os.open(self.temp, flags, NEW_FILE_MODE)
+            except FileExistsError:  # a name another run holds: draw again
+                continue
+            break
+        self.file: BinaryIO = os.fdopen(fd, "wb", buffering=WRITE_BUFFER)
+
+    def _check_target(self) -> None:
+        if os.path.isdir(self.target):
+            raise IsADirectoryError(errno.EISDIR, "is a directory", self.path)
+        if not self.overwrite and os.path.lexists(self.path):
+            raise FileExistsError(errno.EEXIST, "file exists", self.path)
+
+    def commit(self) -> None:
+        """Flush the data to disk and rename the file into place (keeping an old target's mode)."""
+        try:
+            self.file.flush()
+            os.fsync(self.file.fileno())
+            self.file.close()
+            self._check_target()
+            try:
+                os.chmod(self.temp, stat.S_IMODE(os.stat(self.target).st_mode))
+            except FileNotFoundError:
+                pass
+            os.replace(self.temp, self.target)
+        except BaseException:
+            self.discard()
+            raise
+        self.done = True
+
+    def discard(self) -> None:
+        """Close and remove the temporary file; the target is left as it was. No-op after commit."""
+        if self.done:
+            return
+        self.done = True
+        try:
+            self.file.close()
+        except OSError:
+            pass
+        try:
+            os.unlink(self.temp)
+        except FileNotFoundError:
+            pass
+
+
+class StdoutFile:
+    """Standard output with the interface of :class:`AtomicFile` (it cannot be atomic: commit flushes)."""
+
+    path = STDOUT
+
+    def __init__(self):
+        self.file: BinaryIO = sys.stdout.buffer
+
+    def commit(self) -> None:
+        self.file.flush()
+
+    def discard(self) -> None:
+        pass
+
+
+def output_file(out, *, overwrite: bool = True) -> AtomicFile | StdoutFile:
+    """An :class:`AtomicFile` for a path, a :class:`StdoutFile` for ``"-"``.
+
+    Write to ``.file``, then call ``.commit()`` on success or ``.discard()`` on failure.
+    """
+    if isinstance(out, str) and out == STDOUT:
+        return StdoutFile()
+    return AtomicFile(out, overwrite=overwrite)
+
+
+@contextmanager
+def open_output(out, *, overwrite: bool = True) -> Iterator[BinaryIO]:
+    """A binary stream for ``out``: a path (written atomically), ``"-"`` (stdout) or an open binary file.
+
+    A path is written through an :class:`AtomicFile`: it is renamed into place
+    when the block ends normally and removed when the block raises, so a
+    failure never leaves half a file and never touches an existing one.
+    Standard output is flushed at the end; an open file is used as it is.
+
+    Raises
+    ------
+    FileExistsError
+        If ``overwrite`` is False and the path exists.
+    OSError
+        If the file cannot be created or written.
+    """
+    if hasattr(out, "write"):
+        yield out
+        return
+    target = output_file(out, overwrite=overwrite)
+    try:
+        yield target.file
+    except BaseException:
+        target.discard()
+        raise
+    target.commit()
+
+
+@contextmanager
+def _gc_paused():
+    """Pause the cyclic garbage collector: a chunk's many small objects hold no cycles,
+    and collecting them over and over would cost more than the serialization."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+# ---------------------------------------------------------------------------
+# rings to JSON text
+
+
+def _ring_texts(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> tuple[memoryview, list, list]:
+    """Serialize closed rings in one orjson call and locate each ring in the text.
+
+    Parameters
+    ----------
+    xy : (p, 2) float64
+        The positions of all rings, one after the other, each ring closed.
+    first, last : (k,) int64
+        Ring k is ``xy[first[k]:last[k] + 1]``.
+
+    Returns
+    -------
+    text, starts, stops
+        ``text[starts[k]:stops[k]]`` is ring k as ``[x,y],...,[x,y]``; numbers are
+        orjson's shortest representation that reads back to the same float64.
+    """
+    text = orjson.dumps(np.ascontiguousarray(xy, dtype=np.float64), option=_OPT_NUMPY)
+    # "[[x,y],[x,y],...]": position j ends at the j-th "]" (numbers hold none); the last
+    # "]" closes the array
+    close = np.flatnonzero(np.frombuffer(text, np.uint8) == _CLOSE_BRACKET)[:-1]
+    open_ = np.empty(len(close), np.int64)
+    if len(close):
+        open_[0] = 1
+        open_[1:] = close[:-1] + 2  # after "],"
+    return memoryview(text), open_[first].tolist(), (close[last] + 1).tolist()
+
+
+def _closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Closed rings of the cells of rows a..b-1 where ``keep`` (a (b-a,) bool mask) holds.
+
+    Returns (xy, first, last) as :func:`_ring_texts` takes them.
+    """
+    offsets = diagram.cell_offsets
+    lengths = np.diff(offsets[a : b + 1])
+    ring = diagram.cell_vertices[offsets[a] : offsets[b]]
+    if not keep.all():
+        ring = ring[np.repeat(keep, lengths)]
+        lengths = lengths[keep]
+    stops = np.cumsum(lengths)
+    starts = stops - lengths
+    # repeat each ring's first point after its last one
+    index = np.insert(ring, stops, ring[starts])
+    shift = np.arange(len(lengths), dtype=np.int64)
+    # np.take is much faster than fancy indexing for gathering rows
+    return np.take(diagram.cell_points, index, axis=0), starts + shift, stops + shift
+
+
+def missing_cells(diagram) -> np.ndarray:
+    """Rows of distinct sites whose cell misses the box (they are written with ``"geometry": null``).
+
+    Only a box that leaves a site outside can do this; with the default box it is empty.
+    """
+    rows = np.arange(diagram.n_sites)
+    lengths = np.diff(diagram.cell_offsets)
+    return np.flatnonzero((diagram.site_of == rows) & (lengths < MIN_RING_POINTS))
+
+
+# ---------------------------------------------------------------------------
+# properties
+
+
+def _renames(names: list[str]) -> dict[str, str]:
+    """New names for site properties that clash with tvoronoi's own ("site" becomes "site_2")."""
+    renames = {}
+    taken = set(names) | set(RESERVED)
+    for name in RESERVED:
+        if name in names:
+            k = 2
+            while f"{name}_{k}" in taken:
+                k += 1
+            renames[name] = f"{name}_{k}"
+            taken.add(renames[name])
+    return renames
+
+
+def _properties_writer(diagram, points) -> Callable[[int], bytes]:
+    """A function of a row giving the JSON text of its feature's properties."""
+    duplicates = diagram.duplicates()
+    columns: list = []
+    records = None
+    renames: dict[str, str] = {}
+    if points is not None:
+        if len(points) != diagram.n_sites:
+            raise TvoronoiError(
+                f"the point set has {len(points)} rows but the diagram has {diagram.n_sites} sites; "
+                f"pass the points the diagram was built from"
+            )
+        renames = _renames(points.property_names)
+        if points.records is not None:
+            records = points.records
+        else:
+            columns = [(renames.get(name, name), values) for name, values in points.columns.items()]
+
+    def properties(i: int) -> bytes:
+        repeats = duplicates.get(i)
+        if not columns and not (records and records[i]) and repeats is None:
+            return b'{"site":%d}' % i
+        out = {"site": i}
+        if records is not None:
+            for key, value in records[i].items():
+                out[renames.get(key, key)] = value
+        for name, values in columns:
+            out[name] = values[i]
+        if repeats is not None:
+            out["duplicates"] = repeats
+        try:
+            return orjson.dumps(out, option=_OPT_NUMPY)
+        except orjson.JSONEncodeError as e:
+            raise TvoronoiError(f"the properties of site {i} cannot be written as JSON: {e}") from None
+
+    return properties
+
+
+# ---------------------------------------------------------------------------
+# writers
+
+
+def _bbox_member(bbox) -> bytes:
+    return b'"bbox":%b,' % orjson.dumps([float(v) for v in bbox])
+
+
+def write_cells(diagram, points, out, *, progress: ProgressCallback | None = None,
+                overwrite: bool = True) -> int:
+    """Write the Voronoi cells as an RFC 7946 GeoJSON FeatureCollection.
+
+    One Polygon feature per distinct site, in input order, one feature per
+    line. The exterior ring is counter-clockwise and closed (its first
+    position repeated at the end); coordinates are written as given (no CRS
+    is implied) in the shortest form that reads back to the same float64.
+    The properties are ``{"site": <0-based input row>, <the row's other
+    properties>..., "duplicates": [<later rows at the same place>]}``; the
+    last key only where the site repeats. A site property named "site" or
+    "duplicates" is kept as "site_2" / "duplicates_2".
+
+    A cell that misses the box (only possible with a box that leaves its
+    site outside) has ``"geometry": null``, which RFC 7946 (section 3.2)
+    allows for an unlocated feature; see :func:`missing_cells`.
+
+    Parameters
+    ----------
+    diagram : Diagram
+    points : PointSet or None
+        The sites as read from a file, whose properties the features carry;
+        None for sites without properties.
+    out : str, os.PathLike or binary file
+        A path, ``"-"`` for standard output, or an open binary stream. A path
+        is written through a temporary file renamed into place on success.
+    progress : callable(done, total), optional
+        Called with the number of features written so far and in all.
+    overwrite : bool
+        Replace an existing file at ``out``.
+
+    Returns
+    -------
+    int
+        The number of features written.
+
+    Raises
+    ------
+    TvoronoiError
+        If ``points`` does not match the diagram.
+    OSError
+        If writing fails (an existing file at ``out`` is then left untouched).
+    """
+    properties = _properties_writer(diagram, points)
+    n_sites = diagram.n_sites
+    rows = np.arange(n_sites)
+    distinct = diagram.site_of == rows
+    has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
+    total = int(distinct.sum())
+    done = 0
+    with open_output(out, overwrite=overwrite) as stream, _gc_paused():
+        bbox = _bbox_member(diagram.bbox) if has_ring.any() else b""
+        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+        if progress is not None:
+            progress(0, total)
+        for a in range(0, n_sites, CHUNK_FEATURES):
+            b = min(a + CHUNK_FEATURES, n_sites)
+            # the rings of this chunk, serialized together
+            keep = has_ring[a:b]
+            text, starts, stops = _ring_texts(*_closed_rings(diagram, a, b, keep))
+            spans = zip(starts, stops)
+            features = []
+            for i, ring in zip(rows[a:b][distinct[a:b]].tolist(), keep[distinct[a:b]].tolist()):
+                if ring:
+                    start, stop = next(spans)
+                    features.append(_POLYGON % (text[start:stop], properties(i)))
+                else:  # a cell that misses the box
+                    features.append(_NULL % properties(i))
+            if not features:
+                continue
+            if done:
+                stream.write(_SEPARATOR)
+            stream.write(_SEPARATOR.join(features))
+            done += len(features)
+            if progress is not None:
+                progress(done, total)
+        stream.write(b"\n]}\n")
+    return done
+
+
+def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
+                   overwrite: bool = True) -> int:
+    """Write the Delaunay triangles as a GeoJSON FeatureCollection of Polygons.
+
+    Each triangle is a closed counter-clockwise ring of its three sites, with
+    properties ``{"sites": [i, j, k]}`` (0-based input rows). Output, progress
+    and errors as in :func:`write_cells`.
+
+    Returns
+    -------
+    int
+        The number of triangles written.
+    """
+    triangles = np.asarray(diagram.triangles, dtype=np.int64).reshape(-1, 3)
+    total = len(triangles)
+    with open_output(out, overwrite=overwrite) as stream, _gc_paused():
+        bbox = b""
+        if total:
+            used = np.zeros(diagram.n_sites, bool)
+            used[triangles.ravel()] = True
+            corners = diagram.sites[used]
+            bbox = _bbox_member([*corners.min(axis=0), *corners.max(axis=0)])
+        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+        if progress is not None:
+            progress(0, total)
+        for a in range(0, total, CHUNK_FEATURES):
+            chunk = triangles[a : a + CHUNK_FEATURES]
+            # ring i, j, k, i
+            xy = np.take(diagram.sites, chunk[:, [0, 1, 2, 0]].ravel(), axis=0)
+            first = np.arange(0, 4 * len(chunk), 4, dtype=np.int64)
+            text, starts, stops = _ring_texts(xy, first, first + 3)
+            features = [
+                _TRIANGLE % (text[start:stop], i, j, k)
+                for start, stop, (i, j, k) in zip(starts, stops, chunk.tolist())
+            ]
+            if a:
+                stream.write(_SEPARATOR)
+            stream.write(_SEPARATOR.join(features))
+            if progress is not None:
+                progress(a + len(chunk), total)
+        stream.write(b"\n]}\n")
+    return total
