@@ -148,6 +148,11 @@ def test_extreme_scales_are_exact():
         validate(d)
 
 
+def test_dynamic_range_beyond_exact_arithmetic_is_refused():
+    with pytest.raises(tvoronoi.TvoronoiError, match="point 2 .* 2\\^170"):
+        tvoronoi.voronoi([[0.0, 0.0], [0.0, 1.0], [1e-60, 0.5]])
+
+
 small_ints = st.integers(min_value=-6, max_value=6)
 
 

@@ -13,6 +13,10 @@ ENGINES = ("incremental", "fortune")
 INSERTION_ORDERS = ("brio", "random")
 # The default box grows the sites' bounding box by this fraction of its larger side.
 BBOX_MARGIN = 0.10
+# The exact predicates multiply up to four coordinate differences; so that no
+# product underflows, a nonzero coordinate may be at most this many times
+# smaller than the largest one (2^170, about 1.5e51).
+DYNAMIC_RANGE = 2.0 ** 170
 
 
 def as_points(points) -> np.ndarray:
@@ -37,6 +41,15 @@ def as_points(points) -> np.ndarray:
         raise TvoronoiError(
             f"point {row} is ({pts[row, 0]!r}, {pts[row, 1]!r}): coordinates must be finite "
             f"({int(bad.sum())} such point(s))"
+        )
+    top = float(np.abs(pts).max())
+    tiny = (pts != 0) & (np.abs(pts) * DYNAMIC_RANGE < top)
+    if tiny.any():
+        row, col = (int(v) for v in np.argwhere(tiny)[0])
+        raise TvoronoiError(
+            f"point {row} has coordinate {pts[row, col]!r}, over 1e51 times smaller than the largest "
+            f"({top!r}): exact arithmetic covers a range of 2^170 within one point set; "
+            f"round such values to 0 or split the data"
         )
     return np.ascontiguousarray(pts)
 

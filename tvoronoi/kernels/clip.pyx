@@ -3,13 +3,13 @@
 import numpy as np
 
 from libc.stdint cimport int32_t, int64_t
-from libc.math cimport atan2, fabs, sqrt, INFINITY
+from libc.math cimport atan2, fabs, hypot, INFINITY
+
+from tvoronoi.kernels.distance cimport closer
 
 # A clipped point closer than this fraction of the box size to a box corner
 # becomes that corner, so that the corner is not emitted twice by rounding.
 cdef double CORNER_SNAP = 1e-12
-# Distance ties when deciding which cell owns a box corner (relative).
-cdef double OWNER_SLACK = 1e-12
 
 cdef enum:
     MAX_RING = 4096     # points of one clipped cell before it is sorted
@@ -17,10 +17,6 @@ cdef enum:
 
 cdef struct Box:
     double xmin, ymin, xmax, ymax, snap
-
-
-cdef inline double sq_dist(double ax, double ay, double bx, double by) noexcept nogil:
-    return (ax - bx) * (ax - bx) + (ay - by) * (ay - by)
 
 
 cdef inline bint clip_param(double p, double q, double* t0, double* t1) noexcept nogil:
@@ -90,7 +86,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef signed char[::1] inside = np.zeros(max(m, 1), np.int8)
     cdef int n_pts = m, corner0, h, tw, o, d, a, b, v, i, k, count, j
     cdef int64_t n_ring = 0
-    cdef double bx, by, dx, dy, t0, t1, lo, hi, x, y, cxm, cym, da, db, key
+    cdef double bx, by, dx, dy, norm, t0, t1, lo, hi, x, y, cxm, cym, key
     cdef bint fast, owned
     cdef int buf[MAX_RING]
     cdef double ang[MAX_RING]
@@ -132,14 +128,19 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             # computed from M keep their precision even when a far-off vertex
             # (of nearly collinear sites) ends the edge
             bx = 0.5 * (xs[a] + xs[b]); by = 0.5 * (ys[a] + ys[b])
+            # (a unit direction: t is then a length, and nothing is squared that could underflow
+            # for sites that are very close)
             dx = -(ys[b] - ys[a])
             dy = xs[b] - xs[a]
+            norm = hypot(dx, dy)
+            dx /= norm
+            dy /= norm
             lo = -INFINITY
             hi = INFINITY
             if o >= 0:
-                lo = ((pts[o, 0] - bx) * dx + (pts[o, 1] - by) * dy) / (dx * dx + dy * dy)
+                lo = (pts[o, 0] - bx) * dx + (pts[o, 1] - by) * dy
             if d >= 0:
-                hi = ((pts[d, 0] - bx) * dx + (pts[d, 1] - by) * dy) / (dx * dx + dy * dy)
+                hi = (pts[d, 0] - bx) * dx + (pts[d, 1] - by) * dy
             t0 = lo
             t1 = hi
             if not (clip_param(-dx, bx - box.xmin, &t0, &t1)
@@ -147,7 +148,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                     and clip_param(-dy, by - box.ymin, &t0, &t1)
                     and clip_param(dy, box.ymax - by, &t0, &t1)):
                 continue
-            if (t1 - t0) * sqrt(dx * dx + dy * dy) <= box.snap:
+            if t1 - t0 <= box.snap:
                 continue          # the edge only touches the box (up to rounding)
             # an end inside the box is the vertex itself, shared with its other edges
             if o >= 0 and inside[o]:
@@ -213,13 +214,12 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 if h == face_edge[i]:
                     break
             for k in range(4):
+                # the corner is the cell's if no neighbour's site is strictly nearer (exact)
                 owned = True
-                da = sq_dist(corner_x[k], corner_y[k], xs[i], ys[i])
                 h = face_edge[i]
                 while h >= 0:
                     j = he_face[he_twin[h]]
-                    db = sq_dist(corner_x[k], corner_y[k], xs[j], ys[j])
-                    if da > db * (1.0 + OWNER_SLACK):
+                    if closer(corner_x[k], corner_y[k], xs[i], ys[i], xs[j], ys[j]) > 0:
                         owned = False
                         break
                     h = he_next[h]

@@ -703,3 +703,25 @@ cdef dict _state(Sweep* s, dict arrays):
         },
         "triangles": arrays["tv"][:3 * s.n_tri].reshape(-1, 3).copy(),
     }
+
+
+def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_t[::1] opp):
+    """Flip the edges of a triangulation (tv, opp; vertex n at infinity) until it is Delaunay.
+
+    The exact repair that closes every sweep, exposed for tests. Modifies tv
+    and opp in place; returns the number of flips.
+    """
+    cdef Sweep s
+    cdef int n_he = tv.shape[0]
+    cdef int32_t[::1] stack = np.empty(max(n_he, 1), np.int32)
+    cdef int8_t[::1] queued = np.zeros(max(n_he, 1), np.int8)
+    cdef int flips
+    s.x = &xs[0]
+    s.y = &ys[0]
+    s.n = xs.shape[0]
+    s.tv = &tv[0]
+    s.opp = &opp[0]
+    s.n_tri = n_he // 3
+    with nogil:
+        flips = repair(&s, &stack[0], &queued[0])
+    return flips

@@ -1,0 +1,122 @@
+"""Fortune's sweepline engine: the same diagram as the incremental engine and the oracle, on every data set."""
+
+import numpy as np
+import pytest
+import scipy.spatial
+from hypothesis import given, settings, strategies as st
+
+import tvoronoi
+from conftest import DATASETS, GENERAL_POSITION
+from invariants import validate
+from oracle import assert_matches_oracle
+from tvoronoi.build import sweep_order
+from tvoronoi.kernels import delaunay, fortune
+
+
+def assert_same_diagram(a, b):
+    """Same cells (vertices to rounding, same count), same vertex count."""
+    assert a.n_vertices == b.n_vertices
+    assert a.n_edges == b.n_edges
+    assert np.array_equal(a.site_of, b.site_of)
+    scale = max(a.bbox[2] - a.bbox[0], a.bbox[3] - a.bbox[1])
+    for i in range(a.n_sites):
+        ra, rb = a.cell_polygon(i), b.cell_polygon(i)
+        assert len(ra) == len(rb), f"cell {i}: {len(ra)} vs {len(rb)} vertices"
+        if len(ra):
+            k = int(np.argmin(np.hypot(*(rb - ra[0]).T)))
+            np.testing.assert_allclose(np.roll(rb, -k, axis=0), ra, rtol=0, atol=1e-9 * scale)
+
+
+def test_fortune_invariants_and_oracle(dataset):
+    name, pts = dataset
+    d = tvoronoi.voronoi(pts, engine="fortune")
+    assert d.engine == "fortune"
+    validate(d)
+    assert_matches_oracle(d)
+
+
+def test_engines_agree(dataset):
+    name, pts = dataset
+    assert_same_diagram(tvoronoi.voronoi(pts, engine="fortune"), tvoronoi.voronoi(pts, engine="incremental"))
+
+
+@pytest.mark.parametrize("name", GENERAL_POSITION)
+def test_fortune_delaunay_matches_qhull(name):
+    pts = DATASETS[name]
+    ours = {tuple(sorted(t)) for t in tvoronoi.voronoi(pts, engine="fortune").delaunay_triangles().tolist()}
+    shifted = pts - pts.min(axis=0) if name == "huge" else pts
+    theirs = {tuple(sorted(t)) for t in scipy.spatial.Delaunay(shifted).simplices.tolist()}
+    assert ours == theirs
+
+
+def test_sweep_needs_no_repair_on_general_position():
+    """Exact decisions make the sweep itself right; the flips are a safety net for near-ties."""
+    pts = DATASETS["uniform"]
+    order = sweep_order(pts[:, 0], pts[:, 1])
+    out = fortune.sweep(np.ascontiguousarray(pts[order, 0]), np.ascontiguousarray(pts[order, 1]))
+    assert out["flips"] == 0
+    assert out["steps"] >= len(pts)
+
+
+def test_first_row_of_equal_y():
+    """Several sites on the first sweep position, then the rest above them."""
+    pts = np.array([(x, 0.0) for x in range(8)] + [(3.5, 2.0), (1.2, 3.0), (6.1, 1.0)])
+    d = tvoronoi.voronoi(pts, engine="fortune")
+    validate(d)
+    assert_matches_oracle(d)
+
+
+def test_legalize_restores_delaunay(rng):
+    """Spoil a Delaunay triangulation with flips; the exact repair brings it back."""
+    pts = DATASETS["uniform"]
+    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+    _, tv, opp, _ = delaunay.triangulate(xs, ys)
+    want = {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()}
+    n, spoiled = len(pts), 0
+    for e in rng.permutation(len(tv)):
+        o = opp[e]
+        t, u = e // 3, o // 3
+        if n in tv[3 * t:3 * t + 3] or n in tv[3 * u:3 * u + 3]:
+            continue
+        nxt = lambda h: h - 2 if h % 3 == 2 else h + 1          # noqa: E731
+        prv = lambda h: h + 2 if h % 3 == 0 else h - 1          # noqa: E731
+        a, b, c, d = tv[e], tv[nxt(e)], tv[prv(e)], tv[prv(o)]
+        # flip only where the quadrilateral a, d, b, c is convex
+        cross = lambda p, q, r: (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])  # noqa: E731
+        if cross(pts[c], pts[a], pts[d]) <= 0 or cross(pts[d], pts[b], pts[c]) <= 0:
+            continue
+        e2, o2 = prv(e), prv(o)
+        A, B = opp[e2], opp[o2]
+        tv[e], tv[o] = d, c
+        opp[e], opp[B] = B, e
+        opp[o], opp[A] = A, o
+        opp[e2], opp[o2] = o2, e2
+        spoiled += 1
+        if spoiled == 40:
+            break
+    assert {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()} != want
+    assert fortune.legalize(xs, ys, tv, opp) >= 1
+    assert {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()} == want
+
+
+small_ints = st.integers(min_value=-5, max_value=5)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.lists(st.tuples(small_ints, small_ints), min_size=0, max_size=30))
+def test_property_engines_agree_on_degenerate_sets(points):
+    """Integer sets: repeats, rows of equal y, collinear runs, cocircular quads."""
+    pts = np.array(points, float).reshape(-1, 2)
+    f = tvoronoi.voronoi(pts, engine="fortune")
+    validate(f)
+    assert_same_diagram(f, tvoronoi.voronoi(pts, engine="incremental"))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1)), min_size=3, max_size=60)
+       .filter(lambda pts: all(v == 0 or v > 1e-40 for p in pts for v in p)))
+def test_property_engines_agree_on_floats(points):
+    pts = np.array(points, float)
+    f = tvoronoi.voronoi(pts, engine="fortune")
+    validate(f)
+    assert_same_diagram(f, tvoronoi.voronoi(pts, engine="incremental"))

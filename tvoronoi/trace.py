@@ -1,0 +1,275 @@
+"""Step-by-step traces of both engines, for playback: the state after any number of events.
+
+A trace reruns its engine up to the requested step, which costs well under a
+millisecond per thousand sites, so a timeline can be scrubbed freely.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tvoronoi.api import as_points, default_bbox, as_bbox
+from tvoronoi.build import assemble, collinear_dcel, power_of_two_scale, sweep_order
+from tvoronoi.diagram import Diagram
+from tvoronoi.kernels import dcel, delaunay, fortune
+
+KIND_NAMES = {0: "site", 1: "circle", 2: "repeat"}
+
+
+def parabola_y(sx, sy, x, sweep_y):
+    """Height of the beach-line parabola of site (sx, sy) above x, for the sweep line at sweep_y.
+
+    The parabola is the set of points as far from the site as from the
+    sweep line (which lies above the site); it opens downwards.
+    """
+    d = 2.0 * (sy - sweep_y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return ((x - sx) ** 2 + sy * sy - sweep_y * sweep_y) / d
+
+
+def breakpoint_xy(a, b, sweep_y):
+    """Where the arcs of sites a (left) and b (right) meet, for the sweep line at sweep_y."""
+    (ax, ay), (bx, by) = a, b
+    da, db = 2.0 * (ay - sweep_y), 2.0 * (by - sweep_y)
+    if da == 0.0 and db == 0.0:
+        return 0.5 * (ax + bx), -math.inf          # two sites on the sweep line: a vertical line
+    if da == 0.0:
+        return ax, float(parabola_y(bx, by, ax, sweep_y))
+    if db == 0.0:
+        return bx, float(parabola_y(ax, ay, bx, sweep_y))
+    # db ((x - ax)^2 + ay^2 - L^2) = da ((x - bx)^2 + by^2 - L^2)
+    qa = db - da
+    qb = -2.0 * (db * ax - da * bx)
+    qc = db * (ax * ax + ay * ay - sweep_y ** 2) - da * (bx * bx + by * by - sweep_y ** 2)
+    if qa == 0.0:
+        x = -qc / qb
+    else:
+        root = math.sqrt(max(qb * qb - 4.0 * qa * qc, 0.0))
+        x1, x2 = sorted(((-qb - root) / (2.0 * qa), (-qb + root) / (2.0 * qa)))
+        # the narrower parabola (site nearer the line) is above between the crossings
+        x = x2 if ay > by else x1
+    return x, float(parabola_y(ax, ay, x, sweep_y))
+
+
+def circumcentres(p, q, r):
+    """Circumcentres of triangles (p, q, r), each a (k, 2) array."""
+    bx, by = (q - p).T
+    cx, cy = (r - p).T
+    det = 2.0 * (bx * cy - by * cx)
+    bb, cc = bx * bx + by * by, cx * cx + cy * cy
+    return np.column_stack((p[:, 0] + (cy * bb - by * cc) / det, p[:, 1] + (bx * cc - cx * bb) / det))
+
+
+@dataclass(frozen=True)
+class FortuneStep:
+    """The sweep after ``index`` events (0: before the first).
+
+    Sites are input rows. Edges are (k, 2, 2) arrays of segments; a growing
+    edge runs from where it began (a Voronoi vertex, or the point where a site
+    event started it; y = -inf for the first row's vertical edges) to its
+    breakpoint on the beach line now.
+    """
+
+    index: int
+    n_steps: int
+    kind: str                    # "start", "site", "circle", "repeat"
+    site: int                    # the new site, or the site whose arc vanished
+    position: tuple              # the event's point: the site, or the circle's top
+    vertex: tuple | None         # the Voronoi vertex a circle event created
+    sweep_y: float
+    beach: np.ndarray            # (k,) sites of the arcs, left to right
+    breakpoints: np.ndarray      # (k - 1, 2) where consecutive arcs meet
+    circles: np.ndarray          # (m, 3) pending circle events: centre x, y, radius
+    circle_arcs: np.ndarray      # (m,) index in beach of the arc each would remove
+    vertices: np.ndarray         # (v, 2) Voronoi vertices so far
+    finished_edges: np.ndarray   # (f, 2, 2)
+    growing_edges: np.ndarray    # (g, 2, 2)
+
+    def describe(self) -> str:
+        """One line saying what this step did."""
+        if self.kind == "start":
+            return f"before the sweep: {self.n_steps} events to come"
+        x, y = self.position
+        if self.kind == "site":
+            return f"site event at ({x:.4g}, {y:.4g}): site {self.site} splits an arc"
+        if self.kind == "repeat":
+            return f"site {self.site} repeats an earlier site at ({x:.4g}, {y:.4g}): no new arc"
+        vx, vy = self.vertex
+        return (f"circle event at ({vx:.4g}, {vy:.4g}): vertex {len(self.vertices) - 1} created, "
+                f"arc of site {self.site} vanishes")
+
+
+class FortuneTrace:
+    """Replay Fortune's sweep over a point set, one event at a time.
+
+    >>> import tvoronoi.trace as tr
+    >>> t = tr.FortuneTrace([[0, 0], [2, 0], [1, 2]])
+    >>> len(t), t.step(len(t)).kind
+    (4, 'circle')
+    """
+
+    def __init__(self, points):
+        self.points = as_points(points)
+        self._perm = sweep_order(self.points[:, 0], self.points[:, 1])
+        self._xs = np.ascontiguousarray(self.points[self._perm, 0])
+        self._ys = np.ascontiguousarray(self.points[self._perm, 1])
+        self.n_steps = int(fortune.sweep(self._xs, self._ys)["steps"])
+
+    def __len__(self) -> int:
+        return self.n_steps
+
+    def step(self, k: int) -> FortuneStep:
+        """The state after k events, 0 <= k <= len(self)."""
+        k = max(0, min(int(k), self.n_steps))
+        st = fortune.sweep(self._xs, self._ys, k)
+        perm, xs, ys = self._perm, self._xs, self._ys
+        pts = np.column_stack((xs, ys))
+        tri = st["triangles"]
+        centres = circumcentres(pts[tri[:, 0]], pts[tri[:, 1]], pts[tri[:, 2]])
+        beach = st["beach"]
+        sweep_y = st["sweep_y"]
+        bps = np.array([breakpoint_xy(pts[beach[i]], pts[beach[i + 1]], sweep_y)
+                        for i in range(len(beach) - 1)]).reshape(-1, 2)
+        rec = st["records"]
+        closed = rec["e1"] >= 0
+        finished = np.stack((centres[rec["e0"][closed] // 3], centres[rec["e1"][closed] // 3]), axis=1)
+        live = st["beach_edges"]
+        e0 = rec["e0"][live]
+        starts = np.column_stack((rec["x"][live], rec["y"][live]))
+        if len(live):
+            starts[e0 >= 0] = centres[e0[e0 >= 0] // 3]
+        growing = np.stack((starts, bps), axis=1) if len(live) else np.empty((0, 2, 2))
+        events = st["events"]
+        if len(events):
+            arcs = events[:, 0].astype(int)
+            radius = events[:, 3] - events[:, 2]
+            circles = np.column_stack((events[:, 1], events[:, 2], radius))
+        else:
+            arcs, circles = np.empty(0, int), np.empty((0, 3))
+        kind, site, t = st["last"]
+        name = "start" if k == 0 else KIND_NAMES[kind]
+        if name == "circle":
+            position = (float(centres[t][0]), float(sweep_y))
+            vertex = (float(centres[t][0]), float(centres[t][1]))
+        elif name == "start":
+            position, vertex = (math.nan, math.nan), None
+        else:
+            position, vertex = (float(xs[site]), float(ys[site])), None
+        return FortuneStep(
+            index=k, n_steps=self.n_steps, kind=name,
+            site=int(perm[site]) if site >= 0 else -1,
+            position=position, vertex=vertex, sweep_y=float(sweep_y),
+            beach=perm[beach].astype(np.int32), breakpoints=bps,
+            circles=circles, circle_arcs=arcs, vertices=centres,
+            finished_edges=np.asarray(finished, float).reshape(-1, 2, 2),
+            growing_edges=np.asarray(growing, float).reshape(-1, 2, 2),
+        )
+
+
+@dataclass(frozen=True)
+class IncrementalStep:
+    """The randomized incremental engine after ``index`` sites were inserted.
+
+    ``conflict`` holds the Delaunay triangles the new site destroyed (its
+    conflict region, as (c, 3) input rows), ``stolen_from`` the sites whose
+    cells it took area from, and ``diagram`` the Voronoi diagram of the sites
+    inserted so far (the others have empty cells).
+    """
+
+    index: int
+    n_steps: int
+    site: int
+    conflict: np.ndarray
+    new_triangles: np.ndarray
+    stolen_from: np.ndarray
+    inserted: np.ndarray
+    diagram: Diagram
+
+    def describe(self) -> str:
+        if self.index == 0:
+            return f"before the first insertion: {self.n_steps} sites to insert"
+        x, y = self.diagram.sites[self.site]
+        if len(self.conflict) == 0:
+            return f"site {self.site} inserted at ({x:.4g}, {y:.4g})"
+        return (f"site {self.site} inserted at ({x:.4g}, {y:.4g}): {len(self.conflict)} triangles "
+                f"in conflict, cells taken from {len(self.stolen_from)} sites")
+
+
+class IncrementalTrace:
+    """Replay the randomized incremental engine, one insertion at a time."""
+
+    def __init__(self, points, *, bbox=None, seed: int = 0):
+        self.points = as_points(points)
+        self.bbox = default_bbox(self.points) if bbox is None else as_bbox(bbox)
+        n = len(self.points)
+        self._e = power_of_two_scale(self.points, self.bbox)
+        xs = np.ldexp(self.points[:, 0], -self._e)
+        ys = np.ldexp(self.points[:, 1], -self._e)
+        rng = np.random.default_rng(seed)
+        rank = rng.permutation(n).astype(np.int64)
+        self._perm = (np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+                      if n else np.empty(0, np.int32))
+        self._xs = np.ascontiguousarray(xs[self._perm])
+        self._ys = np.ascontiguousarray(ys[self._perm])
+        self.n_steps = n
+
+    def __len__(self) -> int:
+        return self.n_steps
+
+    def step(self, k: int) -> IncrementalStep:
+        """The state after k insertions, 0 <= k <= len(self)."""
+        n = self.n_steps
+        k = max(0, min(int(k), n))
+        res = delaunay.triangulate(self._xs, self._ys, stop_after=k) if n >= 3 else (delaunay.STATUS_COLLINEAR,)
+        if res[0] == delaunay.STATUS_OK and k >= 3:
+            _, tv, opp, dup, trace = res
+            order = trace["order"]
+            present = np.zeros(n, bool)
+            present[order[:k]] = True
+            out = dcel.voronoi_from_delaunay(self._xs, self._ys, tv, opp)
+            out["dup"] = dup
+            cavity = trace["cavity"] if k > 3 else np.empty((0, 3), np.int32)
+            fan = tv.reshape(-1, 3)[trace["fan"]] if k > 3 else tv.reshape(-1, 3)[:1]
+            new_site = order[k - 1]
+        else:
+            # the first sites (or a collinear start): strips between them
+            order = np.arange(n) if res[0] != delaunay.STATUS_OK else res[-1]["order"]
+            present = np.zeros(n, bool)
+            present[order[:k]] = True
+            idx = np.flatnonzero(present)
+            sub = collinear_dcel(self._xs[idx], self._ys[idx]) if len(idx) else collinear_dcel(
+                self._xs[:0], self._ys[:0])
+            out = _lift(sub, idx, n)
+            cavity = fan = np.empty((0, 3), np.int32)
+            new_site = order[k - 1] if k else -1
+        d = assemble(self.points, self.bbox, self._e, self._perm, self._xs, self._ys, out,
+                     engine="incremental", present=present)
+        n_inf = n
+        real = lambda tri: tri[np.all(tri != n_inf, axis=1)] if len(tri) else tri.reshape(-1, 3)  # noqa: E731
+        conflict = real(cavity)
+        stolen = np.unique(cavity[cavity != n_inf]) if len(cavity) else np.empty(0, np.int32)
+        stolen = stolen[stolen != new_site] if len(stolen) else stolen
+        to_row = self._perm
+        return IncrementalStep(
+            index=k, n_steps=n, site=int(to_row[new_site]) if new_site >= 0 else -1,
+            conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[real(fan)].reshape(-1, 3),
+            stolen_from=to_row[stolen], inserted=np.sort(to_row[present]), diagram=d,
+        )
+
+
+def _lift(sub: dict, idx: np.ndarray, n: int) -> dict:
+    """A DCEL over a subset of the sites, renumbered to the full numbering."""
+    out = dict(sub)
+    out["he_face"] = idx[sub["he_face"]].astype(np.int32)
+    face_edge = np.full(n, -1, np.int32)
+    face_edge[idx] = sub["face_edge"]
+    out["face_edge"] = face_edge
+    dup = np.full(n, -1, np.int32)
+    sd = sub["dup"]
+    dup[idx[sd >= 0]] = idx[sd[sd >= 0]]
+    out["dup"] = dup
+    out["triangles"] = np.empty((0, 3), np.int32)
+    return out
