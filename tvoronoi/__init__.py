@@ -2,7 +2,7 @@
 
 __version__ = "0.1.0"
 
-__all__ = ["voronoi", "Diagram", "TvoronoiError", "generate"]
+__all__ = ["voronoi", "Diagram", "TvoronoiError", "generate", "fortune_steps", "incremental_steps"]
 
 from tvoronoi.errors import TvoronoiError
 
@@ -18,6 +18,14 @@ def __getattr__(name):
         from tvoronoi.diagram import Diagram
 
         return Diagram
+    if name == "fortune_steps":
+        from tvoronoi.trace import FortuneTrace
+
+        return FortuneTrace
+    if name == "incremental_steps":
+        from tvoronoi.trace import IncrementalTrace
+
+        return IncrementalTrace
     if name == "generate":
         from tvoronoi.generators import generate
 
