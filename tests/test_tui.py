@@ -1,0 +1,379 @@
+"""The terminal UI: behaviour through the Textual pilot, looks through snapshots."""
+
+import asyncio
+import functools
+
+import numpy as np
+import pytest
+from textual.events import MouseMove, MouseScrollDown, MouseScrollUp
+from textual.widgets import Input, Select
+from textual.widgets._toast import Toast
+
+import tvoronoi
+from tvoronoi.errors import EngineError
+from tvoronoi.generators import generate
+from tvoronoi.tui.app import VoronoiApp
+from tvoronoi.tui.raster import View
+from tvoronoi.tui.screens import HelpScreen, PathDialog
+
+SIZE = (100, 40)
+
+
+def pilot_test(test):
+    """Run an async test body in its own event loop (no async plugin needed)."""
+
+    @functools.wraps(test)
+    def run(*args, **kwargs):
+        asyncio.run(test(*args, **kwargs))
+
+    return run
+
+
+def fixed_clock() -> float:
+    """A clock that never moves: the status line always says 0 ms."""
+    return 0.0
+
+
+def make_app(**kwargs) -> VoronoiApp:
+    return VoronoiApp(clock=fixed_clock, **kwargs)
+
+
+def error_toasts(app) -> list[str]:
+    return [toast.render().plain for toast in app.screen.query(Toast) if toast.has_class("-error")]
+
+
+def status_text(app) -> str:
+    return str(app.query_one("#status").render())
+
+
+@pilot_test
+async def test_starts_with_300_uniform_points():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert app.built.diagram.n_sites == 300
+        assert app.canvas.scene.n_sites == 300
+        assert app.canvas.has_focus
+        assert status_text(app).startswith("300 sites · ")
+        assert "incremental" in status_text(app)
+
+
+@pilot_test
+async def test_given_points_are_shown():
+    points = generate("gaussian", 40, seed=2)
+    app = make_app(points=points)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert np.array_equal(app.built.diagram.sites, points)
+
+
+@pilot_test
+async def test_keys_pan_zoom_and_fit():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        canvas = app.canvas
+        fitted = canvas.view
+        await pilot.press("right")
+        assert canvas.view.cx > fitted.cx and canvas.view.cy == fitted.cy
+        await pilot.press("k")  # up
+        assert canvas.view.cy > fitted.cy
+        await pilot.press("h", "j")  # back left and down
+        assert canvas.view.cx == pytest.approx(fitted.cx)
+        assert canvas.view.cy == pytest.approx(fitted.cy)
+        await pilot.press("plus")
+        assert canvas.view.scale < fitted.scale
+        await pilot.press("minus", "minus")
+        assert canvas.view.scale > fitted.scale
+        assert not canvas.fitted
+        await pilot.press("0")
+        assert canvas.view == fitted
+        assert canvas.fitted
+
+
+@pilot_test
+async def test_mouse_wheel_zooms_about_the_pointer():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        canvas = app.canvas
+        width, height = canvas.content_size
+        before = canvas.view
+        under = before.char_to_world(12, 7, width, height)
+        # the pilot's own helper for mouse events, as used by its click()
+        await pilot._post_mouse_events([MouseScrollUp], canvas, offset=(12, 7))
+        after = canvas.view
+        assert after.scale < before.scale
+        assert after.char_to_world(12, 7, width, height) == pytest.approx(under)
+        await pilot._post_mouse_events([MouseScrollDown], canvas, offset=(12, 7))
+        assert canvas.view.scale == pytest.approx(before.scale)
+
+
+@pilot_test
+async def test_dragging_pans():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        canvas = app.canvas
+        before = canvas.view
+        await pilot.mouse_down(canvas, offset=(20, 10))
+        await pilot._post_mouse_events([MouseMove], canvas, offset=(25, 10), button=1)
+        await pilot.mouse_up(canvas, offset=(25, 10))
+        # dragged 5 characters right: the world moved right, so the centre moved left
+        assert canvas.view.cx == pytest.approx(before.cx - 5 * 2 * before.scale)
+        assert canvas.view.cy == pytest.approx(before.cy)
+
+
+@pilot_test
+async def test_generate_with_another_count():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        count = app.query_one("#count", Input)
+        count.focus()
+        count.value = ""
+        await pilot.press("5", "0", "0", "enter")
+        await pilot.pause()
+        assert app.built.diagram.n_sites == 500
+        assert status_text(app).startswith("500 sites")
+
+
+@pilot_test
+async def test_generate_button_and_distribution_parameters():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#distribution", Select).value = "clustered"
+        await pilot.pause()
+        assert app.query_one("#clusters").parent.display
+        assert not app.query_one("#sigma").parent.display
+        app.query_one("#clusters", Input).value = "3"
+        await pilot.click("#generate")
+        await pilot.pause()
+        assert app.built.source.startswith("clustered")
+        assert "clusters 3" in status_text(app)
+
+
+@pilot_test
+async def test_bad_count_is_a_notification_and_the_diagram_stays():
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        built = app.built
+        app.query_one("#count", Input).value = ""
+        app.canvas.focus()
+        await pilot.press("g")
+        await pilot.pause()
+        assert app.built is built
+        assert any("count" in text for text in error_toasts(app))
+
+
+def engine_not_available(monkeypatch):
+    """Make the fortune engine fail the way an engine that is not there yet does."""
+    real = tvoronoi.voronoi
+
+    def voronoi(points, *, engine="incremental", **kwargs):
+        if engine == "fortune":
+            raise EngineError("engine 'fortune' is not available yet: use engine='incremental'")
+        return real(points, engine=engine, **kwargs)
+
+    monkeypatch.setattr(tvoronoi, "voronoi", voronoi)
+
+
+async def pick_fortune(app, pilot):
+    engine = app.query_one("#engine", Select)
+    engine.focus()
+    await pilot.press("enter", "down", "enter")  # open the list, pick fortune
+    await pilot.pause()
+    assert engine.value == "fortune"
+
+
+@pilot_test
+async def test_engine_error_is_a_notification_and_the_diagram_stays(monkeypatch):
+    engine_not_available(monkeypatch)
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        built = app.built
+        view = app.canvas.view
+        await pick_fortune(app, pilot)
+        assert app.built is built
+        assert app.canvas.scene is built.scene
+        assert app.canvas.view == view
+        assert any("not available" in text for text in error_toasts(app))
+        assert "incremental" in status_text(app)
+
+
+@pilot_test
+async def test_engine_selector_rebuilds_the_same_points():
+    """With the real API: either the other engine builds the same sites, or it says why not."""
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        built = app.built
+        await pick_fortune(app, pilot)
+        if app.built is built:
+            assert error_toasts(app)
+        else:
+            assert app.built.diagram.engine == "fortune"
+            assert np.array_equal(app.built.diagram.sites, built.diagram.sites)
+            assert "fortune" in status_text(app)
+
+
+@pilot_test
+async def test_help_opens_and_escape_closes_it():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("question_mark")
+        assert isinstance(app.screen, HelpScreen)
+        listed = " ".join(f"{keys} {what}" for keys, what in app.screen.keys)
+        for key in ("q", "?", "d", "o", "s", "g", "0", "+", "-", "←", "h", "j", "k", "l"):
+            assert key in listed.split(), key
+        await pilot.press("escape")
+        assert not isinstance(app.screen, HelpScreen)
+
+
+@pilot_test
+async def test_delaunay_toggle():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert not app.canvas.show_delaunay
+        await pilot.press("d")
+        assert app.canvas.show_delaunay
+        assert "Delaunay" in status_text(app)
+        await pilot.press("d")
+        assert not app.canvas.show_delaunay
+
+
+@pilot_test
+async def test_q_quits():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("q")
+        await pilot.pause()
+        assert app.return_code == 0
+
+
+@pilot_test
+async def test_open_a_point_file(tmp_path):
+    path = tmp_path / "points.csv"
+    path.write_text("x,y\n0,0\n1,0\n0,1\n1,1\n0.5,0.4\n")
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("o")
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one(Input).value = str(path)
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built.diagram.n_sites == 5
+        assert app.built.source == "points.csv"
+
+
+@pilot_test
+async def test_a_missing_file_is_a_notification(tmp_path):
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        built = app.built
+        await pilot.press("o")
+        app.screen.query_one(Input).value = str(tmp_path / "nowhere.csv")
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built is built
+        assert any("nowhere.csv" in text for text in error_toasts(app))
+
+
+@pilot_test
+async def test_save_writes_geojson_and_asks_before_replacing(tmp_path):
+    import json
+
+    path = tmp_path / "cells.geojson"
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("s")
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one(Input).value = str(path)
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        features = json.loads(path.read_text())["features"]
+        assert len(features) == 300
+        # a second save to the same path needs a second Enter
+        path.write_text("keep me")
+        await pilot.press("s")
+        app.screen.query_one(Input).value = str(path)
+        await pilot.press("enter")
+        assert isinstance(app.screen, PathDialog)
+        await pilot.press("escape")
+        await pilot.pause()
+        assert path.read_text() == "keep me"
+
+
+@pilot_test
+async def test_large_count_builds_in_a_worker():
+    app = make_app()
+    seen = []
+    async with app.run_test(size=SIZE, message_hook=lambda m: seen.append(type(m).__name__)) as pilot:
+        await pilot.pause()
+        app.query_one("#count", Input).value = "100000"
+        app.canvas.focus()
+        await pilot.press("g")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        # the worker hands its diagram over by message; the loading indicator is gone again
+        assert "DiagramReady" in seen
+        assert not app.canvas.loading
+        assert app.built.diagram.n_sites == 100_000
+
+
+@pilot_test
+async def test_resize_keeps_a_fitted_view_fitted():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.resize_terminal(140, 50)
+        await pilot.pause()
+        width, height = app.canvas.content_size
+        assert app.canvas.view == View.fit(app.canvas.scene.bbox, width, height)
+
+
+# -- snapshots ---------------------------------------------------------------
+
+
+def test_snapshot_initial_view(snap_compare):
+    """The start: 300 uniform points fitted in the canvas, the side panel on the right,
+    the status line and the footer's main keys."""
+    assert snap_compare(make_app(), terminal_size=SIZE)
+
+
+def test_snapshot_zoomed_with_delaunay(snap_compare):
+    """Zoomed in twice and panned right once, with the Delaunay triangulation over the cells."""
+    assert snap_compare(make_app(), press=["plus", "plus", "right", "d"], terminal_size=SIZE)
+
+
+def test_snapshot_help_screen(snap_compare):
+    """The help screen over the diagram, listing every key and mouse gesture."""
+    assert snap_compare(make_app(), press=["question_mark"], terminal_size=SIZE)
+
+
+def test_snapshot_narrow_terminal(snap_compare):
+    """A 60 x 20 terminal: the panel is hidden and the diagram fills the width."""
+    assert snap_compare(make_app(), terminal_size=(60, 20))
+
+
+def test_snapshot_light_theme_zoomed_in(snap_compare):
+    """The light theme, zoomed in three times: pastel fills, dark edges, sites as small
+    blocks and the Voronoi vertices marked."""
+
+    async def light(pilot):
+        pilot.app.theme = "textual-light"
+        await pilot.press("plus", "plus", "plus")
+
+    assert snap_compare(make_app(), run_before=light, terminal_size=SIZE)

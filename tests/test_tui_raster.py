@@ -1,0 +1,216 @@
+"""The braille rasterizer and the cell colouring of the terminal UI, without a terminal."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import tvoronoi
+from conftest import DATASETS
+from tvoronoi.generators import generate
+from tvoronoi.tui.colours import DARK, LIGHT, cell_adjacency, cell_colours, colour_graph
+from tvoronoi.tui.raster import (
+    BRAILLE_BLANK,
+    EDGE,
+    SITE,
+    Scene,
+    View,
+    braille_text,
+    frame_lines,
+    pack_braille,
+    point_dots,
+    rasterize,
+    segment_dots,
+)
+
+
+def test_dot_bits_follow_the_braille_standard():
+    """Each dot of a character lights the bit Unicode gives it."""
+    expected = {(0, 0): 0x01, (0, 1): 0x02, (0, 2): 0x04, (1, 0): 0x08,
+                (1, 1): 0x10, (1, 2): 0x20, (0, 3): 0x40, (1, 3): 0x80}
+    for (col, row), bit in expected.items():
+        dots = np.zeros((4, 2), bool)
+        dots[row, col] = True
+        assert pack_braille(dots)[0, 0] == bit
+    assert pack_braille(np.ones((4, 2), bool))[0, 0] == 0xFF
+    assert braille_text(np.array([0xFF, 0, 0x01], np.uint8)) == "\u28ff \u2801"
+
+
+def test_horizontal_segment_sets_one_dot_row():
+    dots = np.zeros((8, 10), bool)
+    segment_dots(dots, [0.5], [5.5], [9.5], [5.5])
+    assert dots[5].all()
+    assert dots.sum() == 10
+    codes = pack_braille(dots)
+    # dot row 5 is row 1 of the second character row: bits 0x02 and 0x10
+    assert (codes[1] == 0x12).all()
+    assert (codes[0] == 0).all()
+
+
+def test_vertical_and_diagonal_segments_have_no_gaps():
+    dots = np.zeros((20, 20), bool)
+    segment_dots(dots, [2.5, 0.5], [0.5, 0.5], [2.5, 19.5], [19.5, 19.5])
+    assert dots[:, 2].all()
+    assert np.diag(dots).all()
+
+
+def test_crossing_lines_keep_all_their_dots():
+    """Where two lines meet in one character, both keep every dot (bit patterns are OR-ed)."""
+    alone_h = np.zeros((8, 8), bool)
+    alone_v = np.zeros((8, 8), bool)
+    segment_dots(alone_h, [0.5], [3.5], [7.5], [3.5])
+    segment_dots(alone_v, [3.5], [0.5], [3.5], [7.5])
+    both = np.zeros((8, 8), bool)
+    segment_dots(both, [0.5, 3.5], [3.5, 0.5], [7.5, 3.5], [3.5, 7.5])
+    assert (both == (alone_h | alone_v)).all()
+    assert (pack_braille(both) == (pack_braille(alone_h) | pack_braille(alone_v))).all()
+
+
+def test_segments_are_clipped_to_the_canvas():
+    dots = np.zeros((8, 8), bool)
+    # far outside both ways, through the middle row
+    segment_dots(dots, [-1e9], [4.5], [1e9], [4.5])
+    assert dots[4].all() and dots.sum() == 8
+    dots[:] = False
+    # wholly outside
+    segment_dots(dots, [-10, 20], [-10, -5], [-1, 30], [-1, 5])
+    assert not dots.any()
+
+
+def test_points_off_the_canvas_are_ignored():
+    dots = np.zeros((8, 4), bool)
+    point_dots(dots, [-1, 1.2, 10], [1, 6.7, 1])
+    assert dots.sum() == 1 and dots[6, 1]
+
+
+def test_view_zoom_keeps_the_point_under_the_pointer():
+    view = View(0.5, 0.5, 0.01)
+    about = view.char_to_world(10, 5, 40, 20)
+    zoomed = view.zoomed(2.0, about)
+    assert zoomed.char_to_world(10, 5, 40, 20) == pytest.approx(about)
+    assert zoomed.scale == pytest.approx(0.005)
+
+
+def test_fit_shows_the_whole_box():
+    view = View.fit((0, 0, 2, 1), 40, 20)
+    u, v = view.to_dots([0, 2], [0, 1], 40, 20)
+    assert 0 <= u.min() and u.max() <= 80
+    assert 0 <= v.min() and v.max() <= 80
+
+
+def test_frame_of_a_diagram_draws_sites_edges_and_fills():
+    diagram = tvoronoi.voronoi(generate("uniform", 50, seed=3))
+    scene = Scene.from_diagram(diagram)
+    view = View.fit(scene.bbox, 60, 20)
+    frame = rasterize(scene, view, 60, 20, delaunay=True)
+    assert frame.codes.shape == frame.mark.shape == frame.fill.shape == (20, 60)
+    assert (frame.mark == SITE).sum() >= 40  # a few sites may share a character
+    assert (frame.mark == EDGE).any()
+    assert (frame.fill >= 0).any() and (frame.fill < len(DARK.fills)).all()
+    lines = frame_lines(frame, DARK)
+    assert len(lines) == 20
+    for line in lines:
+        text = "".join(seg.text for seg in line)
+        assert len(text) == 60
+        assert all(c == " " or BRAILLE_BLANK <= ord(c) <= BRAILLE_BLANK + 0xFF for c in text)
+
+
+def test_every_site_lies_in_a_character_of_its_own_fill():
+    """The fill comes from the nearest site, so a site's own character shows its cell's colour."""
+    diagram = tvoronoi.voronoi(generate("uniform", 30, seed=5))
+    scene = Scene.from_diagram(diagram)
+    cols, rows = 120, 40
+    view = View.fit(scene.bbox, cols, rows)
+    frame = rasterize(scene, view, cols, rows)
+    u, v = view.to_dots(scene.sites[:, 0], scene.sites[:, 1], cols, rows)
+    col, row = (u // 2).astype(int), (v // 4).astype(int)
+    # a character whose centre is nearer another site may differ; nearly all agree
+    agree = frame.fill[row, col] == scene.colours
+    assert agree.mean() > 0.8
+
+
+@pytest.mark.parametrize("name", ["uniform", "clustered", "grid", "circle", "collinear", "duplicates", "two"])
+def test_neighbouring_cells_never_share_a_colour(name):
+    diagram = tvoronoi.voronoi(DATASETS[name])
+    colours = cell_colours(diagram)
+    a, b = cell_adjacency(diagram)
+    assert len(colours) == diagram.n_sites
+    assert colours.min() >= 0 and colours.max() < len(DARK.fills)
+    assert not (colours[a] == colours[b]).any()
+    # a repeated point shows its first copy's colour
+    assert (colours == colours[diagram.site_of]).all()
+
+
+def test_colouring_of_a_large_diagram_uses_the_palette_and_has_no_clash():
+    diagram = tvoronoi.voronoi(generate("clustered", 20_000, seed=11))
+    colours = cell_colours(diagram)
+    a, b = cell_adjacency(diagram)
+    assert not (colours[a] == colours[b]).any()
+    assert len(np.unique(colours)) == len(DARK.fills)
+
+
+def test_adjacency_comes_from_the_half_edges():
+    diagram = tvoronoi.voronoi([[0, 0], [2, 0], [1, 2]])
+    a, b = cell_adjacency(diagram)
+    assert sorted(zip(a.tolist(), b.tolist())) == [(0, 1), (0, 2), (1, 2)]
+
+
+def test_colour_graph_on_a_wheel():
+    """A hub with 12 spokes and a rim: the hub needs a colour none of the rim uses."""
+    rim = np.arange(1, 13)
+    a = np.concatenate([np.zeros(12, int), rim])
+    b = np.concatenate([rim, np.roll(rim, 1)])
+    colours = colour_graph(13, a, b)
+    assert not (colours[a] == colours[b]).any()
+
+
+def test_palettes_have_eight_distinct_fills():
+    for palette in (DARK, LIGHT):
+        assert len(set(palette.fills)) == 8
+        assert palette.edge not in palette.fills
+
+
+coordinates = st.floats(-30, 60, allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(coordinates, coordinates, coordinates, coordinates), min_size=1, max_size=8))
+def test_segment_dots_match_the_segments(segments):
+    """Every dot lies within one dot of some segment; ends on the canvas are drawn; no gaps."""
+    height, width = 24, 32
+    dots = np.zeros((height, width), bool)
+    seg = np.array(segments, float)
+    segment_dots(dots, seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3])
+    rows, cols = np.nonzero(dots)
+    centres = np.column_stack([cols + 0.5, rows + 0.5])
+    a, b = seg[:, :2], seg[:, 2:]
+    ab = b - a
+    length2 = np.maximum((ab ** 2).sum(1), 1e-12)
+    t = np.clip(((centres[:, None, :] - a) * ab).sum(2) / length2, 0, 1)
+    nearest = a + t[..., None] * ab
+    distance = np.sqrt(((centres[:, None, :] - nearest) ** 2).sum(2)).min(1)
+    assert (distance <= np.sqrt(0.5) + 1e-6).all()
+    for x, y in np.concatenate([a, b]):
+        if 0 <= x < width and 0 <= y < height:
+            assert dots[int(y), int(x)]
+    # a segment wholly on the canvas: every step along its longer axis has a dot
+    x0, y0, x1, y1 = seg[0]
+    if all(0 <= x < width for x in (x0, x1)) and all(0 <= y < height for y in (y0, y1)):
+        alone = np.zeros_like(dots)
+        segment_dots(alone, [x0], [y0], [x1], [y1])
+        if abs(x1 - x0) >= abs(y1 - y0):
+            lo, hi = sorted((int(x0), int(x1)))
+            assert alone[:, lo:hi + 1].any(axis=0).all()
+        else:
+            lo, hi = sorted((int(y0), int(y1)))
+            assert alone[lo:hi + 1, :].any(axis=1).all()
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(3, 400), st.integers(0, 2**32 - 1), st.sampled_from(["uniform", "gaussian", "clustered"]))
+def test_colouring_has_no_clash_on_random_diagrams(n, seed, distribution):
+    diagram = tvoronoi.voronoi(generate(distribution, n, seed=seed))
+    colours = cell_colours(diagram)
+    a, b = cell_adjacency(diagram)
+    assert not (colours[a] == colours[b]).any()
+    assert colours.max() < len(DARK.fills)

@@ -1,0 +1,93 @@
+"""The modal screens of the terminal UI: the key help and the path dialog for open and save."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Vertical, VerticalScroll
+from textual.screen import ModalScreen
+from textual.widgets import Input, Label, Static
+
+# Mouse gestures, listed in the help beside the keys.
+MOUSE_HELP = (
+    ("wheel", "zoom about the pointer"),
+    ("drag", "pan"),
+    ("click", "focus a control; hover for its tooltip"),
+)
+
+
+class HelpScreen(ModalScreen[None]):
+    """Every key of the UI, with what it does."""
+
+    BINDINGS = [
+        Binding("escape,question_mark,q", "dismiss", "Close", key_display="esc"),
+    ]
+
+    def __init__(self, keys: list[tuple[str, str]]) -> None:
+        super().__init__()
+        self.keys = keys
+
+    def compose(self) -> ComposeResult:
+        width = max((len(k) for k, _ in (*self.keys, *MOUSE_HELP)), default=0)
+        lines = ["[b]Keys[/b]"]
+        lines += [f"  [b $accent]{key:<{width}}[/]  {what}" for key, what in self.keys]
+        lines += ["", "[b]Mouse[/b]"]
+        lines += [f"  [b $accent]{key:<{width}}[/]  {what}" for key, what in MOUSE_HELP]
+        lines += ["", "[dim]In a text field, Esc returns to the diagram; Tab moves between controls.[/dim]"]
+        with VerticalScroll(id="help-box") as box:
+            box.border_title = "tvoronoi help"
+            box.border_subtitle = "esc to close"
+            yield Static("\n".join(lines), id="help-text")
+
+    def action_dismiss(self) -> None:
+        self.dismiss(None)
+
+
+class PathDialog(ModalScreen[Path | None]):
+    """Ask for a file path; dismissed with the path, or None when cancelled.
+
+    With ``confirm_overwrite``, a path that exists must be submitted twice.
+    """
+
+    BINDINGS = [Binding("escape", "cancel", "Cancel")]
+
+    def __init__(self, title: str, *, value: str = "", placeholder: str = "",
+                 confirm_overwrite: bool = False) -> None:
+        super().__init__()
+        self.title_text = title
+        self.value = value
+        self.placeholder = placeholder
+        self.confirm_overwrite = confirm_overwrite
+        self._confirmed: str | None = None
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="dialog") as box:
+            box.border_title = self.title_text
+            yield Input(self.value, placeholder=self.placeholder, id="path")
+            yield Label("Enter to accept · Esc to cancel", id="dialog-hint")
+
+    def on_mount(self) -> None:
+        self.query_one("#path", Input).focus()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        text = event.value.strip()
+        hint = self.query_one("#dialog-hint", Label)
+        if not text:
+            hint.update("[b $error]Give a path[/] · Esc to cancel")
+            return
+        path = Path(text).expanduser()
+        if self.confirm_overwrite and path.exists() and self._confirmed != text:
+            self._confirmed = text
+            hint.update(f"[b $warning]{path.name} exists:[/] Enter again to replace it · Esc to cancel")
+            return
+        self.dismiss(path)
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        # a changed path needs its own confirmation
+        self._confirmed = None
+
+    def action_cancel(self) -> None:
+        self.dismiss(None)
