@@ -58,6 +58,8 @@ def assert_matches_oracle(d, *, rtol=1e-7):
             assert len(ring) == 0 or shapely.Polygon(ring).area <= (rtol * size) ** 2
             continue
         got = shapely.Polygon(ring - origin)
-        gap = got.symmetric_difference(want).area
-        assert gap <= rtol * size * size, f"cell {i}: differs from the oracle by area {gap}"
+        # areas and vertex distances, not an overlay: GEOS can mis-node two rings that
+        # differ only in the last bits of their vertices
+        assert abs(got.area - want.area) <= rtol * size * (got.length + want.length), \
+            f"cell {i}: area {got.area}, the oracle's {want.area}"
         assert got.hausdorff_distance(want) <= rtol * size, f"cell {i}: a vertex is off"

@@ -2,7 +2,8 @@
 
 __version__ = "0.1.0"
 
-__all__ = ["voronoi", "Diagram", "TvoronoiError", "generate", "fortune_steps", "incremental_steps"]
+__all__ = ["voronoi", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "fortune_steps",
+           "incremental_steps"]
 
 from tvoronoi.errors import TvoronoiError
 
@@ -18,6 +19,10 @@ def __getattr__(name):
         from tvoronoi.diagram import Diagram
 
         return Diagram
+    if name == "DynamicVoronoi":
+        from tvoronoi.dynamic import DynamicVoronoi
+
+        return DynamicVoronoi
     if name == "fortune_steps":
         from tvoronoi.trace import FortuneTrace
 

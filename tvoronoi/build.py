@@ -110,7 +110,7 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     return assemble(pts, box, e, perm, exs, eys, out, engine=engine)
 
 
-def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None) -> Diagram:
+def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True) -> Diagram:
     """Clip an engine's DCEL and map it back to input rows.
 
     Parameters
@@ -120,6 +120,10 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None) -> Diagr
     out : the engine's DCEL dict (with ``dup``)
     present : (n,) bool in engine order, optional -- sites already in the
         diagram (the step trace shows diagrams of the first sites only)
+    first_row_holds : bool
+        A place shared by repeated points gets its cell under the first input
+        row there (batch); False keeps it with the site the engine holds it by
+        (dynamic diagrams, where the oldest copy at a place holds it).
     """
     n = len(pts)
     sbox = tuple(math.ldexp(v, -e) for v in box)
@@ -133,7 +137,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None) -> Diagr
     # the cell of a repeated point belongs to the first input row at that place
     root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
     owner = perm.copy()                              # engine site -> input row owning its cell
-    if (dup >= 0).any():
+    if first_row_holds and (dup >= 0).any():
         np.minimum.at(owner, root, perm)
     site_of = np.empty(n, np.int32)
     site_of[perm] = owner[root]

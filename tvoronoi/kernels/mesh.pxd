@@ -50,6 +50,7 @@ cdef struct Mesh:
     int32_t* vedge
     int32_t* changed
     int n_changed
+    int n_finite        # finite triangles (kept up to date only where vedge is kept)
     int n
     int inf
     int vmap_inf        # vmap's entry for the vertex at infinity
@@ -191,6 +192,10 @@ cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
             m.head[t] = -1
         m.where[i] = -1
 
+    if m.vedge != NULL:
+        for q in range(n_cav):
+            if not is_infinite(m, m.cavity[q]):
+                m.n_finite -= 1
     if m.trace_cav != NULL:
         for q in range(n_cav):
             t = m.cavity[q]
@@ -223,6 +228,8 @@ cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
         else:
             m.vmap[a] = T
         if m.vedge != NULL and a != m.inf:
+            if b != m.inf:
+                m.n_finite += 1
             m.vedge[a] = 3 * T
             m.changed[m.n_changed] = a
             m.n_changed += 1

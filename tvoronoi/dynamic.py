@@ -1,0 +1,324 @@
+"""Dynamic Voronoi diagrams: insert, move and remove sites with local work, and read cells as they change."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tvoronoi.api import ENGINES, as_bbox, as_points, default_bbox
+from tvoronoi.build import assemble, collinear_dcel, sweep_order
+from tvoronoi.diagram import Diagram
+from tvoronoi.errors import EngineError, TvoronoiError
+from tvoronoi.kernels import dcel, delaunay, dynamic, fortune
+
+# Without a global rescaling, the exact predicates stay exact (no product over- or
+# underflows) for coordinates that are 0 or within this range in magnitude.
+COORD_MIN = 1e-60
+COORD_MAX = 1e60
+
+
+def check_coordinate(x: float, y: float) -> tuple[float, float]:
+    try:
+        x, y = float(x), float(y)
+    except (TypeError, ValueError):
+        raise TvoronoiError(f"coordinates must be numbers, got ({x!r}, {y!r})") from None
+    for v in (x, y):
+        if not math.isfinite(v):
+            raise TvoronoiError(f"coordinates must be finite, got ({x!r}, {y!r})")
+        if v != 0 and not COORD_MIN <= abs(v) <= COORD_MAX:
+            raise TvoronoiError(f"coordinate {v!r} is outside the exact range: use 0 or magnitudes "
+                                f"from {COORD_MIN:g} to {COORD_MAX:g}")
+    return x, y
+
+
+class DynamicVoronoi:
+    """A Voronoi diagram that follows insertions, moves and removals of sites.
+
+    Each update changes the Delaunay triangulation only around the sites it
+    touches (the conflict region of a new site, the hole of a removed one),
+    and reading a cell computes that cell alone, so an update followed by
+    reading the changed cells costs only the local work.
+
+    Parameters
+    ----------
+    points : array_like (n, 2)
+        The initial sites, ids 0 .. n-1.
+    engine : {"incremental", "fortune"}
+        "incremental": Bowyer-Watson insertion, ear-by-ear Delaunay removal.
+        "fortune": the changed region's sites are swept by Fortune's algorithm
+        and the result is spliced into the triangulation.
+    bbox : (xmin, ymin, xmax, ymax), optional
+        Fixed at creation; by default the initial points' box grown by 10%.
+
+    Examples
+    --------
+    >>> dv = DynamicVoronoi([[0, 0], [2, 0], [0, 2]])
+    >>> i = dv.insert(1.5, 1.5)
+    >>> sorted(dv.changed.tolist())      # the new site and the cells it took area from
+    [0, 1, 2, 3]
+    >>> dv.move(i, 3, 3); dv.remove(0)
+    >>> len(dv.diagram().cell_polygon(0)), len(dv.diagram().cell_polygon(1)) > 0
+    (0, True)
+    """
+
+    def __init__(self, points=(), *, engine: str = "incremental", bbox=None):
+        pts = as_points(points)
+        if engine not in ENGINES:
+            raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
+        for x, y in pts[np.any((pts != 0) & ((np.abs(pts) < COORD_MIN) | (np.abs(pts) > COORD_MAX)), axis=1)]:
+            check_coordinate(x, y)
+        self.engine = engine
+        self.bbox = default_bbox(pts) if bbox is None else as_bbox(bbox)
+        n = len(pts)
+        self._xy = np.full((max(2 * n, 16), 2), np.nan)
+        self._xy[:n] = pts
+        self._alive = np.zeros(len(self._xy), bool)
+        self._alive[:n] = True
+        self._n_ids = n
+        self._primary: dict[int, int] = {}      # a repeated point's id -> the id holding the place
+        self._copies: dict[int, list[int]] = {}  # the holder -> its repeats, oldest first
+        self._mesh: dynamic.DynamicMesh | None = None
+        self._flat: Diagram | None = None       # the diagram while the sites are collinear
+        self.changed = np.arange(n, dtype=np.int32)
+        self._rebuild()
+
+    # -- bookkeeping -------------------------------------------------------------------------------
+
+    def _check_id(self, i) -> int:
+        try:
+            i = int(i)
+        except (TypeError, ValueError):
+            raise TvoronoiError(f"site id must be an integer, got {i!r}") from None
+        if not 0 <= i < self._n_ids:
+            raise TvoronoiError(f"no site {i}: ids run from 0 to {self._n_ids - 1}")
+        if not self._alive[i]:
+            raise TvoronoiError(f"site {i} was removed")
+        return i
+
+    def _new_id(self) -> int:
+        i = self._n_ids
+        if i == len(self._xy):
+            grow = len(self._xy)
+            self._xy = np.concatenate([self._xy, np.full((grow, 2), np.nan)])
+            self._alive = np.concatenate([self._alive, np.zeros(grow, bool)])
+        self._n_ids += 1
+        return i
+
+    def _holders(self) -> np.ndarray:
+        """Alive ids that hold a place (not repeats), ascending."""
+        ids = np.flatnonzero(self._alive[:self._n_ids])
+        if self._primary:
+            ids = ids[~np.isin(ids, list(self._primary))]
+        return ids.astype(np.int32)
+
+    def _rebuild(self) -> None:
+        """Build the triangulation of all holders at once (the start, or after the sites were flat)."""
+        self._mesh, self._flat = None, None
+        ids = np.flatnonzero(self._alive[:self._n_ids]).astype(np.int32)
+        self._primary.clear()
+        self._copies.clear()
+        if len(ids) == 0:
+            return
+        xs = np.ascontiguousarray(self._xy[ids, 0])
+        ys = np.ascontiguousarray(self._xy[ids, 1])
+        if self.engine == "fortune":
+            perm = sweep_order(xs, ys)
+            sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
+            res = fortune.sweep(sx, sy)
+            ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
+        else:
+            perm = np.arange(len(ids), dtype=np.int32)
+            sx, sy = xs, ys
+            status, tv, opp, dup = delaunay.triangulate(sx, sy)
+            ok = status == delaunay.STATUS_OK
+        order_ids = ids[perm]
+        if not ok:
+            from tvoronoi.build import first_copies
+
+            dup = first_copies(sx, sy)
+        # repeats: the smallest id at a place holds it
+        groups: dict[int, list[int]] = {}
+        for k in np.flatnonzero(dup >= 0).tolist():
+            groups.setdefault(int(dup[k]), []).append(int(order_ids[k]))
+        holder_of_vertex = {}
+        for k, copies in groups.items():
+            everyone = sorted(copies + [int(order_ids[k])])
+            holder_of_vertex[k] = everyone[0]
+            self._copies[everyone[0]] = everyone[1:]
+            for c in everyone[1:]:
+                self._primary[c] = everyone[0]
+        if not ok:
+            return
+        mesh = dynamic.DynamicMesh(max(len(self._xy), 16))
+        mesh.load(sx, sy, order_ids.astype(np.int32), tv, opp, len(sx))
+        for k, holder in holder_of_vertex.items():
+            if holder != int(order_ids[k]):
+                mesh.relabel(int(order_ids[k]), holder)
+        for c, p in self._primary.items():
+            mesh.set_site(c, *self._xy[c])
+        self._mesh = mesh
+
+    def _after_change(self) -> None:
+        if self._mesh is not None and self._mesh.n_finite == 0:
+            self._rebuild()
+
+    # -- updates -----------------------------------------------------------------------------------
+
+    def insert(self, x, y) -> int:
+        """Add a site at (x, y); returns its id."""
+        x, y = check_coordinate(x, y)
+        i = self._new_id()
+        self._place(i, x, y)
+        return i
+
+    def _place(self, i: int, x: float, y: float) -> None:
+        self._flat = None
+        self._xy[i] = (x, y)
+        self._alive[i] = True
+        if self._mesh is None:
+            self._rebuild()
+            self.changed = np.union1d(self._holders(), [i]).astype(np.int32)
+            return
+        held = self._mesh.insert(i, x, y)
+        if held >= 0:
+            # a repeated point: it shares the cell of the site already there
+            holder = self._primary.get(held, held)
+            self._primary[i] = holder
+            self._copies.setdefault(holder, []).append(i)
+            self.changed = np.array([i], np.int32)
+        else:
+            self.changed = self._mesh.changed()
+
+    def remove(self, i) -> None:
+        """Remove site i (its id is not reused)."""
+        i = self._check_id(i)
+        changed = self._unplace(i)
+        self._alive[i] = False
+        self._xy[i] = np.nan
+        self.changed = changed
+
+    def _unplace(self, i: int) -> np.ndarray:
+        self._flat = None
+        if i in self._primary:
+            holder = self._primary.pop(i)
+            self._copies[holder].remove(i)
+            if not self._copies[holder]:
+                del self._copies[holder]
+            return np.array([i], np.int32)
+        if i in self._copies:
+            # the oldest repeat takes the place over
+            copies = self._copies.pop(i)
+            heir = copies[0]
+            del self._primary[heir]
+            if copies[1:]:
+                self._copies[heir] = copies[1:]
+                for c in copies[1:]:
+                    self._primary[c] = heir
+            if self._mesh is not None:
+                self._mesh.relabel(i, heir)
+            return np.array([i, heir], np.int32)
+        if self._mesh is None:
+            self._alive[i] = False
+            self._rebuild()
+            return np.append(self._holders(), i).astype(np.int32)
+        status = self._mesh.remove(i)
+        if status != 0:
+            # the sites left are collinear (or the hole was beyond the local repair): start again
+            self._alive[i] = False
+            self._rebuild()
+            return np.append(self._holders(), i).astype(np.int32)
+        return np.append(self._mesh.changed(), i).astype(np.int32)
+
+    def move(self, i, x, y) -> None:
+        """Move site i to (x, y), keeping its id."""
+        i = self._check_id(i)
+        x, y = check_coordinate(x, y)
+        gone = self._unplace(i)
+        self._alive[i] = False
+        self._place(i, x, y)
+        self.changed = np.union1d(gone, self.changed).astype(np.int32)
+
+    # -- reading -----------------------------------------------------------------------------------
+
+    def diagram(self) -> "DynamicDiagram":
+        """The current diagram, as a cheap view (no copy, no rebuild)."""
+        return DynamicDiagram(self)
+
+    def __len__(self) -> int:
+        return int(self._alive[:self._n_ids].sum())
+
+
+class DynamicDiagram:
+    """A view of a DynamicVoronoi: cells are computed when read, each on its own."""
+
+    def __init__(self, owner: DynamicVoronoi):
+        self._owner = owner
+        self.bbox = owner.bbox
+
+    @property
+    def n_sites(self) -> int:
+        """Ids issued so far (removed ones included)."""
+        return self._owner._n_ids
+
+    @property
+    def sites(self) -> np.ndarray:
+        """(n_sites, 2) coordinates by id; NaN rows for removed ids."""
+        return self._owner._xy[:self._owner._n_ids]
+
+    @property
+    def alive(self) -> np.ndarray:
+        return self._owner._alive[:self._owner._n_ids]
+
+    def cell_polygon(self, i: int) -> np.ndarray:
+        """Cell of site i, clipped to the box: (k, 2), counter-clockwise; empty for a removed
+        id and for a repeated point (the site holding the place has the cell)."""
+        o = self._owner
+        i = int(i)
+        if not 0 <= i < o._n_ids:
+            raise IndexError(f"no site {i}: ids run from 0 to {o._n_ids - 1}")
+        if not o._alive[i] or i in o._primary:
+            return np.empty((0, 2))
+        if o._mesh is not None:
+            return o._mesh.cell(i, *self.bbox)
+        if o._flat is None:
+            o._flat = self.to_diagram()
+        return o._flat.cell_polygon(i)
+
+    def neighbours(self, i: int) -> np.ndarray:
+        """Sites whose cells share an edge with cell i (its Delaunay neighbours)."""
+        o = self._owner
+        if o._mesh is None:
+            d = self.to_diagram()
+            cyc = d.half_edge_cycle(i)
+            return np.unique(d.he_face[d.he_twin[cyc]])
+        return o._mesh.neighbours(int(i))
+
+    def to_diagram(self) -> Diagram:
+        """The whole diagram as a Diagram (O(n): for saving or comparing, not for every update)."""
+        o = self._owner
+        n = o._n_ids
+        pts = np.where(o._alive[:n, None], o._xy[:n], 0.0)
+        xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+        dup = np.full(n, -1, np.int32)
+        for c, p in o._primary.items():
+            dup[c] = p
+        present = o._alive[:n].copy()
+        if o._mesh is not None:
+            tv, opp = o._mesh.export()
+            tv = np.where(tv == dynamic.INFINITE, n, tv).astype(np.int32)
+            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp)
+        else:
+            holders = o._holders()
+            sub = collinear_dcel(xs[holders], ys[holders])
+            out = dict(sub)
+            out["he_face"] = holders[sub["he_face"]].astype(np.int32)
+            face_edge = np.full(n, -1, np.int32)
+            face_edge[holders] = sub["face_edge"]
+            out["face_edge"] = face_edge
+        out["dup"] = dup
+        return assemble(pts, self.bbox, 0, np.arange(n, dtype=np.int32), xs, ys, out,
+                        engine=o.engine, present=present, first_row_holds=False)
+
+    def delaunay_triangles(self) -> np.ndarray:
+        return self.to_diagram().delaunay_triangles()

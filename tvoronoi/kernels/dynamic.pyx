@@ -1,0 +1,483 @@
+"""A Delaunay triangulation that changes locally: insert, remove and relabel sites; read one cell."""
+
+import numpy as np
+
+from libc.stdint cimport int8_t, int32_t
+
+from tvoronoi.kernels.predicates cimport orient2d, incircle
+from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between, locate, insert_site
+from tvoronoi.kernels.cliplib cimport Box, make_box, on_box, clip_bisector, snap_inside, angular_ring
+from tvoronoi.kernels.distance cimport closer
+
+# The vertex at infinity of a dynamic mesh (site ids are 0 .. capacity - 1).
+INFINITE = 0x7FFFFFFE
+
+cdef enum:
+    MAX_STAR = 2048         # neighbours of one site handled by remove() and cell()
+    MAX_GROUP = 64          # triangles of one cocircular group looked at for its vertex
+    STATUS_DONE = 0
+    STATUS_FLAT = 1         # the sites left are collinear: no triangle remains
+
+
+cdef class DynamicMesh:
+    """Sites and their Delaunay triangulation (closed by a vertex at infinity).
+
+    Site ids are chosen by the caller; a removed id may be inserted again.
+    Every operation touches only the triangles around the sites it changes.
+    """
+
+    cdef Mesh m
+    cdef double* wx                 # the mesh's coordinates, writable
+    cdef double* wy
+    cdef dict arrays
+    cdef int cap_v, cap_t
+
+    def __init__(self, int capacity):
+        self.cap_v = 0
+        self.cap_t = 0
+        self.arrays = {}
+        self.m.n_finite = 0
+        self.m.n_tri = 0
+        self.m.n_free = 0
+        self.m.last = -1
+        self.m.epoch = 0
+        self.m.inf = INFINITE
+        self.m.n = 0
+        self.m.head = NULL
+        self.m.next_site = NULL
+        self.m.where = NULL
+        self.m.trace_cav = NULL
+        self.m.trace_new = NULL
+        self._grow(max(capacity, 4), 2 * max(capacity, 4))
+
+    def _grow(self, int cap_v, int cap_t):
+        """Make room for cap_v sites and cap_t triangles (arrays are copied, pointers renewed)."""
+        old = self.arrays
+        spec = {"x": (cap_v, np.float64), "y": (cap_v, np.float64), "vedge": (cap_v, np.int32),
+                "vmap": (cap_v, np.int32), "dup": (cap_v, np.int32),
+                "tv": (3 * cap_t, np.int32), "opp": (3 * cap_t, np.int32), "stamp": (cap_t, np.int32),
+                "cavity": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
+                "bnd_twin": (cap_t + 2, np.int32), "free_tri": (cap_t, np.int32),
+                "changed": (cap_t + 2, np.int32)}
+        new = {}
+        for name, (size, dtype) in spec.items():
+            arr = np.full(size, -1, dtype) if dtype is np.int32 else np.zeros(size, dtype)
+            if name in old:
+                arr[:len(old[name])] = old[name]
+            new[name] = arr
+        self.arrays = new
+        self.cap_v = cap_v
+        self.cap_t = cap_t
+        cdef double[::1] x = new["x"], y = new["y"]
+        cdef int32_t[::1] vedge = new["vedge"], vmap = new["vmap"], dup = new["dup"], tv = new["tv"]
+        cdef int32_t[::1] opp = new["opp"], stamp = new["stamp"], cavity = new["cavity"]
+        cdef int32_t[::1] bnd_a = new["bnd_a"], bnd_b = new["bnd_b"], bnd_twin = new["bnd_twin"]
+        cdef int32_t[::1] free_tri = new["free_tri"], changed = new["changed"]
+        self.m.x = &x[0]
+        self.m.y = &y[0]
+        self.wx = &x[0]
+        self.wy = &y[0]
+        self.m.vedge = &vedge[0]
+        self.m.vmap = &vmap[0]
+        self.m.dup = &dup[0]
+        self.m.tv = &tv[0]
+        self.m.opp = &opp[0]
+        self.m.stamp = &stamp[0]
+        self.m.cavity = &cavity[0]
+        self.m.bnd_a = &bnd_a[0]
+        self.m.bnd_b = &bnd_b[0]
+        self.m.bnd_twin = &bnd_twin[0]
+        self.m.free_tri = &free_tri[0]
+        self.m.changed = &changed[0]
+
+    def _reserve(self, int site):
+        if site >= self.cap_v:
+            self._grow(max(2 * self.cap_v, site + 1), self.cap_t)
+        if self.m.n_tri + 4 >= self.cap_t or 2 * self.cap_v + 8 > self.cap_t:
+            self._grow(self.cap_v, max(2 * self.cap_t, 2 * self.cap_v + 8))
+
+    def load(self, const double[::1] xs, const double[::1] ys, const int32_t[::1] ids,
+             const int32_t[::1] tv, const int32_t[::1] opp, int inf):
+        """Start from a batch triangulation: its vertex k is site ids[k], vertex inf is infinity."""
+        cdef int n = xs.shape[0], k, e, v, n_he = tv.shape[0]
+        top = int(np.max(ids)) + 1 if n else 0
+        self._grow(max(self.cap_v, top, 4), max(self.cap_t, n_he // 3 + 8, 2 * top + 8))
+        for k in range(n):
+            self.wx[ids[k]] = xs[k]
+            self.wy[ids[k]] = ys[k]
+        self.m.n_finite = 0
+        for e in range(n_he):
+            v = tv[e]
+            self.m.tv[e] = INFINITE if v == inf else ids[v]
+            self.m.opp[e] = opp[e]
+            if v != inf:
+                self.m.vedge[ids[v]] = e
+        self.m.n_tri = n_he // 3
+        self.m.n_free = 0
+        for k in range(self.m.n_tri):
+            if not is_infinite(&self.m, k):
+                self.m.n_finite += 1
+                self.m.last = k
+
+    @property
+    def n_finite(self):
+        """Finite triangles: 0 once the sites left are collinear (the mesh cannot hold them)."""
+        return self.m.n_finite
+
+    def set_site(self, int site, double x, double y):
+        """Place a site (not yet in the mesh), e.g. a repeated point that stays outside it."""
+        self._reserve(site)
+        self.wx[site] = x
+        self.wy[site] = y
+
+    def insert(self, int site, double x, double y):
+        """Insert a site; returns the site already at (x, y), or -1 once inserted."""
+        cdef int t0, before, k, e
+        self._reserve(site)
+        self.wx[site] = x
+        self.wy[site] = y
+        self.m.dup[site] = -1
+        self.m.n_changed = 0
+        with nogil:
+            t0 = locate(&self.m, self.m.last, x, y)
+            before = self.m.n_tri - self.m.n_free
+            insert_site(&self.m, site, t0)
+        if self.m.dup[site] >= 0:
+            return self.m.dup[site]
+        self.m.changed[self.m.n_changed] = site
+        self.m.n_changed += 1
+        return -1
+
+    def remove(self, int site):
+        """Take a site out and fill its hole with the Delaunay triangles of its neighbours."""
+        cdef int status
+        self._reserve(site)
+        with nogil:
+            status = remove_site(&self.m, site)
+        return status
+
+    def relabel(self, int old, int new):
+        """Give the vertex of site old to site new (a repeated point taking over its place)."""
+        cdef int e0, e
+        self._reserve(new)
+        self.wx[new] = self.m.x[old]
+        self.wy[new] = self.m.y[old]
+        e0 = self.m.vedge[old]
+        e = e0
+        while True:
+            self.m.tv[e] = new
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        self.m.vedge[new] = e0
+        self.m.vedge[old] = -1
+
+    def changed(self):
+        """Sites whose cells the last insert or remove changed."""
+        return np.asarray(self.arrays["changed"][:self.m.n_changed]).copy()
+
+    def coordinates(self, int site):
+        return self.m.x[site], self.m.y[site]
+
+    def export(self):
+        """(tv, opp) of the live triangles, compacted (vertex INFINITE kept)."""
+        tv = self.arrays["tv"][:3 * self.m.n_tri].reshape(-1, 3)
+        live = np.ones(self.m.n_tri, bool)
+        live[self.arrays["free_tri"][:self.m.n_free]] = False
+        new_index = np.cumsum(live) - 1
+        opp = self.arrays["opp"][:3 * self.m.n_tri]
+        opp_t = new_index[opp // 3] * 3 + opp % 3
+        return (tv[live].ravel().copy(), opp_t.reshape(-1, 3)[live].ravel().astype(np.int32))
+
+    def cell(self, int site, double xmin, double ymin, double xmax, double ymax):
+        """The cell of a site in the mesh, clipped to the box: a (k, 2) ring, counter-clockwise."""
+        cdef double rx[MAX_STAR * 2 + 8]
+        cdef double ry[MAX_STAR * 2 + 8]
+        cdef int k
+        cdef Box box = make_box(xmin, ymin, xmax, ymax)
+        if self.m.vedge[site] < 0:
+            return np.empty((0, 2))
+        with nogil:
+            k = cell_ring(&self.m, site, &box, rx, ry)
+        out = np.empty((max(k, 0), 2))
+        for i in range(k):
+            out[i, 0] = rx[i]
+            out[i, 1] = ry[i]
+        return out
+
+    def neighbours(self, int site):
+        """Sites joined to this one by a Delaunay edge, counter-clockwise."""
+        out = []
+        cdef int e0 = self.m.vedge[site], e = e0
+        if e0 < 0:
+            return np.empty(0, np.int32)
+        while True:
+            if self.m.tv[nxt(e)] != INFINITE:
+                out.append(self.m.tv[nxt(e)])
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        return np.asarray(out, np.int32)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# removal: the hole is filled ear by ear, each ear a Delaunay triangle of the hole's vertices
+
+cdef inline bint ear_ok(Mesh* m, int* poly, int* nextp, int a, int b, int c) noexcept nogil:
+    """Triangle (poly[a], poly[b], poly[c]) of consecutive hole vertices is Delaunay among them."""
+    cdef int va = poly[a], vb = poly[b], vc = poly[c], u, w, q, vq, o
+    cdef bint finite = va != m.inf and vb != m.inf and vc != m.inf
+    if finite:
+        if orient2d(m.x[va], m.y[va], m.x[vb], m.y[vb], m.x[vc], m.y[vc]) <= 0:
+            return False
+    elif vc == m.inf:
+        u = va; w = vb
+    elif va == m.inf:
+        u = vb; w = vc
+    else:
+        u = vc; w = va
+    q = nextp[c]
+    while q != a:
+        vq = poly[q]
+        if vq != m.inf:
+            if finite:
+                if incircle(m.x[va], m.y[va], m.x[vb], m.y[vb], m.x[vc], m.y[vc], m.x[vq], m.y[vq]) > 0:
+                    return False
+            else:
+                # an infinite ear is a new hull edge u->w: nothing may lie beyond it
+                o = orient2d(m.x[u], m.y[u], m.x[w], m.y[w], m.x[vq], m.y[vq])
+                if o > 0 or (o == 0 and strictly_between(m, u, w, m.x[vq], m.y[vq])):
+                    return False
+        q = nextp[q]
+    return True
+
+
+cdef int new_triangle(Mesh* m, int a, int b, int c, int o_ab, int o_bc, int o_ca) noexcept nogil:
+    """A triangle in a free slot, glued to the given outside half-edges (-1: none yet)."""
+    cdef int T, k, v
+    m.n_free -= 1
+    T = m.free_tri[m.n_free]
+    m.tv[3 * T] = a
+    m.tv[3 * T + 1] = b
+    m.tv[3 * T + 2] = c
+    m.opp[3 * T] = o_ab
+    m.opp[o_ab] = 3 * T
+    m.opp[3 * T + 1] = o_bc
+    m.opp[o_bc] = 3 * T + 1
+    if o_ca >= 0:
+        m.opp[3 * T + 2] = o_ca
+        m.opp[o_ca] = 3 * T + 2
+    for k in range(3):
+        v = m.tv[3 * T + k]
+        if v != m.inf:
+            m.vedge[v] = 3 * T + k
+    if not is_infinite(m, T):
+        m.n_finite += 1
+        m.last = T
+    return T
+
+
+cdef int remove_site(Mesh* m, int v) noexcept nogil:
+    cdef int poly[MAX_STAR]
+    cdef int out[MAX_STAR]
+    cdef int nextp[MAX_STAR]
+    cdef int prevp[MAX_STAR]
+    cdef int e0 = m.vedge[v], e, ne, k = 0, q, t, a, b, c, j, tries, remaining, T
+    cdef bint found
+    m.n_changed = 0
+    # the star of v: its triangles go, the edges opposite v bound the hole (counter-clockwise)
+    e = e0
+    while True:
+        t = e // 3
+        if k == MAX_STAR:
+            return -1
+        if not is_infinite(m, t):
+            m.n_finite -= 1
+        ne = nxt(e)
+        poly[k] = m.tv[ne]
+        out[k] = m.opp[ne]
+        m.free_tri[m.n_free] = t
+        m.n_free += 1
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            break
+    m.vedge[v] = -1
+    for q in range(k):
+        nextp[q] = q + 1 if q + 1 < k else 0
+        prevp[q] = q - 1 if q > 0 else k - 1
+        if poly[q] != m.inf:
+            m.changed[m.n_changed] = poly[q]
+            m.n_changed += 1
+    remaining = k
+    j = 0
+    while remaining > 3:
+        found = False
+        tries = 0
+        while tries < remaining:
+            if ear_ok(m, poly, nextp, prevp[j], j, nextp[j]):
+                found = True
+                break
+            j = nextp[j]
+            tries += 1
+        if not found:
+            return -1
+        a = prevp[j]
+        c = nextp[j]
+        T = new_triangle(m, poly[a], poly[j], poly[c], out[a], out[j], -1)
+        out[a] = 3 * T + 2          # the hole's new edge a->c has the ear beyond it
+        nextp[a] = c
+        prevp[c] = a
+        remaining -= 1
+        j = a
+    a = j
+    b = nextp[a]
+    c = nextp[b]
+    new_triangle(m, poly[a], poly[b], poly[c], out[a], out[b], out[c])
+    if m.n_finite == 0:
+        return STATUS_FLAT
+    if m.last < 0 or is_infinite(m, m.last) or m.tv[3 * m.last] == v or m.tv[3 * m.last + 1] == v \
+            or m.tv[3 * m.last + 2] == v:
+        # the walks' starting triangle went with the hole: take the finite one beyond a new hull edge
+        for q in range(k):
+            if out[q] >= 0 and not is_infinite(m, out[q] // 3):
+                m.last = out[q] // 3
+                break
+    return STATUS_DONE
+
+
+# ---------------------------------------------------------------------------------------------------------
+# one cell, read locally
+
+cdef void group_centre(Mesh* m, int t, double* cx, double* cy) noexcept nogil:
+    """The Voronoi vertex of triangle t: the circumcentre of the best-conditioned triangle of its
+    cocircular group, so that every cell sharing the vertex computes the same bits."""
+    cdef int group[MAX_GROUP]
+    cdef int n = 1, j = 0, k, e, o, u, best = t, a, b, c, d
+    cdef double det, best_det = -1.0, bx, by, qx, qy, bb, qq
+    group[0] = t
+    while j < n:
+        u = group[j]
+        j += 1
+        a = m.tv[3 * u]; b = m.tv[3 * u + 1]; c = m.tv[3 * u + 2]
+        det = (m.x[b] - m.x[a]) * (m.y[c] - m.y[a]) - (m.y[b] - m.y[a]) * (m.x[c] - m.x[a])
+        if det < 0:
+            det = -det
+        if det > best_det or (det == best_det and u < best):
+            best_det = det
+            best = u
+        for e in range(3 * u, 3 * u + 3):
+            o = m.opp[e]
+            if is_infinite(m, o // 3):
+                continue
+            d = m.tv[prv(o)]
+            if incircle(m.x[a], m.y[a], m.x[b], m.y[b], m.x[c], m.y[c], m.x[d], m.y[d]) != 0:
+                continue
+            for k in range(n):
+                if group[k] == o // 3:
+                    break
+            else:
+                if n < MAX_GROUP:
+                    group[n] = o // 3
+                    n += 1
+    a = m.tv[3 * best]; b = m.tv[3 * best + 1]; c = m.tv[3 * best + 2]
+    bx = m.x[b] - m.x[a]; by = m.y[b] - m.y[a]
+    qx = m.x[c] - m.x[a]; qy = m.y[c] - m.y[a]
+    det = 2.0 * (bx * qy - by * qx)
+    bb = bx * bx + by * by
+    qq = qx * qx + qy * qy
+    cx[0] = m.x[a] + (qy * bb - by * qq) / det
+    cy[0] = m.y[a] + (bx * qq - qx * bb) / det
+
+
+cdef int cell_ring(Mesh* m, int site, Box* box, double* rx, double* ry) noexcept nogil:
+    """The cell of site clipped to the box, counter-clockwise, into rx, ry; returns its length."""
+    cdef int nb[MAX_STAR]
+    cdef int tri[MAX_STAR]
+    cdef double vx[MAX_STAR]
+    cdef double vy[MAX_STAR]
+    cdef bint fin[MAX_STAR]
+    cdef bint ins[MAX_STAR]
+    cdef int ids[MAX_STAR * 2 + 8]
+    cdef double ang[MAX_STAR * 2 + 8]
+    cdef double cxs[4]
+    cdef double cys[4]
+    cdef int e0 = m.vedge[site], e, k = 0, j, p, count = 0, a, c
+    cdef double sx = m.x[site], sy = m.y[site], mx, my, dx, dy, t0, t1, x, y
+    cdef bint fast = True, owned
+    e = e0
+    while True:
+        if k == MAX_STAR:
+            return 0
+        nb[k] = m.tv[nxt(e)]
+        tri[k] = e // 3
+        fin[k] = not is_infinite(m, tri[k])
+        if fin[k]:
+            group_centre(m, tri[k], &vx[k], &vy[k])
+            ins[k] = snap_inside(box, &vx[k], &vy[k])
+        else:
+            ins[k] = False
+        fast = fast and ins[k]
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            break
+    if fast:
+        # an interior cell: its vertices in order, each group's vertex once
+        for j in range(k):
+            if count > 0 and vx[j] == rx[count - 1] and vy[j] == ry[count - 1]:
+                continue
+            rx[count] = vx[j]
+            ry[count] = vy[j]
+            count += 1
+        while count > 1 and rx[count - 1] == rx[0] and ry[count - 1] == ry[0]:
+            count -= 1
+        return count
+    # a cell that meets the box edge: clipped edges and owned corners, in angular order
+    for j in range(k):
+        a = nb[j]
+        if a == m.inf:
+            continue
+        p = j - 1 if j > 0 else k - 1          # the triangle on the right of site->a
+        if fin[p] and fin[j] and vx[p] == vx[j] and vy[p] == vy[j]:
+            continue                             # a zero-length edge of a cocircular group
+        if fin[p] and fin[j] and ins[p] and ins[j]:
+            rx[count] = vx[p]; ry[count] = vy[p]
+            rx[count + 1] = vx[j]; ry[count + 1] = vy[j]
+            count += 2
+            continue
+        if not clip_bisector(box, sx, sy, m.x[a], m.y[a], vx[p], vy[p], fin[p], vx[j], vy[j], fin[j],
+                             &mx, &my, &dx, &dy, &t0, &t1):
+            continue
+        if fin[p] and ins[p]:
+            rx[count] = vx[p]; ry[count] = vy[p]
+        else:
+            x = mx + t0 * dx; y = my + t0 * dy
+            on_box(box, &x, &y)
+            rx[count] = x; ry[count] = y
+        if fin[j] and ins[j]:
+            rx[count + 1] = vx[j]; ry[count + 1] = vy[j]
+        else:
+            x = mx + t1 * dx; y = my + t1 * dy
+            on_box(box, &x, &y)
+            rx[count + 1] = x; ry[count + 1] = y
+        count += 2
+    cxs[0] = box.xmin; cxs[1] = box.xmax; cxs[2] = box.xmax; cxs[3] = box.xmin
+    cys[0] = box.ymin; cys[1] = box.ymin; cys[2] = box.ymax; cys[3] = box.ymax
+    for c in range(4):
+        owned = True
+        for j in range(k):
+            a = nb[j]
+            if a != m.inf and closer(cxs[c], cys[c], sx, sy, m.x[a], m.y[a]) > 0:
+                owned = False
+                break
+        if owned:
+            rx[count] = cxs[c]
+            ry[count] = cys[c]
+            count += 1
+    if count < 3:
+        return 0
+    for j in range(count):
+        ids[j] = j
+    count = angular_ring(rx, ry, ids, ang, count)
+    return count if count >= 3 else 0
