@@ -128,8 +128,10 @@ class DynamicVoronoi:
             res = fortune.sweep(sx, sy)
             ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
         else:
-            perm = np.arange(len(ids), dtype=np.int32)
-            sx, sy = xs, ys
+            # a biased randomized insertion order, as in the batch engine
+            rank = np.random.default_rng(0).permutation(len(ids)).astype(np.int64)
+            perm = np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+            sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
             status, tv, opp, dup = delaunay.triangulate(sx, sy)
             ok = status == delaunay.STATUS_OK
         order_ids = ids[perm]
@@ -180,7 +182,10 @@ class DynamicVoronoi:
             self._rebuild()
             self.changed = np.union1d(self._holders(), [i]).astype(np.int32)
             return
-        held = self._mesh.insert(i, x, y)
+        if self.engine == "fortune":
+            held = self._mesh.insert_swept(i, x, y)
+        else:
+            held = self._mesh.insert(i, x, y)
         if held >= 0:
             # a repeated point: it shares the cell of the site already there
             holder = self._primary.get(held, held)
@@ -222,7 +227,7 @@ class DynamicVoronoi:
             self._alive[i] = False
             self._rebuild()
             return np.append(self._holders(), i).astype(np.int32)
-        status = self._mesh.remove(i)
+        status = self._mesh.remove_swept(i) if self.engine == "fortune" else self._mesh.remove(i)
         if status != 0:
             # the sites left are collinear (or the hole was beyond the local repair): start again
             self._alive[i] = False

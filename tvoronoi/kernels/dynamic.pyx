@@ -2,21 +2,26 @@
 
 import numpy as np
 
+from tvoronoi.kernels import fortune
+
 from libc.stdint cimport int8_t, int32_t
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
-from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between, locate, insert_site
+from tvoronoi.kernels.mesh cimport (
+    Mesh, nxt, prv, is_infinite, strictly_between, locate, insert_site, find_cavity, fill_cavity,
+)
 from tvoronoi.kernels.cliplib cimport Box, make_box, on_box, clip_bisector, snap_inside, angular_ring
 from tvoronoi.kernels.distance cimport closer
 
-# The vertex at infinity of a dynamic mesh (site ids are 0 .. capacity - 1).
-INFINITE = 0x7FFFFFFE
-
 cdef enum:
+    INF_VERTEX = 0x7FFFFFFE  # the vertex at infinity of a dynamic mesh (site ids stay below it)
     MAX_STAR = 2048         # neighbours of one site handled by remove() and cell()
     MAX_GROUP = 64          # triangles of one cocircular group looked at for its vertex
     STATUS_DONE = 0
     STATUS_FLAT = 1         # the sites left are collinear: no triangle remains
+
+
+INFINITE = INF_VERTEX
 
 
 cdef class DynamicMesh:
@@ -30,6 +35,7 @@ cdef class DynamicMesh:
     cdef double* wx                 # the mesh's coordinates, writable
     cdef double* wy
     cdef dict arrays
+    cdef public bint swept_ok       # the last swept update used the sweep's own triangles
     cdef int cap_v, cap_t
 
     def __init__(self, int capacity):
@@ -41,7 +47,7 @@ cdef class DynamicMesh:
         self.m.n_free = 0
         self.m.last = -1
         self.m.epoch = 0
-        self.m.inf = INFINITE
+        self.m.inf = INF_VERTEX
         self.m.n = 0
         self.m.head = NULL
         self.m.next_site = NULL
@@ -108,7 +114,7 @@ cdef class DynamicMesh:
         self.m.n_finite = 0
         for e in range(n_he):
             v = tv[e]
-            self.m.tv[e] = INFINITE if v == inf else ids[v]
+            self.m.tv[e] = INF_VERTEX if v == inf else ids[v]
             self.m.opp[e] = opp[e]
             if v != inf:
                 self.m.vedge[ids[v]] = e
@@ -156,6 +162,126 @@ cdef class DynamicMesh:
             status = remove_site(&self.m, site)
         return status
 
+    # -- the same updates the way of Fortune's engine: sweep the changed region, splice the result --
+
+    def _swept(self, sites):
+        """Fortune's sweep over a few sites: their Delaunay triangles as global vertex triples."""
+        ids = np.fromiter(sites, np.int32)
+        xs = np.array([self.m.x[v] for v in ids])
+        ys = np.array([self.m.y[v] for v in ids])
+        order = np.lexsort((xs, ys))
+        ids, xs, ys = ids[order], np.ascontiguousarray(xs[order]), np.ascontiguousarray(ys[order])
+        res = fortune.sweep(xs, ys)
+        if "tv" not in res:
+            return None
+        glob = np.append(ids, INF_VERTEX).astype(np.int64)
+        return glob[res["tv"].reshape(-1, 3)]
+
+    def insert_swept(self, int site, double x, double y):
+        """Insert a site as Fortune's engine does: find the region whose cells the site takes
+        (its conflict region), sweep the region's sites and the ring around them, and splice
+        the new site's triangles from that sweep in. Returns as insert(); the sweep's star of
+        the site is checked against the region's boundary (where cocircular sites let the
+        two differ, the exact cavity fan is used)."""
+        cdef int t0, q, a, b
+        self._reserve(site)
+        self.wx[site] = x
+        self.wy[site] = y
+        self.m.dup[site] = -1
+        self.m.n_changed = 0
+        t0 = locate(&self.m, self.m.last, x, y)
+        if not find_cavity(&self.m, site, t0):
+            return self.m.dup[site]
+        boundary = set()
+        region = {site}
+        for q in range(self.m.n_bnd):
+            a = self.m.bnd_a[q]
+            b = self.m.bnd_b[q]
+            boundary.add((a, b))
+            if a != INF_VERTEX:
+                region.add(a)
+                region.update(self.neighbours(a).tolist())
+        tris = self._swept(region)
+        star = set()
+        if tris is not None:
+            for t in tris.tolist():
+                if site in t:
+                    k = t.index(site)
+                    star.add((t[(k + 1) % 3], t[(k + 2) % 3]))
+        self.swept_ok = star == boundary
+        with nogil:
+            fill_cavity(&self.m, site)
+        self.m.changed[self.m.n_changed] = site
+        self.m.n_changed += 1
+        return -1
+
+    def remove_swept(self, int site):
+        """Remove a site as Fortune's engine does: sweep the sites around the hole and splice
+        the sweep's triangles inside the hole in (ear filling where the hole is open to
+        infinity, or the sweep's triangles do not fit the hole exactly)."""
+        cdef int e0 = self.m.vedge[site], e, k, q, t, T, j, x, y
+        poly, outs, slots = [], [], []
+        e = e0
+        while True:
+            poly.append(self.m.tv[nxt(e)])
+            outs.append(self.m.opp[nxt(e)])
+            slots.append(e // 3)
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        k = len(poly)
+        self.swept_ok = False
+        if INF_VERTEX in poly or k > 64:
+            return self.remove(site)
+        pos = {v: q for q, v in enumerate(poly)}
+        tris = self._swept(poly)
+        if tris is None:
+            return self.remove(site)
+        inside = []
+        for tri in tris.tolist():
+            if INF_VERTEX in tri:
+                continue
+            pa, pb, pc = pos[tri[0]], pos[tri[1]], pos[tri[2]]
+            # a triangle inside the hole meets the hole's vertices in their own cyclic order
+            if (pb - pa) % k + (pc - pb) % k + (pa - pc) % k == k:
+                inside.append(tri)
+        edges = {(tri[j], tri[(j + 1) % 3]) for tri in inside for j in range(3)}
+        if len(inside) != k - 2 or any((poly[q], poly[(q + 1) % k]) not in edges for q in range(k)):
+            return self.remove(site)
+        # splice: the star's slots are freed, the sweep's triangles take them
+        for t in slots:
+            if not is_infinite(&self.m, t):
+                self.m.n_finite -= 1
+            self.m.free_tri[self.m.n_free] = t
+            self.m.n_free += 1
+        self.m.vedge[site] = -1
+        half = {}
+        for tri in inside:
+            self.m.n_free -= 1
+            T = self.m.free_tri[self.m.n_free]
+            for j in range(3):
+                x = tri[j]
+                y = tri[(j + 1) % 3]
+                self.m.tv[3 * T + j] = x
+                self.m.vedge[x] = 3 * T + j
+                if pos[y] == (pos[x] + 1) % k:
+                    q = outs[pos[x]]
+                else:
+                    q = half.pop((y, x), -1)
+                    if q < 0:
+                        half[(x, y)] = 3 * T + j
+                        continue
+                self.m.opp[3 * T + j] = q
+                self.m.opp[q] = 3 * T + j
+            self.m.n_finite += 1
+            self.m.last = T
+        self.m.n_changed = 0
+        for v in poly:
+            self.m.changed[self.m.n_changed] = v
+            self.m.n_changed += 1
+        self.swept_ok = True
+        return STATUS_DONE
+
     def relabel(self, int old, int new):
         """Give the vertex of site old to site new (a repeated point taking over its place)."""
         cdef int e0, e
@@ -180,7 +306,7 @@ cdef class DynamicMesh:
         return self.m.x[site], self.m.y[site]
 
     def export(self):
-        """(tv, opp) of the live triangles, compacted (vertex INFINITE kept)."""
+        """(tv, opp) of the live triangles, compacted (vertex INF_VERTEX kept)."""
         tv = self.arrays["tv"][:3 * self.m.n_tri].reshape(-1, 3)
         live = np.ones(self.m.n_tri, bool)
         live[self.arrays["free_tri"][:self.m.n_free]] = False
@@ -212,7 +338,7 @@ cdef class DynamicMesh:
         if e0 < 0:
             return np.empty(0, np.int32)
         while True:
-            if self.m.tv[nxt(e)] != INFINITE:
+            if self.m.tv[nxt(e)] != INF_VERTEX:
                 out.append(self.m.tv[nxt(e)])
             e = self.m.opp[prv(e)]
             if e == e0:

@@ -57,6 +57,8 @@ cdef struct Mesh:
     int n_tri
     int last            # a recently created finite triangle: where walks start
     int epoch           # counts insertions: stamps of older cavities never match
+    int n_cav           # the last cavity found: its triangles and boundary edges
+    int n_bnd
 
 
 cdef inline bint is_infinite(Mesh* m, int t) noexcept nogil:
@@ -131,18 +133,17 @@ cdef inline void list_site(Mesh* m, int t, int s) noexcept nogil:
     m.where[s] = t
 
 
-cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
-    """Insert site i, whose conflict region contains triangle t0.
+cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
+    """The conflict region of site i, which contains triangle t0; False for a repeated point.
 
     # the cavity: every triangle whose circumcircle strictly contains i,
     # found by a search over edges from t0 (the region is connected and
     # star-shaped from i); its boundary is a cycle of k + 2 edges for k
-    # triangles, each of which is joined to i by a new triangle.
+    # triangles (m.cavity, m.bnd_a, m.bnd_b, m.bnd_twin; m.n_cav, m.n_bnd)
     """
     cdef double px = m.x[i], py = m.y[i]
     cdef int32_t conflict, tested
-    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, q, a, b, T, T2, s, s_next
-    cdef int pending = -1
+    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, a
     # degenerate case: a repeated point; the walk ends on a triangle that has it as a vertex
     if not is_infinite(m, t0):
         for k in range(3):
@@ -151,7 +152,7 @@ cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
                 m.dup[i] = a
                 if m.head != NULL:
                     m.where[i] = -1
-                return
+                return False
     m.epoch += 1
     conflict = 2 * m.epoch
     tested = conflict + 1
@@ -177,6 +178,15 @@ cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
             m.bnd_b[n_bnd] = m.tv[nxt(e)]
             m.bnd_twin[n_bnd] = o
             n_bnd += 1
+    m.n_cav = n_cav
+    m.n_bnd = n_bnd
+    return True
+
+
+cdef inline void fill_cavity(Mesh* m, int i) noexcept nogil:
+    """Replace the cavity just found by the fan of triangles joining its boundary to site i."""
+    cdef int n_cav = m.n_cav, n_bnd = m.n_bnd, q, t, s, s_next, a, b, o, T, T2
+    cdef int pending = -1
 
     # take the waiting sites of the doomed triangles (textbook order only)
     if m.head != NULL:
@@ -254,3 +264,9 @@ cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
         pending = s_next
 
 
+
+
+cdef inline void insert_site(Mesh* m, int i, int t0) noexcept nogil:
+    """Insert site i, whose conflict region contains triangle t0 (Bowyer-Watson)."""
+    if find_cavity(m, i, t0):
+        fill_cavity(m, i)
