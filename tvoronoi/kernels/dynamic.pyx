@@ -2,8 +2,6 @@
 
 import numpy as np
 
-from tvoronoi.kernels import fortune
-
 from libc.stdint cimport int8_t, int32_t
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
@@ -12,11 +10,14 @@ from tvoronoi.kernels.mesh cimport (
 )
 from tvoronoi.kernels.cliplib cimport Box, make_box, on_box, clip_bisector, snap_inside, angular_ring
 from tvoronoi.kernels.distance cimport closer
+from tvoronoi.kernels.fortune cimport sweep_triangles
 
 cdef enum:
     INF_VERTEX = 0x7FFFFFFE  # the vertex at infinity of a dynamic mesh (site ids stay below it)
     MAX_STAR = 2048         # neighbours of one site handled by remove() and cell()
     MAX_GROUP = 64          # triangles of one cocircular group looked at for its vertex
+    MAX_REGION = 256        # sites swept for one local update by Fortune's engine
+    MAX_HOLE = 64           # hole size filled by a sweep (larger holes are filled by ears)
     STATUS_DONE = 0
     STATUS_FLAT = 1         # the sites left are collinear: no triangle remains
 
@@ -36,6 +37,9 @@ cdef class DynamicMesh:
     cdef double* wy
     cdef dict arrays
     cdef public bint swept_ok       # the last swept update used the sweep's own triangles
+    cdef int32_t* vmark             # scratch marks per site, and the epoch that makes them current
+    cdef int32_t mark_epoch
+    cdef int32_t* nextb             # scratch: the boundary edge leaving each site
     cdef int cap_v, cap_t
 
     def __init__(self, int capacity):
@@ -43,6 +47,7 @@ cdef class DynamicMesh:
         self.cap_t = 0
         self.arrays = {}
         self.m.n_finite = 0
+        self.mark_epoch = 0
         self.m.n_tri = 0
         self.m.n_free = 0
         self.m.last = -1
@@ -64,7 +69,7 @@ cdef class DynamicMesh:
                 "tv": (3 * cap_t, np.int32), "opp": (3 * cap_t, np.int32), "stamp": (cap_t, np.int32),
                 "cavity": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
                 "bnd_twin": (cap_t + 2, np.int32), "free_tri": (cap_t, np.int32),
-                "changed": (cap_t + 2, np.int32)}
+                "changed": (cap_t + 2, np.int32), "vmark": (cap_v, np.int32), "nextb": (cap_v, np.int32)}
         new = {}
         for name, (size, dtype) in spec.items():
             arr = np.full(size, -1, dtype) if dtype is np.int32 else np.zeros(size, dtype)
@@ -79,6 +84,9 @@ cdef class DynamicMesh:
         cdef int32_t[::1] opp = new["opp"], stamp = new["stamp"], cavity = new["cavity"]
         cdef int32_t[::1] bnd_a = new["bnd_a"], bnd_b = new["bnd_b"], bnd_twin = new["bnd_twin"]
         cdef int32_t[::1] free_tri = new["free_tri"], changed = new["changed"]
+        cdef int32_t[::1] vmark = new["vmark"], nextb = new["nextb"]
+        self.vmark = &vmark[0]
+        self.nextb = &nextb[0]
         self.m.x = &x[0]
         self.m.y = &y[0]
         self.wx = &x[0]
@@ -164,53 +172,24 @@ cdef class DynamicMesh:
 
     # -- the same updates the way of Fortune's engine: sweep the changed region, splice the result --
 
-    def _swept(self, sites):
-        """Fortune's sweep over a few sites: their Delaunay triangles as global vertex triples."""
-        ids = np.fromiter(sites, np.int32)
-        xs = np.array([self.m.x[v] for v in ids])
-        ys = np.array([self.m.y[v] for v in ids])
-        order = np.lexsort((xs, ys))
-        ids, xs, ys = ids[order], np.ascontiguousarray(xs[order]), np.ascontiguousarray(ys[order])
-        res = fortune.sweep(xs, ys)
-        if "tv" not in res:
-            return None
-        glob = np.append(ids, INF_VERTEX).astype(np.int64)
-        return glob[res["tv"].reshape(-1, 3)]
-
     def insert_swept(self, int site, double x, double y):
         """Insert a site as Fortune's engine does: find the region whose cells the site takes
-        (its conflict region), sweep the region's sites and the ring around them, and splice
-        the new site's triangles from that sweep in. Returns as insert(); the sweep's star of
-        the site is checked against the region's boundary (where cocircular sites let the
-        two differ, the exact cavity fan is used)."""
-        cdef int t0, q, a, b
+        (its conflict region), sweep the region's sites with the ring around them, and splice
+        the sweep's triangles around the new site in. Returns as insert(). (Where cocircular
+        sites let the sweep's star differ from the region's boundary, the exact cavity fan is
+        spliced instead; swept_ok says which happened.)"""
+        cdef int status
         self._reserve(site)
         self.wx[site] = x
         self.wy[site] = y
         self.m.dup[site] = -1
         self.m.n_changed = 0
-        t0 = locate(&self.m, self.m.last, x, y)
-        if not find_cavity(&self.m, site, t0):
-            return self.m.dup[site]
-        boundary = set()
-        region = {site}
-        for q in range(self.m.n_bnd):
-            a = self.m.bnd_a[q]
-            b = self.m.bnd_b[q]
-            boundary.add((a, b))
-            if a != INF_VERTEX:
-                region.add(a)
-                region.update(self.neighbours(a).tolist())
-        tris = self._swept(region)
-        star = set()
-        if tris is not None:
-            for t in tris.tolist():
-                if site in t:
-                    k = t.index(site)
-                    star.add((t[(k + 1) % 3], t[(k + 2) % 3]))
-        self.swept_ok = star == boundary
+        self.mark_epoch += 1
         with nogil:
-            fill_cavity(&self.m, site)
+            status = insert_by_sweep(&self.m, site, self.vmark, self.mark_epoch, self.nextb)
+        if status == -2:
+            return self.m.dup[site]
+        self.swept_ok = status == 1
         self.m.changed[self.m.n_changed] = site
         self.m.n_changed += 1
         return -1
@@ -218,69 +197,15 @@ cdef class DynamicMesh:
     def remove_swept(self, int site):
         """Remove a site as Fortune's engine does: sweep the sites around the hole and splice
         the sweep's triangles inside the hole in (ear filling where the hole is open to
-        infinity, or the sweep's triangles do not fit the hole exactly)."""
-        cdef int e0 = self.m.vedge[site], e, k, q, t, T, j, x, y
-        poly, outs, slots = [], [], []
-        e = e0
-        while True:
-            poly.append(self.m.tv[nxt(e)])
-            outs.append(self.m.opp[nxt(e)])
-            slots.append(e // 3)
-            e = self.m.opp[prv(e)]
-            if e == e0:
-                break
-        k = len(poly)
-        self.swept_ok = False
-        if INF_VERTEX in poly or k > 64:
-            return self.remove(site)
-        pos = {v: q for q, v in enumerate(poly)}
-        tris = self._swept(poly)
-        if tris is None:
-            return self.remove(site)
-        inside = []
-        for tri in tris.tolist():
-            if INF_VERTEX in tri:
-                continue
-            pa, pb, pc = pos[tri[0]], pos[tri[1]], pos[tri[2]]
-            # a triangle inside the hole meets the hole's vertices in their own cyclic order
-            if (pb - pa) % k + (pc - pb) % k + (pa - pc) % k == k:
-                inside.append(tri)
-        edges = {(tri[j], tri[(j + 1) % 3]) for tri in inside for j in range(3)}
-        if len(inside) != k - 2 or any((poly[q], poly[(q + 1) % k]) not in edges for q in range(k)):
-            return self.remove(site)
-        # splice: the star's slots are freed, the sweep's triangles take them
-        for t in slots:
-            if not is_infinite(&self.m, t):
-                self.m.n_finite -= 1
-            self.m.free_tri[self.m.n_free] = t
-            self.m.n_free += 1
-        self.m.vedge[site] = -1
-        half = {}
-        for tri in inside:
-            self.m.n_free -= 1
-            T = self.m.free_tri[self.m.n_free]
-            for j in range(3):
-                x = tri[j]
-                y = tri[(j + 1) % 3]
-                self.m.tv[3 * T + j] = x
-                self.m.vedge[x] = 3 * T + j
-                if pos[y] == (pos[x] + 1) % k:
-                    q = outs[pos[x]]
-                else:
-                    q = half.pop((y, x), -1)
-                    if q < 0:
-                        half[(x, y)] = 3 * T + j
-                        continue
-                self.m.opp[3 * T + j] = q
-                self.m.opp[q] = 3 * T + j
-            self.m.n_finite += 1
-            self.m.last = T
-        self.m.n_changed = 0
-        for v in poly:
-            self.m.changed[self.m.n_changed] = v
-            self.m.n_changed += 1
-        self.swept_ok = True
-        return STATUS_DONE
+        infinity, or the sweep's triangles do not fit it exactly). Returns as remove()."""
+        cdef int status
+        self._reserve(site)
+        with nogil:
+            status = remove_by_sweep(&self.m, site)
+        self.swept_ok = status == 1
+        if status == 1:
+            return STATUS_DONE
+        return self.remove(site)
 
     def relabel(self, int old, int new):
         """Give the vertex of site old to site new (a repeated point taking over its place)."""
@@ -607,3 +532,186 @@ cdef int cell_ring(Mesh* m, int site, Box* box, double* rx, double* ry) noexcept
         ids[j] = j
     count = angular_ring(rx, ry, ids, ang, count)
     return count if count >= 3 else 0
+
+
+# ---------------------------------------------------------------------------------------------------------
+# local updates by Fortune's sweep
+
+cdef void sort_by_sweep(int* ids, double* xs, double* ys, int n) noexcept nogil:
+    """Sort sites by y, then x (insertion sort: a region has a few dozen sites)."""
+    cdef int k, j, v
+    cdef double x, y
+    for k in range(1, n):
+        v = ids[k]; x = xs[k]; y = ys[k]
+        j = k - 1
+        while j >= 0 and (ys[j] > y or (ys[j] == y and xs[j] > x)):
+            ids[j + 1] = ids[j]; xs[j + 1] = xs[j]; ys[j + 1] = ys[j]
+            j -= 1
+        ids[j + 1] = v; xs[j + 1] = x; ys[j + 1] = y
+
+
+cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_t* nextb) noexcept nogil:
+    """1: the sweep's star was spliced; 0: the cavity fan was (cocircular or large region); -2: a repeat."""
+    cdef int ids[MAX_REGION]
+    cdef double xs[MAX_REGION]
+    cdef double ys[MAX_REGION]
+    cdef int32_t tvl[6 * MAX_REGION]
+    cdef int n = 0, q, a, b, e0, e, nt, k, j, lp = -1, matched = 0, nextb_inf = -1
+    cdef bint ok = True
+    cdef int t0 = locate(m, m.last, m.x[site], m.y[site])
+    if not find_cavity(m, site, t0):
+        return -2
+    # the region: the new site, the sites whose cells it takes (the cavity's boundary) and their ring
+    ids[n] = site
+    n += 1
+    mark[site] = epoch
+    nextb[site] = -1
+    for q in range(m.n_bnd):
+        a = m.bnd_a[q]
+        if a == m.inf:
+            nextb_inf = m.bnd_b[q]
+            continue
+        if mark[a] != epoch:
+            if n == MAX_REGION:
+                ok = False
+                break
+            mark[a] = epoch
+            ids[n] = a
+            n += 1
+        nextb[a] = m.bnd_b[q]
+        # the ring: every neighbour of a boundary site
+        e0 = m.vedge[a]
+        e = e0
+        while True:
+            b = m.tv[nxt(e)]
+            if b != m.inf and mark[b] != epoch:
+                if n == MAX_REGION:
+                    ok = False
+                    break
+                mark[b] = epoch
+                nextb[b] = -1
+                ids[n] = b
+                n += 1
+            e = m.opp[prv(e)]
+            if e == e0:
+                break
+        if not ok:
+            break
+    if ok:
+        for k in range(n):
+            xs[k] = m.x[ids[k]]
+            ys[k] = m.y[ids[k]]
+        sort_by_sweep(ids, xs, ys, n)
+        nt = sweep_triangles(xs, ys, n, tvl, 2 * MAX_REGION)
+        ok = nt > 0
+    if ok:
+        for k in range(n):
+            if ids[k] == site:
+                lp = k
+        # the sweep's star of the new site must be the region's boundary, edge for edge
+        for q in range(nt):
+            for k in range(3):
+                if tvl[3 * q + k] != lp:
+                    continue
+                a = tvl[3 * q + (k + 1) % 3]
+                b = tvl[3 * q + (k + 2) % 3]
+                a = m.inf if a == n else ids[a]
+                b = m.inf if b == n else ids[b]
+                if (a == m.inf and nextb_inf == b) or (a != m.inf and mark[a] == epoch and nextb[a] == b):
+                    matched += 1
+                else:
+                    ok = False
+        ok = ok and matched == m.n_bnd
+    fill_cavity(m, site)
+    return 1 if ok else 0
+
+
+cdef int remove_by_sweep(Mesh* m, int site) noexcept nogil:
+    """1 when the hole was filled with the sweep's triangles; 0 when the caller must use ears."""
+    cdef int poly[MAX_HOLE]
+    cdef int outs[MAX_HOLE]
+    cdef int slots[MAX_HOLE]
+    cdef int ids[MAX_HOLE]
+    cdef int pos_of[MAX_HOLE]
+    cdef double xs[MAX_HOLE]
+    cdef double ys[MAX_HOLE]
+    cdef int32_t tvl[6 * MAX_HOLE]
+    cdef int inside[3 * MAX_HOLE]
+    cdef int32_t half[MAX_HOLE * MAX_HOLE]
+    cdef int e0 = m.vedge[site], e, k = 0, q, j, nt, n_in = 0, pa, pb, pc, T, x, y, h
+    e = e0
+    while True:
+        if k == MAX_HOLE:
+            return 0
+        poly[k] = m.tv[nxt(e)]
+        if poly[k] == m.inf:
+            return 0
+        outs[k] = m.opp[nxt(e)]
+        slots[k] = e // 3
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            break
+    for q in range(k):
+        ids[q] = q
+        xs[q] = m.x[poly[q]]
+        ys[q] = m.y[poly[q]]
+    sort_by_sweep(ids, xs, ys, k)
+    nt = sweep_triangles(xs, ys, k, tvl, 2 * MAX_HOLE)
+    if nt <= 0:
+        return 0
+    # the sweep's triangles inside the hole meet its vertices in their own cyclic order
+    for q in range(nt):
+        if tvl[3 * q] == k or tvl[3 * q + 1] == k or tvl[3 * q + 2] == k:
+            continue
+        pa = ids[tvl[3 * q]]; pb = ids[tvl[3 * q + 1]]; pc = ids[tvl[3 * q + 2]]
+        if (pb - pa + k) % k + (pc - pb + k) % k + (pa - pc + k) % k == k:
+            if n_in == k - 2:
+                return 0
+            inside[3 * n_in] = pa; inside[3 * n_in + 1] = pb; inside[3 * n_in + 2] = pc
+            n_in += 1
+    if n_in != k - 2:
+        return 0
+    for q in range(k * k):
+        half[q] = -1
+    for q in range(3 * n_in):
+        x = inside[q]
+        y = inside[q - q % 3 + (q % 3 + 1) % 3]
+        if half[x * k + y] != -1:
+            return 0
+        half[x * k + y] = -2
+    for q in range(k):
+        if half[q * k + (q + 1) % k] != -2:
+            return 0            # a side of the hole is missing: cocircular sites triangulated another way
+    # splice: the star's slots are freed, the sweep's triangles take them
+    for q in range(k):
+        if not is_infinite(m, slots[q]):
+            m.n_finite -= 1
+        m.free_tri[m.n_free] = slots[q]
+        m.n_free += 1
+    m.vedge[site] = -1
+    for q in range(n_in):
+        m.n_free -= 1
+        T = m.free_tri[m.n_free]
+        for j in range(3):
+            x = inside[3 * q + j]
+            y = inside[3 * q + (j + 1) % 3]
+            m.tv[3 * T + j] = poly[x]
+            m.vedge[poly[x]] = 3 * T + j
+            half[x * k + y] = 3 * T + j
+        m.n_finite += 1
+        m.last = T
+    for q in range(3 * n_in):
+        x = inside[q]
+        y = inside[q - q % 3 + (q % 3 + 1) % 3]
+        h = half[x * k + y]
+        if y == (x + 1) % k:
+            m.opp[h] = outs[x]
+            m.opp[outs[x]] = h
+        else:
+            m.opp[h] = half[y * k + x]
+    m.n_changed = 0
+    for q in range(k):
+        m.changed[m.n_changed] = poly[q]
+        m.n_changed += 1
+    return 1

@@ -4,6 +4,7 @@ import numpy as np
 
 from libc.stdint cimport int8_t, int32_t, int64_t
 from libc.math cimport sqrt, INFINITY
+from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.parabola cimport parabola_order
@@ -725,3 +726,78 @@ def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_
     with nogil:
         flips = repair(&s, &stack[0], &queued[0])
     return flips
+
+
+cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_out, int cap) noexcept nogil:
+    """Fortune's sweep over a few sites (sorted by y, then x), for local updates.
+
+    Writes the Delaunay triangles, vertex n at infinity, into tv_out (room for
+    cap triangles) and returns their number; -1 when no triangle exists (the
+    sites are collinear) or cap is too small. No Python objects: scratch
+    memory comes from malloc.
+    """
+    cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
+    cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
+    cdef int n_f64 = 3 * cap_ev + 2 * cap_rec
+    cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
+    cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
+    cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri) * sizeof(int8_t))
+    cdef int32_t* p = ib
+    cdef double* q = fb
+    cdef Sweep s
+    cdef int next_site = 0, k, result = -1
+    if ib == NULL or fb == NULL or bb == NULL:
+        free(ib); free(fb); free(bb)
+        return -1
+    s.x = x; s.y = y; s.n = n
+    s.arc_site = p; p += cap_arcs
+    s.arc_prev = p; p += cap_arcs
+    s.arc_next = p; p += cap_arcs
+    s.left = p; p += cap_arcs
+    s.right = p; p += cap_arcs
+    s.parent = p; p += cap_arcs
+    s.arc_event = p; p += cap_arcs
+    s.arc_edge = p; p += cap_arcs
+    s.free_arcs = p; p += 3 * cap_arcs
+    s.ev_arc = p; p += cap_ev
+    s.ev_pos = p; p += cap_ev
+    s.heap = p; p += cap_ev
+    s.free_events = p; p += cap_ev
+    s.rec_a = p; p += cap_rec
+    s.rec_b = p; p += cap_rec
+    s.rec_e0 = p; p += cap_rec
+    s.rec_e1 = p; p += cap_rec
+    s.tv = p; p += 3 * cap_tri
+    s.opp = p; p += 3 * cap_tri
+    s.dup = p; p += n
+    cdef int32_t* vmap = p
+    p += n + 1
+    cdef int32_t* stack = p
+    s.height = bb
+    cdef int8_t* queued = bb + cap_arcs
+    s.ev_y = q; q += cap_ev
+    s.ev_x = q; q += cap_ev
+    s.ev_cy = q; q += cap_ev
+    s.rec_x = q; q += cap_rec
+    s.rec_y = q
+    s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
+    s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0; s.n_free = 0; s.n_recs = 0; s.n_tri = 0
+    s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
+    s.row_mode = False; s.row_last = NONE
+    for k in range(n):
+        s.dup[k] = NONE
+    while step(&s, &next_site):
+        pass
+    if s.n_tri > 0:
+        close_hull(&s, vmap)
+        for k in range(3 * s.n_tri):
+            queued[k] = 0
+        repair(&s, stack, queued)
+        if s.n_tri <= cap:
+            for k in range(3 * s.n_tri):
+                tv_out[k] = s.tv[k]
+            result = s.n_tri
+    free(ib)
+    free(fb)
+    free(bb)
+    return result
