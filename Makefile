@@ -32,10 +32,10 @@ test: setup
 	$(BIN)/python -m pytest -q
 
 bench-quick: setup
-	$(BIN)/python benchmarks/bench_build.py --quick
+	$(BIN)/python benchmarks/run.py --quick
 
 bench: setup
-	$(BIN)/python benchmarks/bench_build.py
+	$(BIN)/python benchmarks/run.py
 
 clean:
 	rm -rf build tvoronoi/kernels/*.c tvoronoi/kernels/*.so $(BUILT)
