@@ -1,0 +1,176 @@
+"""Point files in: CSV, whitespace text, GeoJSON and .npy, read fast and checked line by line."""
+
+from __future__ import annotations
+
+import codecs
+import json
+import os
+import sys
+from pathlib import Path
+
+from ..errors import InputFileError, TvoronoiError
+from .geojson import _read_geojson
+from .npy import NPY_MAGIC, _read_npy
+from .pointset import PointSet
+from .tabular import COMMENT, _read_table
+
+# the column names recognised and the steps of a table read, reached through the
+# package by the tests that hold the fast path of a table to the slow one
+from .columns import X_NAMES, Y_NAMES  # noqa: F401
+from .tabular import _fast_table, _line_offset, _slow_table, _table_layout  # noqa: F401
+
+__all__ = ["FORMATS", "PointSet", "read_points"]
+
+FORMATS = ("csv", "text", "geojson", "npy")
+EXTENSIONS = {
+    ".csv": "csv",
+    ".txt": "text",
+    ".xy": "text",
+    ".dat": "text",
+    ".pts": "text",
+    ".geojson": "geojson",
+    ".json": "geojson",
+    ".npy": "npy",
+}
+STDIN = "-"
+STDIN_SOURCE = "<stdin>"
+SNIFF_BYTES = 1 << 16
+
+
+def read_points(
+    path: str | os.PathLike,
+    *,
+    x: str | int | None = None,
+    y: str | int | None = None,
+    fmt: str | None = None,
+) -> PointSet:
+    """Read sites from a CSV, whitespace-text, GeoJSON or .npy file, or standard input.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, or ``"-"`` for standard input.
+    x, y : str or int, optional
+        The coordinate columns of a table: a name (any case), a 0-based index
+        (int or digit string) or ``"colN"`` (1-based). By default the columns
+        named x/lon/lng/long/longitude and y/lat/latitude, else the first two
+        numeric columns.
+    fmt : {None, "csv", "text", "geojson", "npy"}
+        The format; ``None`` detects it from the extension, else from the content.
+
+    Returns
+    -------
+    PointSet
+        The sites, with the other columns (or properties) of each.
+
+    Raises
+    ------
+    InputFileError
+        If the file is missing or unreadable, has no points, or holds a value that
+        is not a finite coordinate; the message names the file, the line (or the
+        feature or row) and the fix.
+    TvoronoiError
+        If ``fmt`` is unknown, or ``x``/``y`` are given for a GeoJSON file.
+    """
+    if fmt is not None and fmt not in FORMATS:
+        raise TvoronoiError(f"unknown format {fmt!r}; choose one of: {', '.join(FORMATS)}")
+    source, suffix, data = _read_bytes(path)
+    if fmt is None:
+        fmt = EXTENSIONS.get(suffix) or _sniff_format(data)
+    if fmt == "npy":
+        return _read_npy(data, source, x, y)
+    if fmt == "geojson":
+        return _read_geojson(data, source, x, y, _loads_json)
+    return _read_table(_decode(data, source), source, fmt, x, y)
+
+
+# ---------------------------------------------------------------------------
+# bytes in, format detected, decoded
+
+
+def _read_bytes(path) -> tuple[str, str, bytes]:
+    """Return (source name, lower-case suffix, content) of a file or of standard input."""
+    if isinstance(path, str) and path == STDIN:
+        return STDIN_SOURCE, "", sys.stdin.buffer.read()
+    try:
+        source = os.fsdecode(os.fspath(path))
+    except TypeError:
+        raise TvoronoiError(f"a point file must be a path or '-', got {path!r}") from None
+    p = Path(source)
+    try:
+        if p.is_dir():
+            raise InputFileError(f"{source}: is a directory, not a point file; name a file inside it")
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise InputFileError(f"{source}: no such file; check the name and the directory") from None
+    except IsADirectoryError:
+        raise InputFileError(f"{source}: is a directory, not a point file; name a file inside it") from None
+    except PermissionError:
+        raise InputFileError(f"{source}: permission denied; make the file readable (chmod +r)") from None
+    except OSError as e:
+        raise InputFileError(f"{source}: cannot read the file: {e.strerror or e}") from None
+    return source, p.suffix.lower(), data
+
+
+def _sniff_format(data: bytes) -> str:
+    """Guess the format from the first bytes: npy magic, a JSON object, a comma, else text."""
+    if data.startswith(NPY_MAGIC):
+        return "npy"
+    head = _decode_lenient(data[:SNIFF_BYTES]).lstrip()
+    if head.startswith("{"):
+        return "geojson"
+    for line in head.splitlines():
+        line = line.strip()
+        # a "#" line is a comment of a text file, whatever it holds
+        if line and not line.startswith(COMMENT):
+            return "csv" if "," in line else "text"
+    return "text"
+
+
+def _encoding(data: bytes) -> str:
+    if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return "utf-16"
+    return "utf-8-sig"
+
+
+def _decode_lenient(data: bytes) -> str:
+    return data.decode(_encoding(data), errors="replace")
+
+
+def _decode(data: bytes, source: str) -> str:
+    """Decode a text file (UTF-8, with or without BOM; UTF-16 with BOM)."""
+    encoding = _encoding(data)
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as e:
+        line = _line_of(data, e.start)
+        name = "UTF-16" if encoding == "utf-16" else "UTF-8"
+        raise InputFileError(
+            f"{source}, line {line}: byte 0x{data[e.start]:02x} is not valid {name}; save the file as UTF-8"
+        ) from None
+
+
+def _loads_json(data: bytes, source: str):
+    """Parse a JSON file (UTF-8, with or without BOM)."""
+    if data.startswith(codecs.BOM_UTF8):
+        data = data[len(codecs.BOM_UTF8) :]
+    try:
+        import orjson
+    except ImportError:  # orjson is a dependency; json is the stand-in
+        loads = json.loads
+    else:
+        loads = orjson.loads
+    try:
+        return loads(data)
+    except json.JSONDecodeError as e:  # orjson's error derives from it
+        raise InputFileError(
+            f"{source}, line {e.lineno}, column {e.colno}: broken JSON: {e.msg}; fix the file there"
+        ) from None
+    except UnicodeDecodeError as e:
+        line = _line_of(data, e.start)
+        raise InputFileError(f"{source}, line {line}: the file is not UTF-8; save it as UTF-8") from None
+
+
+def _line_of(data: bytes, offset: int) -> int:
+    """The 1-based line of the byte at ``offset``."""
+    return data.count(b"\n", 0, offset) + 1

@@ -1,0 +1,185 @@
+"""GeoJSON point files: Point and MultiPoint features, with their properties."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputFileError, TvoronoiError
+from .pointset import PointSet, _gc_paused
+
+GEOMETRY_TYPES = (
+    "Point",
+    "MultiPoint",
+    "LineString",
+    "MultiLineString",
+    "Polygon",
+    "MultiPolygon",
+    "GeometryCollection",
+)
+
+
+def _describe(value) -> str:
+    if isinstance(value, dict):
+        return f'an object of type "{value["type"]}"' if "type" in value else "an object without a type"
+    return {list: "a list", str: "a string", bool: "a boolean", type(None): "null"}.get(
+        type(value), "a number"
+    )
+
+
+def _geojson_sites(doc, source: str):
+    """Yield (where, part, position, properties) for each site of a GeoJSON document.
+
+    ``where`` names the feature ("features[3]"), ``part`` is the index within a MultiPoint
+    (None for a Point); the position is checked to be a list of at least two numbers.
+    """
+    kind = doc.get("type") if isinstance(doc, dict) else None
+    if kind == "FeatureCollection":
+        features = doc.get("features")
+        if not isinstance(features, list):
+            raise InputFileError(f'{source}: the FeatureCollection has no "features" list')
+        labelled = ((f"features[{k}]", feature) for k, feature in enumerate(features))
+    elif kind == "Feature":
+        labelled = iter([("the feature", doc)])
+    elif kind in ("Point", "MultiPoint"):
+        labelled = iter([("the geometry", {"type": "Feature", "geometry": doc, "properties": None})])
+    elif kind in GEOMETRY_TYPES:
+        raise InputFileError(
+            f'{source}: the file is a single {kind} geometry; tvoronoi reads Point and MultiPoint geometries'
+        )
+    else:
+        raise InputFileError(
+            f"{source}: not GeoJSON: expected a FeatureCollection, a Feature or a Point/MultiPoint "
+            f"geometry, found {_describe(doc)}"
+        )
+    for where, feature in labelled:
+        if not isinstance(feature, dict):
+            raise InputFileError(f"{source}, {where}: not a Feature object but {_describe(feature)}")
+        properties = feature.get("properties")
+        if properties is None:
+            properties = {}
+        elif not isinstance(properties, dict):
+            raise InputFileError(
+                f'{source}, {where}: "properties" is {_describe(properties)}; it must be an object or null'
+            )
+        geometry = feature.get("geometry")
+        if geometry is None:
+            raise InputFileError(
+                f"{source}, {where}: the geometry is null; tvoronoi reads Point and MultiPoint "
+                f"features: give the feature a point or remove it"
+            )
+        kind = geometry.get("type") if isinstance(geometry, dict) else _describe(geometry)
+        coordinates = geometry.get("coordinates") if isinstance(geometry, dict) else None
+        if kind == "Point":
+            yield where, None, _position(coordinates, source, where), properties
+        elif kind == "MultiPoint":
+            if not isinstance(coordinates, list):
+                raise InputFileError(
+                    f"{source}, {where}: MultiPoint coordinates are {_describe(coordinates)}, not a list of positions"
+                )
+            for part, position in enumerate(coordinates):
+                yield where, part, _position(position, source, f"{where}, point {part}"), properties
+        else:
+            raise InputFileError(
+                f'{source}, {where}: geometry type "{kind}" is not a point; tvoronoi reads Point and '
+                f"MultiPoint features: convert it (e.g. to its centroid) or remove it"
+            )
+
+
+_NUMBER_TYPES = (int, float)
+
+
+def _position(position, source: str, where: str):
+    if (
+        type(position) is list
+        and len(position) >= 2
+        and type(position[0]) in _NUMBER_TYPES
+        and type(position[1]) in _NUMBER_TYPES
+    ):
+        return position
+    raise InputFileError(
+        f"{source}, {where}: coordinates {position!r} are not a position; a point needs [x, y] numbers"
+    )
+
+
+def _point_features(features: list):
+    """(xs, ys, properties) of a list of well-formed Point features, or None at the first
+    feature that is anything else (the checked walk then reads or names it)."""
+    xs: list = []
+    ys: list = []
+    records: list[dict] = []
+    try:
+        for feature in features:
+            geometry = feature["geometry"]
+            properties = feature["properties"]
+            if geometry["type"] != "Point":
+                return None
+            position = geometry["coordinates"]
+            x, y = position[0], position[1]
+            if type(position) is not list or type(x) not in _NUMBER_TYPES or type(y) not in _NUMBER_TYPES:
+                return None
+            if properties is None:
+                properties = {}
+            elif type(properties) is not dict:
+                return None
+            xs.append(x)
+            ys.append(y)
+            records.append(properties)
+    except (KeyError, TypeError, IndexError):
+        return None
+    return xs, ys, records
+
+
+def _checked_sites(doc, source: str):
+    """(xs, ys, properties) of any GeoJSON document, each feature checked."""
+    xs: list = []
+    ys: list = []
+    records: list[dict] = []
+    for _, part, position, properties in _geojson_sites(doc, source):
+        xs.append(position[0])
+        ys.append(position[1])
+        records.append(properties if part is None else {**properties, "part": part})
+    return xs, ys, records
+
+
+def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
+    """The sites of a GeoJSON file; ``loads(data, source)`` parses it (the package's JSON decoder)."""
+    if x is not None or y is not None:
+        raise TvoronoiError(
+            f"{source}: --x/--y choose table columns; a GeoJSON file keeps its coordinates "
+            f"in its geometries: drop --x/--y"
+        )
+    if not data.strip():
+        raise InputFileError(f"{source}: no points found (the file is empty)")
+    # a million features are a million dicts: the collector would walk them again and again
+    with _gc_paused():
+        doc = loads(data, source)
+        sites = None
+        if type(doc) is dict and doc.get("type") == "FeatureCollection" and type(doc.get("features")) is list:
+            sites = _point_features(doc["features"])
+        if sites is None:
+            sites = _checked_sites(doc, source)
+    xs, ys, records = sites
+    if not xs:
+        raise InputFileError(f"{source}: no points found (no Point or MultiPoint features)")
+    xy = np.empty((len(xs), 2), dtype=np.float64)
+    try:
+        xy[:, 0] = xs
+        xy[:, 1] = ys
+    except OverflowError:  # an integer beyond float range
+        xy[:, 0] = [float(v) if abs(v) < 1e308 else math.inf for v in xs]
+        xy[:, 1] = [float(v) if abs(v) < 1e308 else math.inf for v in ys]
+    bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
+    if len(bad):
+        for i, (where, part, position, _) in enumerate(_geojson_sites(doc, source)):
+            if i == bad[0]:
+                break
+        if part is not None:
+            where = f"{where}, point {part}"
+        role = "x" if not math.isfinite(xy[bad[0], 0]) else "y"
+        raise InputFileError(
+            f"{source}, {where}: {role} is {position[0 if role == 'x' else 1]}; tvoronoi needs finite coordinates"
+        )
+    return PointSet(xy, source, {}, records if any(records) else None)
+

@@ -1,0 +1,161 @@
+"""The sites read from a point file, and the JSON-ready values their properties hold."""
+
+from __future__ import annotations
+
+import gc
+import math
+import re
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
+_INT_LITERAL = re.compile(r"[+-]?[0-9]+")
+_FLOAT_LITERAL = re.compile(
+    r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|nan|inf|infinity)", re.IGNORECASE
+)
+
+
+@dataclass
+class PointSet:
+    """Sites read from a file, with the other columns (or GeoJSON properties) of each site.
+
+    Attributes
+    ----------
+    xy : numpy.ndarray
+        ``(n, 2)`` float64, C-contiguous; row ``i`` is site ``i``.
+    source : str
+        The file name as the user gave it, or ``"<stdin>"``.
+    columns : dict of str to list
+        Extra table columns, one list of ``n`` JSON-ready values per column
+        (int, float, str or None), in file order.
+    records : list of dict or None
+        Per-site properties (GeoJSON); ``None`` when the sites carry them in
+        ``columns`` or have none.
+    """
+
+    xy: np.ndarray
+    source: str
+    columns: dict[str, list] = field(default_factory=dict)
+    records: list[dict] | None = None
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+    @property
+    def property_names(self) -> list[str]:
+        """Names of the properties the sites carry, in file order (first seen first)."""
+        if self.records is None:
+            return list(self.columns)
+        return list(dict.fromkeys(key for record in self.records for key in record))
+
+    def properties(self, i: int) -> dict:
+        """Properties of site ``i``: its row's other columns or its GeoJSON properties.
+
+        Parameters
+        ----------
+        i : int
+            Site index, ``-n <= i < n``.
+
+        Returns
+        -------
+        dict
+            A new dict of JSON-ready values; empty when the file had nothing but coordinates.
+
+        Raises
+        ------
+        IndexError
+            If ``i`` is out of range.
+        """
+        n_sites = len(self.xy)
+        if not -n_sites <= i < n_sites:
+            raise IndexError(f"site {i} out of range for {n_sites} sites")
+        if self.records is not None:
+            return dict(self.records[i])
+        return {name: values[i] for name, values in self.columns.items()}
+
+
+@contextmanager
+def _gc_paused():
+    """Pause the cyclic garbage collector: building a million small row lists otherwise
+    triggers it over and over, for nothing (rows hold no cycles)."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+# ---------------------------------------------------------------------------
+# JSON-ready values: from the text of a table field, from a numpy column
+
+
+def _convert_value(s: str):
+    """A property value: int for an int literal, float for a float literal, None for "" or a
+    non-finite number (JSON has none), else the string as written."""
+    t = s.strip()
+    if not t:
+        return None
+    if _INT_LITERAL.fullmatch(t):
+        value = int(t)
+        # beyond 64 bits most JSON writers fail: keep the digits as text
+        return value if INT64_MIN <= value <= INT64_MAX else s
+    if _FLOAT_LITERAL.fullmatch(t):
+        value = float(t)
+        return value if math.isfinite(value) else None
+    return s
+
+
+def _convert_column(values, plain: bool) -> list:
+    """``_convert_value`` over a column; ``plain`` (ASCII, no "_") lets int() and float() decide in bulk,
+    since on such text they accept exactly the literals the regexes describe."""
+    if plain:
+        try:
+            ints = list(map(int, values))
+        except ValueError:
+            pass
+        else:
+            if not ints or (INT64_MIN <= min(ints) and max(ints) <= INT64_MAX):
+                return ints
+        try:
+            floats = np.fromiter(map(float, values), dtype=np.float64, count=len(values))
+        except ValueError:
+            pass
+        else:
+            if np.isfinite(floats).all():
+                # float literals keep the parsed float, int literals go back through _convert_value
+                return [
+                    f if ("." in v or "e" in v or "E" in v) else _convert_value(v)
+                    for v, f in zip(values, floats.tolist())
+                ]
+    # mixed or text: convert each distinct value once
+    memo = {v: _convert_value(v) for v in set(values)}
+    return list(map(memo.__getitem__, values))
+
+
+def _json_column(values: np.ndarray) -> list:
+    """A numpy column as JSON-ready Python values: NaN/inf become None, bytes are decoded."""
+    kind = values.dtype.kind
+    if values.ndim == 1 and kind in "iubU":
+        return values.tolist()
+    if values.ndim == 1 and kind == "f":
+        out = values.tolist()
+        for i in np.flatnonzero(~np.isfinite(values)):
+            out[i] = None
+        return out
+    return [_json_value(v) for v in values.tolist()]
+
+
+def _json_value(value):
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, bytes):
+        return value.decode("utf-8", errors="replace")
+    if isinstance(value, (list, tuple)):
+        return [_json_value(v) for v in value]
+    return str(value)

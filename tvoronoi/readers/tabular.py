@@ -1,0 +1,342 @@
+"""CSV and whitespace-text tables: header, x and y columns, a fast bulk read, a line-by-line check."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+from ..errors import InputFileError
+from .columns import X_NAMES, Y_NAMES, _as_index, _check_distinct, _col_name, _resolve_column
+from .pointset import PointSet, _convert_column, _gc_paused
+
+LAYOUT_CHARS = 1 << 16
+QUOTE = '"'
+COMMENT = "#"
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """Where the sites are in a table: its column names and the x and y columns."""
+
+    names: list[str]  # one per column: the header's, or col1, col2, ...
+    has_header: bool
+    header_lines: int  # physical lines up to the end of the header (0 without one)
+    first_line: int  # line of the first data row
+    ix: int
+    iy: int
+
+
+def _read_table(text: str, source: str, kind: str, x, y) -> PointSet:
+    # the header and the first data row are near the top: look there first, so that
+    # a large file is not scanned for them
+    head = text
+    if len(text) > LAYOUT_CHARS:
+        head = text[: text.find("\n", LAYOUT_CHARS) + 1] or text
+    try:
+        layout = _table_layout(head, source, kind, x, y)
+    except InputFileError:
+        if head is text:
+            raise
+        head = text
+        layout = _table_layout(text, source, kind, x, y)
+    body = text[_line_offset(head, layout.header_lines) :]
+    try:
+        fast = _fast_table(body, kind, layout)
+    except (ValueError, csv.Error):
+        fast = None
+    if fast is None:
+        # the fast path met something it does not handle or a bad value: walk the
+        # file row by row, which either reads it or names the first bad line
+        return _slow_table(text, source, kind, layout)
+    xy, columns = fast
+    return PointSet(xy, source, columns)
+
+
+# ---------------------------------------------------------------------------
+# rows with their line numbers; the layout: header, column names, x and y
+
+
+def _records(text: str, kind: str, source: str) -> Iterator[tuple[int, list[str]]]:
+    """Yield (line number, fields) for each non-blank row of a table; line numbers are 1-based."""
+    if kind == "text":
+        for line_no, line in enumerate(io.StringIO(text, newline=""), 1):
+            fields = line.partition(COMMENT)[0].split()
+            if fields:
+                yield line_no, fields
+        return
+    reader = csv.reader(io.StringIO(text, newline=""))
+    start = 1
+    try:
+        for fields in reader:
+            line_no, start = start, reader.line_num + 1
+            if len(fields) > 1 or (fields and fields[0].strip()):
+                yield line_no, fields
+    except csv.Error as e:
+        raise InputFileError(f"{source}, line {start}: malformed CSV: {e}") from None
+
+
+def _is_blank(fields: list[str]) -> bool:
+    return not fields or (len(fields) == 1 and not fields[0].strip())
+
+
+def _line_offset(text: str, n_lines: int) -> int:
+    """Character offset of the start of line ``n_lines + 1``."""
+    offset = 0
+    lines = io.StringIO(text, newline="")
+    for _ in range(n_lines):
+        offset += len(lines.readline())
+    return offset
+
+
+def _is_number(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def _table_layout(text: str, source: str, kind: str, x, y) -> _Layout:
+    """Find the header (if any), the column names and the x and y columns from the first rows."""
+    records = _records(text, kind, source)
+    first = next(records, None)
+    if first is None:
+        why = "the file is empty" if not text.strip() else "the file has no data rows"
+        raise InputFileError(f"{source}: no points found ({why})")
+    line_no, fields = first
+    has_header = _is_header(fields, x, y, records)
+    if has_header:
+        names = _unique_names([f.strip() for f in fields])
+        header_lines = _header_end(text, kind, source)
+        records = _records(text, kind, source)
+        next(records)
+        data = next(records, None)
+        if data is None:
+            raise InputFileError(f"{source}: no points found (the file has only a header, line {line_no})")
+        first_line, first_fields = data
+    else:
+        names = [_col_name(j) for j in range(len(fields))]
+        header_lines, first_line, first_fields = 0, line_no, fields
+    ix = _resolve_column(x, "x", names, has_header, source)
+    iy = _resolve_column(y, "y", names, has_header, source)
+    if ix is None or iy is None:
+        # the first numeric columns of the first data row that are not taken
+        free = [
+            j
+            for j, f in enumerate(first_fields[: len(names)])
+            if j not in (ix, iy) and _is_number(f)
+        ]
+        if ix is None and free:
+            ix = free.pop(0)
+        if iy is None and free:
+            iy = free.pop(0)
+    if ix is None or iy is None:
+        missing = " and ".join(role for role, i in (("x", ix), ("y", iy)) if i is None)
+        noun = "columns" if ix is None and iy is None else "column"
+        raise InputFileError(
+            f"{source}, line {first_line}: cannot find the {missing} {noun}: no header names it "
+            f"and the row has too few numeric columns; columns: {', '.join(names)}; "
+            f"choose them with --x/--y"
+        )
+    _check_distinct(ix, iy, names, source)
+    return _Layout(names, has_header, header_lines, first_line, ix, iy)
+
+
+def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]]) -> bool:
+    """Whether the first row ``fields`` is a header: a row whose x/y candidates are not numbers.
+
+    The candidates are the columns chosen by index, else the row's first two numeric fields
+    (fewer than two: a header), else the fields named like a coordinate column. A data row
+    can hold such a name as a value ("1,2,lat"): then the row is a header only if the next
+    row has a number where it has the name ("x,y,2019" over "1,2,7").
+    """
+    numeric = [_is_number(f) for f in fields]
+    lowered = [f.strip().lower() for f in fields]
+    chosen = [s.strip().lower() for s in (x, y) if isinstance(s, str) and _as_index(s) is None]
+    if any(name in lowered for name in chosen):
+        return True
+    explicit = [i for i in (_as_index(x), _as_index(y)) if i is not None and i < len(fields)]
+    if any(not numeric[i] for i in explicit) or sum(numeric) < 2:
+        return True
+    named = [j for j, name in enumerate(lowered) if name in X_NAMES + Y_NAMES and not numeric[j]]
+    if not named:
+        return False
+    second = next(records, None)
+    return second is not None and any(j < len(second[1]) and _is_number(second[1][j]) for j in named)
+
+
+def _header_end(text: str, kind: str, source: str) -> int:
+    """Number of physical lines up to the end of the first non-blank row (the header)."""
+    if kind == "text":
+        return next(_records(text, kind, source))[0]
+    reader = csv.reader(io.StringIO(text, newline=""))
+    for fields in reader:
+        if not _is_blank(fields):
+            return reader.line_num
+    return 0
+
+
+def _unique_names(names: list[str]) -> list[str]:
+    """Header names made unique and non-empty: an empty name becomes colN, a repeat name_2."""
+    out: list[str] = []
+    seen: set[str] = set()
+    for j, name in enumerate(names):
+        name = name or _col_name(j)
+        base, k = name, 2
+        while name in seen:
+            name, k = f"{base}_{k}", k + 1
+        seen.add(name)
+        out.append(name)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# the rows: in bulk, else one by one
+
+
+def _fast_table(body: str, kind: str, layout: _Layout):
+    """Read the rows after the header in bulk; None (or ValueError) when a row needs a closer look."""
+    names, ix, iy = layout.names, layout.ix, layout.iy
+    n_cols = len(names)
+    if n_cols == 2:
+        # only coordinates: numpy's C reader, which also checks every row has two fields
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if kind == "csv":
+                table = np.loadtxt(
+                    io.StringIO(body), dtype=np.float64, delimiter=",", quotechar=QUOTE,
+                    comments=None, ndmin=2,
+                )
+            else:
+                table = np.loadtxt(io.StringIO(body), dtype=np.float64, comments=COMMENT, ndmin=2)
+        if table.shape[1] != 2 or len(table) == 0:
+            return None
+        xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
+        return (xy, {}) if np.isfinite(xy).all() else None
+    with _gc_paused():
+        if kind == "csv":
+            rows = list(csv.reader(io.StringIO(body, newline="")))
+        else:
+            if "\r" in body and "\r" in body.replace("\r\n", ""):
+                return None  # a line ending in a lone CR (old Mac): the row walk splits there
+            lines = body.split("\n")
+            if COMMENT in body:
+                lines = [line.partition(COMMENT)[0] for line in lines]
+            rows = list(map(str.split, lines))
+        if set(map(len, rows)) != {n_cols}:
+            # blank lines (csv gives [] or a lone blank field, text gives [])
+            rows = [r for r in rows if not _is_blank(r)]
+            if not rows or set(map(len, rows)) != {n_cols}:
+                return None
+        columns = list(zip(*rows))
+        del rows
+    xy = np.empty((len(columns[0]), 2), dtype=np.float64)
+    xy[:, 0] = np.fromiter(map(float, columns[ix]), dtype=np.float64, count=len(xy))
+    xy[:, 1] = np.fromiter(map(float, columns[iy]), dtype=np.float64, count=len(xy))
+    if not np.isfinite(xy).all():
+        return None
+    return xy, _extras(columns, layout, body)
+
+
+def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
+    """Read a table row by row, keeping line numbers, and raise on the first row that is not a site."""
+    names, ix, iy = layout.names, layout.ix, layout.iy
+    n_cols = len(names)
+    records = _records(text, kind, source)
+    if layout.has_header:
+        next(records)
+    line_nos: list[int] = []
+    rows: list[list[str]] = []
+    with _gc_paused():
+        for line_no, fields in records:
+            if len(fields) != n_cols:
+                # a field spanning lines is quoted: an unclosed quote swallows the lines after it
+                unclosed = any("\n" in f or "\r" in f for f in fields)
+                hint = " (a quote opened here is not closed)" if unclosed else ""
+                raise InputFileError(
+                    f"{source}, line {line_no}: {_plural(len(fields), 'field')}{hint}, "
+                    f"but {_row_shape(layout)}; give every row the same {n_cols} columns"
+                )
+            line_nos.append(line_no)
+            rows.append(fields)
+        columns = list(zip(*rows))
+        del rows
+    xy = np.empty((len(line_nos), 2), dtype=np.float64)
+    xy[:, 0] = _floats_or_nan(columns[ix])
+    xy[:, 1] = _floats_or_nan(columns[iy])
+    bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
+    if len(bad):
+        # the first bad row: x is checked before y, as it reads
+        r = bad[0]
+        for j, role in ((ix, "x"), (iy, "y")):
+            _coordinate(columns[j][r], role, names[j], line_nos[r], source, layout.has_header)
+    return PointSet(xy, source, _extras(columns, layout, text))
+
+
+def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
+    """The columns other than x and y, as JSON-ready values; ``text`` holds the rows they come from."""
+    plain = text.isascii() and "_" not in text
+    return {
+        name: _convert_column(columns[j], plain)
+        for j, name in enumerate(layout.names)
+        if j not in (layout.ix, layout.iy)
+    }
+
+
+def _floats_or_nan(values) -> np.ndarray:
+    """``float`` over a column, NaN where a value is not a number."""
+    try:
+        return np.fromiter(map(float, values), dtype=np.float64, count=len(values))
+    except ValueError:
+        return np.array([_float_or_nan(v) for v in values], dtype=np.float64)
+
+
+def _float_or_nan(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def _quoted(text: str) -> str:
+    """A field as it reads in a message: in double quotes, control characters escaped."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+
+
+def _row_shape(layout: _Layout) -> str:
+    n_cols = len(layout.names)
+    if layout.has_header:
+        return f"the header has {n_cols} ({', '.join(layout.names)})"
+    return f"the first row (line {layout.first_line}) has {n_cols}"
+
+
+def _coordinate(text: str, role: str, name: str, line_no: int, source: str, named: bool) -> float:
+    column = f'column "{name}"' if name == role else f'column "{name}" ({role})'
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputFileError(
+            f"{source}, line {line_no}: {_quoted(text)} in {column} is not a number; "
+            f"fix the value, or choose other columns with --x/--y"
+        ) from None
+    if not math.isfinite(value):
+        who = role if name == role or not named else f'{role} (column "{name}")'
+        shown = text.strip()
+        if shown.lower().lstrip("+-") not in ("nan", "inf", "infinity"):
+            shown += " (it overflows to infinity)"
+        raise InputFileError(
+            f"{source}, line {line_no}: {who} is {shown}; tvoronoi needs finite coordinates"
+        )
+    return value
+
