@@ -25,6 +25,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common import RESULTS, atomic_write  # noqa: E402
+from tvoronoi.trace import circumcentres
 
 N_SITES = 25
 SEED = 7
@@ -138,7 +139,7 @@ def incremental_panel(ax, pts, step, box) -> None:
         corners = pts[step.conflict]
         ax.add_collection(PolyCollection(corners, facecolors="none", edgecolors="tab:red", hatch="////",
                                          linewidths=1.3))
-        centres = tools.circumcentres(corners[:, 0], corners[:, 1], corners[:, 2])
+        centres = circumcentres(corners[:, 0], corners[:, 1], corners[:, 2])
         for (cx, cy), p in zip(centres, corners[:, 0]):
             ax.add_patch(Circle((cx, cy), float(np.hypot(*(p - (cx, cy)))), fill=False, ls="--", lw=0.7,
                                 color="tab:red"))

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from tvoronoi.trace import circumcentres
 
 # Relative tolerances of the checks: distances against the box size, areas against the box area.
 DIST_TOL = 1e-9
@@ -336,15 +337,6 @@ def check_triangle(result, pts, box, tree) -> None:
     _fail(len(edges) + len(ray_origin) == 3 * n - 3 - h,
           f"Triangle: {len(edges) + len(ray_origin)} edges and rays, expected 3n - 3 - h = {3 * n - 3 - h}")
     check_vertices(vertices, tree, box, "Triangle")
-
-
-def circumcentres(p, q, r):
-    """Circumcentres of triangles (p, q, r), each an (k, 2) array."""
-    bx, by = (q - p).T
-    cx, cy = (r - p).T
-    det = 2.0 * (bx * cy - by * cx)
-    bb, cc = bx * bx + by * by, cx * cx + cy * cy
-    return np.column_stack((p[:, 0] + (cy * bb - by * cc) / det, p[:, 1] + (bx * cc - cx * bb) / det))
 
 
 # Textbook insertion (fully random order, conflict lists) is the slow reference; not run above this.
