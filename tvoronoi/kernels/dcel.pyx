@@ -6,6 +6,7 @@ from libc.stdint cimport int32_t
 from libc.math cimport fabs
 
 from tvoronoi.kernels.predicates cimport incircle
+from tvoronoi.kernels.mesh cimport nxt, prv
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
@@ -15,14 +16,6 @@ from tvoronoi.kernels.predicates cimport incircle
 #                 that runs off to infinity is followed by the one coming back
 #   he_face[h]    the site whose cell h bounds
 # An edge lies on the bisector of he_face[h] and he_face[he_twin[h]].
-
-
-cdef inline int nxt(int e) noexcept nogil:
-    return e - 2 if e % 3 == 2 else e + 1
-
-
-cdef inline int prv(int e) noexcept nogil:
-    return e + 2 if e % 3 == 0 else e - 1
 
 
 cdef int find(int32_t* parent, int t) noexcept nogil:

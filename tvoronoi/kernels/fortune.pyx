@@ -8,6 +8,7 @@ from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.parabola cimport parabola_order
+from tvoronoi.kernels.mesh cimport nxt, prv
 
 # The sweep line y = L moves upwards; sites are numbered in event order
 # (by y, then x). Each arc of the beach line is a node of an AVL tree (in
@@ -33,14 +34,6 @@ cdef enum:
     EVENT_SITE = 0
     EVENT_CIRCLE = 1
     EVENT_REPEAT = 2      # a site at the same place as an earlier one
-
-
-cdef inline int nxt(int e) noexcept nogil:
-    return e - 2 if e % 3 == 2 else e + 1
-
-
-cdef inline int prv(int e) noexcept nogil:
-    return e + 2 if e % 3 == 0 else e - 1
 
 
 cdef struct Sweep:
