@@ -9,19 +9,8 @@ import tvoronoi
 from conftest import DATASETS
 from tvoronoi.generators import generate
 from tvoronoi.tui.colours import DARK, LIGHT, cell_adjacency, cell_colours, colour_graph
-from tvoronoi.tui.raster import (
-    BRAILLE_BLANK,
-    EDGE,
-    SITE,
-    Scene,
-    View,
-    braille_text,
-    frame_lines,
-    pack_braille,
-    point_dots,
-    rasterize,
-    segment_dots,
-)
+from tvoronoi.tui.dots import BRAILLE_BLANK, braille_text, pack_braille, point_dots, segment_dots
+from tvoronoi.tui.raster import EDGE, SITE, Scene, View, frame_lines, rasterize
 
 
 def test_dot_bits_follow_the_braille_standard():

@@ -1,4 +1,4 @@
-"""The diagram canvas: a Textual widget that draws a scene in braille, with pan and zoom."""
+"""The diagram canvas: a Textual widget that draws a scene in braille, with pan, zoom and site dragging."""
 
 from __future__ import annotations
 
@@ -14,12 +14,26 @@ from textual.strip import Strip
 from textual.widget import Widget
 
 from tvoronoi.tui.colours import palette_for
-from tvoronoi.tui.raster import DOT_COLS, DOT_ROWS, Scene, View, frame_lines, rasterize
+from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+from tvoronoi.tui.raster import (
+    CURSOR_ARM,
+    Frame,
+    Scene,
+    View,
+    frame_lines,
+    rasterize,
+    redraw_part,
+)
 
 # One key press pans by this fraction of the canvas.
 PAN_STEP = 0.10
 # One key press or one wheel step zooms by this factor.
 ZOOM_STEP = 1.25
+# A site within this many dots of the pointer is under it (a character is 2 x 4 dots).
+PICK_RADIUS_DOTS = 2.5
+# An edit or cursor move that touches more than this fraction of the characters draws
+# the whole frame again rather than just those characters.
+PARTIAL_MAX_FRACTION = 0.5
 # Zoom limits, as a factor of the view that fits the box.
 MAX_ZOOM_IN = 1e6
 MAX_ZOOM_OUT = 50.0
@@ -31,9 +45,15 @@ ZOOM = Binding.Group("Zoom", compact=True)
 class DiagramCanvas(Widget, can_focus=True):
     """Draws the current diagram and owns the view (centre and scale).
 
-    Keys pan and zoom; the mouse wheel zooms about the pointer and dragging
-    pans. The view fits the box until the user moves it; until then a resize
-    fits it again.
+    Keys pan and zoom; the mouse wheel zooms about the pointer. Dragging a
+    site (when ``editable``) reports ``SiteDragged``; dragging elsewhere pans,
+    and a click without a drag reports ``Clicked``. The view fits the box
+    until the user moves it; until then a resize fits it again.
+
+    The scene may be a ``Scene``, a scene of some sites with an ``overlay``
+    (algorithm playback), or a ``LiveScene`` edited in place: the canvas
+    then draws again when its ``version`` changes, and asks it for the owners
+    of only the characters that changed.
     """
 
     BINDINGS = [
@@ -57,15 +77,54 @@ class DiagramCanvas(Widget, can_focus=True):
             super().__init__()
             self.view = view
 
+    class Clicked(Message):
+        """A click (press and release without a drag) at a world point, not on a site being dragged."""
+
+        def __init__(self, x: float, y: float) -> None:
+            super().__init__()
+            self.x = x
+            self.y = y
+
+    class SiteDragged(Message):
+        """The user dragged site ``site`` to (x, y); ``done`` when the button was released.
+
+        ``serial`` grows with every drag message: a handler may skip a message
+        that a newer one follows.
+        """
+
+        def __init__(self, site: int, x: float, y: float, done: bool, serial: int) -> None:
+            super().__init__()
+            self.site = site
+            self.x = x
+            self.y = y
+            self.done = done
+            self.serial = serial
+
     def __init__(self, *, name: str | None = None, id: str | None = None, classes: str | None = None) -> None:
         super().__init__(name=name, id=id, classes=classes)
         self.scene: Scene | None = None
+        self.overlay = None
+        # the keyboard cursor, a world point (None: hidden)
+        self.cursor: tuple[float, float] | None = None
+        # the world point under the mouse pointer (None: not over the canvas)
+        self.pointer: tuple[float, float] | None = None
+        # whether pressing on a site drags it
+        self.editable = True
         # True while the view is the fitted one: a resize then fits again
         self.fitted = True
         self.last_draw_ms = 0.0
+        self.drawn_at = 0.0  # perf_counter() when the last frame was drawn
         self._frame_key: tuple | None = None
         self._lines: list[list[Segment]] = []
+        self._frame: Frame | None = None
+        self._base_key: tuple | None = None
+        self._frame_version = 0
+        self._frame_cursor: tuple[float, float] | None = None
+        self._press: tuple[int, int] | None = None
         self._drag_from: tuple[int, int] | None = None
+        self._grabbed: int | None = None
+        self._moved = False
+        self.drag_serial = 0
         self._fit_size: Size | None = None
 
     def on_mount(self) -> None:
@@ -73,12 +132,45 @@ class DiagramCanvas(Widget, can_focus=True):
 
     # -- the scene -----------------------------------------------------------
 
-    def show_scene(self, scene: Scene, *, fit: bool = True) -> None:
-        """Draw a new scene; fit the view to its box unless told to keep the view."""
+    def show_scene(self, scene: Scene, *, fit: bool = True, overlay=None) -> None:
+        """Draw a new scene (and overlay); fit the view to its box unless told to keep the view."""
         self.scene = scene
+        self.overlay = overlay
         if fit or self.fitted:
             self.fit()
         self.refresh()
+
+    def adopt_scene(self, scene) -> None:
+        """Show a scene that draws exactly as the one shown (the same diagram in an editable
+        form): the frame on screen stays, and later changes of the scene redraw only their part."""
+        if self._base_key is None or self._frame_key is None:
+            self.show_scene(scene, fit=False)
+            return
+        self.scene = scene
+        version = getattr(scene, "version", 0)
+        self._base_key = (id(scene), *self._base_key[1:])
+        self._frame_key = (self._base_key, version, self._frame_key[2])
+        self._frame_version = version
+        self.refresh()
+
+    def set_cursor(self, cursor: tuple[float, float] | None) -> None:
+        self.cursor = cursor
+        self.refresh()
+
+    def world_at(self, col: float, row: float) -> tuple[float, float]:
+        """The world point at the centre of character (col, row)."""
+        width, height = self._canvas_size()
+        return self.view.char_to_world(col, row, width, height)
+
+    def pick_radius(self) -> float:
+        """How near the pointer (world units) a site must be to lie under it."""
+        return PICK_RADIUS_DOTS * self.view.scale
+
+    def site_at(self, x: float, y: float) -> int | None:
+        """The id of the site under the world point (x, y), or None."""
+        if self.scene is None:
+            return None
+        return self.scene.site_near(x, y, self.pick_radius())
 
     def fit(self) -> None:
         """Show the whole box."""
@@ -150,30 +242,54 @@ class DiagramCanvas(Widget, can_focus=True):
     def on_mouse_scroll_down(self, event: MouseScrollDown) -> None:
         self._zoom_at(event, 1 / ZOOM_STEP)
 
+    def _world_of(self, event) -> tuple[float, float]:
+        offset = event.get_content_offset_capture(self)
+        return self.world_at(offset.x, offset.y)
+
     def on_mouse_down(self, event: MouseDown) -> None:
         if event.button != 1:
             return
-        # Dragging always pans for now; moving a site by dragging it belongs here
-        # once the diagram can be updated point by point.
-        self._drag_from = (event.screen_x, event.screen_y)
+        self._keep_fitted()
+        self._press = self._drag_from = (event.screen_x, event.screen_y)
+        self._moved = False
+        self._grabbed = self.site_at(*self._world_of(event)) if self.editable else None
         self.capture_mouse()
         self.focus()
 
     def on_mouse_move(self, event: MouseMove) -> None:
-        if self._drag_from is None or not event.button:
+        if self._press is None or not event.button:
+            offset = event.get_content_offset(self)
+            self.pointer = None if offset is None else self.world_at(offset.x, offset.y)
             return
         x0, y0 = self._drag_from
         dx, dy = event.screen_x - x0, event.screen_y - y0
-        if dx or dy:
-            self._keep_fitted()
-            self._drag_from = (event.screen_x, event.screen_y)
-            # the world follows the pointer: move the view the other way
-            self._set_view(self.view.panned(-dx * DOT_COLS, -dy * DOT_ROWS))
+        if not (dx or dy):
+            return
+        self._moved = True
+        self._drag_from = (event.screen_x, event.screen_y)
+        if self._grabbed is not None:
+            self.drag_serial += 1
+            self.post_message(self.SiteDragged(self._grabbed, *self._world_of(event), False, self.drag_serial))
+            return
+        self._keep_fitted()
+        # the world follows the pointer: move the view the other way
+        self._set_view(self.view.panned(-dx * DOT_COLS, -dy * DOT_ROWS))
 
     def on_mouse_up(self, event: MouseUp) -> None:
-        if self._drag_from is not None:
-            self._drag_from = None
-            self.capture_mouse(False)
+        if self._press is None:
+            return
+        x, y = self._world_of(event)
+        if self._grabbed is not None and self._moved:
+            self.drag_serial += 1
+            self.post_message(self.SiteDragged(self._grabbed, x, y, True, self.drag_serial))
+        elif not self._moved:
+            self.post_message(self.Clicked(x, y))
+        self._press = self._drag_from = None
+        self._grabbed = None
+        self.capture_mouse(False)
+
+    def on_leave(self) -> None:
+        self.pointer = None
 
     def on_resize(self, event: Resize) -> None:
         self._keep_fitted()
@@ -189,20 +305,68 @@ class DiagramCanvas(Widget, can_focus=True):
             self._fit_size = size
             self.set_reactive(DiagramCanvas.view, View.fit(self.scene.bbox, size.width, size.height))
         dark = self.app.current_theme.dark
-        key = (id(self.scene), self.view, size, self.show_delaunay, self.show_vertices, dark)
-        if key != self._frame_key:
-            start = time.perf_counter()
-            if self.scene is None:
-                self._lines = [[] for _ in range(size.height)]
-            else:
-                frame = rasterize(
-                    self.scene, self.view, size.width, size.height,
-                    delaunay=self.show_delaunay, vertices=self.show_vertices,
-                )
-                self._lines = frame_lines(frame, palette_for(dark))
-            self._frame_key = key
-            self.last_draw_ms = (time.perf_counter() - start) * 1000
+        scene = self.scene
+        version = getattr(scene, "version", 0)
+        base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, dark)
+        key = (base, version, self.cursor)
+        if key == self._frame_key:
+            return self._lines
+        start = time.perf_counter()
+        if scene is None:
+            self._frame = None
+            self._lines = [[] for _ in range(size.height)]
+        elif base != self._base_key or not self._redraw_changes(scene, size, dark):
+            self._frame = rasterize(
+                scene, self.view, size.width, size.height,
+                delaunay=self.show_delaunay, vertices=self.show_vertices,
+                overlay=self.overlay, cursor=self.cursor,
+            )
+            self._lines = frame_lines(self._frame, palette_for(dark))
+        self._frame_key, self._base_key = key, base
+        self._frame_version, self._frame_cursor = version, self.cursor
+        self.drawn_at = time.perf_counter()
+        self.last_draw_ms = (self.drawn_at - start) * 1000
         return self._lines
+
+    def _redraw_changes(self, scene, size: Size, dark: bool) -> bool:
+        """Draw again only the characters that an edit of a live scene or a cursor move touched.
+
+        Returns False when that is not possible (the scene cannot say what
+        changed, or too much did); the caller then draws everything.
+        """
+        cols, rows = size.width, size.height
+        boxes, ids = [], None
+        if getattr(scene, "version", 0) != self._frame_version:
+            changes = scene.changes_since(self._frame_version) if hasattr(scene, "changes_since") else None
+            if changes is None:
+                return False
+            ids, box = changes
+            boxes.append(box)
+        if self.cursor != self._frame_cursor:
+            reach = (CURSOR_ARM + 1) * self.view.scale * DOT_ROWS
+            for cursor in (self.cursor, self._frame_cursor):
+                if cursor is not None:
+                    x, y = cursor
+                    boxes.append((x - reach, y - reach, x + reach, y + reach))
+        spans = [self.view.char_span(b, cols, rows) for b in boxes if b is not None]
+        spans = [s for s in spans if s is not None]
+        if not spans:
+            return True
+        c0, r0 = min(s[0] for s in spans), min(s[1] for s in spans)
+        c1, r1 = max(s[2] for s in spans), max(s[3] for s in spans)
+        if (c1 - c0) * (r1 - r0) > PARTIAL_MAX_FRACTION * cols * rows:
+            return False
+        frame = self._frame
+        owner = None
+        if ids is not None:
+            part_view = self.view.window(c0, r0, cols, rows)
+            owner = scene.update_owner(frame.owner[r0:r1, c0:c1], ids, part_view, c1 - c0, r1 - r0)
+        redraw_part(frame, scene, self.view, cols, rows, (c0, r0, c1, r1), owner=owner,
+                    delaunay=self.show_delaunay, vertices=self.show_vertices,
+                    overlay=self.overlay, cursor=self.cursor)
+        part = Frame(frame.codes[r0:r1], frame.mark[r0:r1], frame.fill[r0:r1], frame.owner[r0:r1])
+        self._lines[r0:r1] = frame_lines(part, palette_for(dark))
+        return True
 
     def render_line(self, y: int) -> Strip:
         size = self.content_size

@@ -18,15 +18,56 @@ SCATTER = 0x9E3779B1
 MAX_COLOURS = 8
 
 
+# The six levels of each channel of the xterm 256-colour cube.
+CUBE_LEVELS = (0x00, 0x5F, 0x87, 0xAF, 0xD7, 0xFF)
+
+
+def cube_shift(colour: str, steps: int) -> str:
+    """A cube colour moved ``steps`` levels up (lighter) or down on every channel, within the cube."""
+    channels = [int(colour[k:k + 2], 16) for k in (1, 3, 5)]
+    levels = [min(range(6), key=lambda i: abs(CUBE_LEVELS[i] - c)) for c in channels]
+    return "#" + "".join(f"{CUBE_LEVELS[min(max(lv + steps, 0), 5)]:02x}" for lv in levels)
+
+
 @dataclass(frozen=True)
 class Palette:
-    """The colours of one theme: muted cell fills and the marks drawn over them."""
+    """The colours of one theme: muted cell fills and the marks drawn over them.
+
+    The playback and editing colours: ``future`` for sites the algorithm has
+    not reached, ``sweep``, ``beach``, ``circle`` and ``growing`` for Fortune's
+    sweep line, beach line, pending circle events and growing edges,
+    ``event`` for what the current step did (and the site being moved),
+    ``conflict`` and ``conflict_fill`` for the triangles an insertion
+    destroyed, ``cursor`` and ``cursor_text`` for the keyboard cursor (a
+    block of colour under dots). ``tints`` are the fills
+    of the cells an insertion took area from.
+    """
 
     fills: tuple[str, ...]
     edge: str
     site: str
     vertex: str
     delaunay: str
+    tint_steps: int
+    future: str
+    sweep: str
+    beach: str
+    circle: str
+    growing: str
+    event: str
+    conflict: str
+    conflict_fill: str
+    cursor: str
+    cursor_text: str
+
+    @property
+    def tints(self) -> tuple[str, ...]:
+        return tuple(cube_shift(c, self.tint_steps) for c in self.fills)
+
+    @property
+    def backgrounds(self) -> tuple[str | None, ...]:
+        """Every background a character can have, indexed by its fill + 1 (no fill first)."""
+        return (None, *self.fills, *self.tints, self.conflict_fill)
 
 
 # All colours are exact entries of the xterm 256-colour cube, so a terminal (or a
@@ -48,6 +89,17 @@ DARK = Palette(
     site="#ffd75f",
     vertex="#ff8787",
     delaunay="#87d7d7",
+    tint_steps=1,
+    future="#808080",
+    sweep="#5fd7ff",
+    beach="#ffaf00",
+    circle="#d787ff",
+    growing="#87ff87",
+    event="#ff5fff",
+    conflict="#ff5f5f",
+    conflict_fill="#870000",
+    cursor="#ff87ff",
+    cursor_text="#000000",
 )
 
 # Pastel fills: dark edges and deep marks stay readable on each of them.
@@ -66,6 +118,17 @@ LIGHT = Palette(
     site="#af0000",
     vertex="#5f00af",
     delaunay="#005f5f",
+    tint_steps=-1,
+    future="#8a8a8a",
+    sweep="#0087af",
+    beach="#d75f00",
+    circle="#8700d7",
+    growing="#008700",
+    event="#d700d7",
+    conflict="#d70000",
+    conflict_fill="#ffafaf",
+    cursor="#870087",
+    cursor_text="#ffffff",
 )
 
 
@@ -234,3 +297,59 @@ def cell_colours(diagram, n_colours: int = MAX_COLOURS) -> np.ndarray:
     a, b = cell_adjacency(diagram)
     colour = colour_graph(n, a, b, n_colours)
     return colour[np.asarray(diagram.site_of, np.int64)]
+
+
+def repair_colours(colours: np.ndarray, neighbours, todo, n_colours: int = MAX_COLOURS) -> np.ndarray:
+    """Give new colours to a few cells so that they differ from their neighbours; the others keep theirs.
+
+    Parameters
+    ----------
+    colours : (n,) int8, changed in place
+        Current colours, -1 for a cell without one.
+    neighbours : callable
+        ``neighbours(i)`` gives the cells next to cell i (an int array).
+    todo : iterable of int
+        The cells to check: each keeps its colour unless a neighbour has it
+        or it has none.
+
+    Returns
+    -------
+    ``colours``. A cell with neighbours of every colour keeps the colour
+    fewest of them share.
+    """
+    for i in todo:
+        i = int(i)
+        around = np.asarray(neighbours(i), np.int64)
+        near = colours[around]
+        near = near[near >= 0]
+        mine = int(colours[i])
+        if mine >= 0 and not (near == mine).any():
+            continue
+        used = 0
+        for c in near.tolist():
+            used |= 1 << c
+        # the free colour nearest after the cell's scattered first choice (as colour_graph)
+        first = int((i * SCATTER >> 16) % n_colours)
+        pick = -1
+        for k in range(n_colours):
+            c = (first + k) % n_colours
+            if not used >> c & 1:
+                pick = c
+                break
+        if pick < 0:  # every colour taken around it (not planar, or a crowded vertex)
+            pick = int(np.argmin(np.bincount(near, minlength=n_colours)))
+        colours[i] = pick
+    return colours
+
+
+def adjacency_lists(n: int, a: np.ndarray, b: np.ndarray):
+    """A ``neighbours(i)`` function over the undirected pairs (a, b), in CSR form."""
+    a = np.asarray(a, np.int64)
+    b = np.asarray(b, np.int64)
+    src = np.concatenate([a, b])
+    dst = np.concatenate([b, a])
+    order = np.argsort(src, kind="stable")
+    dst = dst[order]
+    offsets = np.zeros(n + 1, np.int64)
+    np.cumsum(np.bincount(src, minlength=n), out=offsets[1:])
+    return lambda i: dst[offsets[i]:offsets[i + 1]]

@@ -1,11 +1,7 @@
-"""Draw a Voronoi diagram on a braille grid with numpy: dots, cell fills and styled rows of text.
+"""Draw a Voronoi diagram on a braille grid with numpy: views, scenes, layers, cell fills, styled rows.
 
-A character cell holds 2 x 4 braille dots, so a canvas of ``cols x rows``
-characters is a boolean dot array of shape ``(rows * 4, cols * 2)``. Dot
-coordinates ``(u, v)`` are continuous: dot column ``floor(u)``, dot row
-``floor(v)``, with ``v`` growing downwards. Every layer is drawn into its own
-dot array and the layers' bit patterns are OR-ed per character, so no dot is
-lost where lines meet.
+Every layer is drawn into its own dot array (see ``dots``) and the layers'
+bit patterns are OR-ed per character, so no dot is lost where lines meet.
 """
 
 from __future__ import annotations
@@ -18,18 +14,23 @@ from rich.segment import Segment
 from rich.style import Style
 from scipy.spatial import cKDTree
 
-from tvoronoi.tui.colours import Palette, cell_colours
-
-DOT_COLS, DOT_ROWS = 2, 4
-BRAILLE_BLANK = 0x2800
-# DOT_BITS[row, col]: the bit of the dot at (col, row) inside a character
-DOT_BITS = np.array([[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]], np.uint8)
-SPACE = 0x20
+from tvoronoi.tui.colours import MAX_COLOURS, Palette, cell_colours
+from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, braille_text, pack_braille, point_dots, segment_dots
 
 # The layers, in rising precedence: a character has one foreground colour,
-# that of the highest layer with a dot in it.
-NO_MARK, DELAUNAY, EDGE, VERTEX, SITE = 0, 1, 2, 3, 4
-N_MARKS = 5
+# that of the highest layer with a dot in it. FUTURE (sites not reached yet),
+# GROWING, CONFLICT, CIRCLE, BEACH, SWEEP and EVENT belong to algorithm playback,
+# CURSOR to editing.
+(NO_MARK, FUTURE, DELAUNAY, EDGE, GROWING, CONFLICT, CIRCLE, BEACH, SWEEP,
+ VERTEX, SITE, EVENT, CURSOR) = range(13)
+N_MARKS = 13
+# Fills: -1 none, 0 .. N_FILLS - 1 the cell colours, TINTED + c the tinted
+# colour c, CONFLICT_FILL the inside of a conflict region.
+N_FILLS = MAX_COLOURS
+TINTED = N_FILLS
+CONFLICT_FILL = 2 * N_FILLS
+# The keyboard cursor's cross reaches this many dots each way (about a character).
+CURSOR_ARM = 2
 # Below this many sites per character a site is drawn as a 2 x 2 block of dots.
 SPARSE_SITES_PER_CHAR = 0.05
 # Vertex marks are drawn only below this many vertices per character: denser, they
@@ -81,6 +82,26 @@ class View:
         keep = 1.0 - 1.0 / factor
         return View(self.cx + (ax - self.cx) * keep, self.cy + (ay - self.cy) * keep, scale)
 
+    def window(self, c0: int, r0: int, cols: int, rows: int) -> "Window":
+        """The part of a ``cols x rows`` canvas from character (c0, r0) on, as a view of its own."""
+        return Window(self, cols, rows, c0, r0)
+
+    def char_span(self, box, cols: int, rows: int, margin: int = 1) -> tuple[int, int, int, int] | None:
+        """The characters (c0, r0, c1, r1), ends excluded, that a world box touches, grown by
+        ``margin`` characters and cut to the canvas; None if it misses the canvas."""
+        if not np.isfinite(box).all():
+            return None
+        x0, y0, x1, y1 = box
+        u0, v1 = self.to_dots(x0, y0, cols, rows)
+        u1, v0 = self.to_dots(x1, y1, cols, rows)
+        c0 = max(int(np.floor(float(u0) / DOT_COLS)) - margin, 0)
+        c1 = min(int(np.floor(float(u1) / DOT_COLS)) + 1 + margin, cols)
+        r0 = max(int(np.floor(float(v0) / DOT_ROWS)) - margin, 0)
+        r1 = min(int(np.floor(float(v1) / DOT_ROWS)) + 1 + margin, rows)
+        if c0 >= c1 or r0 >= r1:
+            return None
+        return c0, r0, c1, r1
+
     @classmethod
     def fit(cls, bbox, cols: int, rows: int) -> "View":
         """The view that shows the whole box, centred, with a small margin."""
@@ -93,117 +114,33 @@ class View:
         return cls((xmin + xmax) / 2, (ymin + ymax) / 2, scale)
 
 
-# ---------------------------------------------------------------------------
-# dots
+@dataclass(frozen=True)
+class Window:
+    """The part of a canvas of ``cols x rows`` characters from character (c0, r0) on, used as a view.
 
-def segment_dots(dots: np.ndarray, u0, v0, u1, v1) -> None:
-    """Set the dots along many segments at once.
-
-    Each segment is clipped to the dot array, then sampled once per dot
-    along its longer axis (a vectorised DDA), so consecutive samples touch
-    and a line has no gaps.
-
-    Parameters
-    ----------
-    dots : (H, W) bool, changed in place
-    u0, v0, u1, v1 : (k,) float
-        Segment ends in continuous dot coordinates; they may lie outside.
+    Points go through the whole canvas's dots, then move by whole dots,
+    which is exact: a point lands on the same dot whether the part or the
+    whole canvas is drawn (sites put at character centres lie exactly on
+    dot corners, where any rounding would matter).
     """
-    height, width = dots.shape
-    u0, v0, u1, v1 = (np.asarray(c, np.float64).ravel() for c in (u0, v0, u1, v1))
-    if u0.size == 0 or width == 0 or height == 0:
-        return
-    # drop the segments wholly beyond one side
-    lo_u, hi_u = np.minimum(u0, u1), np.maximum(u0, u1)
-    lo_v, hi_v = np.minimum(v0, v1), np.maximum(v0, v1)
-    near = (hi_u >= 0) & (lo_u < width) & (hi_v >= 0) & (lo_v < height)
-    if not near.all():
-        u0, v0, u1, v1 = u0[near], v0[near], u1[near], v1[near]
-        lo_u, hi_u, lo_v, hi_v = lo_u[near], hi_u[near], lo_v[near], hi_v[near]
-    # clip the segments that cross a side
-    crossing = (lo_u < 0) | (hi_u >= width) | (lo_v < 0) | (hi_v >= height)
-    if crossing.any():
-        # clip copies: the caller's arrays stay as they were
-        u0, v0, u1, v1 = u0.copy(), v0.copy(), u1.copy(), v1.copy()
-        keep = np.ones(u0.shape, bool)
-        keep[crossing], u0[crossing], v0[crossing], u1[crossing], v1[crossing] = _clip(
-            u0[crossing], v0[crossing], u1[crossing], v1[crossing], width, height
-        )
-        u0, v0, u1, v1 = u0[keep], v0[keep], u1[keep], v1[keep]
-    du, dv = u1 - u0, v1 - v0
-    # one sample per dot along the longer axis, both ends included; float32 is
-    # ample once the ends lie on the canvas
-    steps = np.ceil(np.maximum(np.abs(du), np.abs(dv))).astype(np.int32)
-    counts = steps + 1
-    owner = np.repeat(np.arange(counts.size, dtype=np.int32), counts)
-    first = np.cumsum(counts) - counts
-    j = (np.arange(owner.size, dtype=np.int32) - first[owner]).astype(np.float32)
-    per = np.maximum(steps, 1).astype(np.float32)
-    step_u, step_v = (du / per).astype(np.float32), (dv / per).astype(np.float32)
-    # the samples are >= 0, so truncation is floor
-    cols = (u0.astype(np.float32)[owner] + j * step_u[owner]).astype(np.int32)
-    rows = (v0.astype(np.float32)[owner] + j * step_v[owner]).astype(np.int32)
-    # the samples are inside [0, W) x [0, H), up to rounding at the far side
-    np.clip(cols, 0, width - 1, out=cols)
-    np.clip(rows, 0, height - 1, out=rows)
-    dots.ravel()[rows.astype(np.int64) * width + cols] = True
 
+    view: View
+    cols: int
+    rows: int
+    c0: int
+    r0: int
 
-def _clip(u0, v0, u1, v1, width: int, height: int):
-    """Clip segments to [0, W) x [0, H) (Liang-Barsky, all at once); returns keep, u0, v0, u1, v1."""
-    du, dv = u1 - u0, v1 - v0
-    t0 = np.zeros_like(u0)
-    t1 = np.ones_like(u0)
-    keep = np.ones(u0.shape, bool)
-    top_u, top_v = np.nextafter(width, 0), np.nextafter(height, 0)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for p, q in ((-du, u0), (du, top_u - u0), (-dv, v0), (dv, top_v - v0)):
-            # this side keeps the points with p * t <= q
-            keep &= ~((p == 0) & (q < 0))
-            r = q / p
-            t0 = np.where(p < 0, np.maximum(t0, r), t0)
-            t1 = np.where(p > 0, np.minimum(t1, r), t1)
-    keep &= t0 <= t1
-    return keep, u0 + t0 * du, v0 + t0 * dv, u0 + t1 * du, v0 + t1 * dv
+    @property
+    def scale(self) -> float:
+        return self.view.scale
 
+    def to_dots(self, xs, ys, cols: int, rows: int):
+        u, v = self.view.to_dots(xs, ys, self.cols, self.rows)
+        return u - self.c0 * DOT_COLS, v - self.r0 * DOT_ROWS
 
-def point_dots(dots: np.ndarray, u, v, *, block: bool = False) -> None:
-    """Set the dot under each point that falls on the array.
-
-    With ``block``, set the 2 x 2 dots around it inside its own character,
-    so that a lone site reads as a spot.
-    """
-    height, width = dots.shape
-    col = np.floor(np.asarray(u, np.float64)).astype(np.int64)
-    row = np.floor(np.asarray(v, np.float64)).astype(np.int64)
-    inside = (col >= 0) & (col < width) & (row >= 0) & (row < height)
-    col, row = col[inside], row[inside]
-    dots[row, col] = True
-    if block:
-        # the other column of the character, and the neighbouring row inside it
-        other_col = col ^ 1
-        other_row = np.where(row % DOT_ROWS == DOT_ROWS - 1, row - 1, row + 1)
-        dots[row, other_col] = True
-        dots[other_row, col] = True
-        dots[other_row, other_col] = True
-
-
-def pack_braille(dots: np.ndarray) -> np.ndarray:
-    """Pack a (rows * 4, cols * 2) dot array into (rows, cols) braille bit patterns."""
-    height, width = dots.shape
-    rows, cols = height // DOT_ROWS, width // DOT_COLS
-    cells = dots[: rows * DOT_ROWS, : cols * DOT_COLS].reshape(rows, DOT_ROWS, cols, DOT_COLS)
-    codes = np.zeros((rows, cols), np.uint8)
-    for r in range(DOT_ROWS):
-        for c in range(DOT_COLS):
-            codes |= cells[:, r, :, c].view(np.uint8) * DOT_BITS[r, c]
-    return codes
-
-
-def braille_text(codes: np.ndarray) -> str:
-    """One row of bit patterns as text: braille glyphs, a plain space where no dot is set."""
-    chars = np.where(codes == 0, SPACE, BRAILLE_BLANK + codes.astype(np.uint32)).astype("<u4")
-    return chars.tobytes().decode("utf-32-le")
+    def to_world(self, u, v, cols: int, rows: int):
+        return self.view.to_world(np.asarray(u) + self.c0 * DOT_COLS, np.asarray(v) + self.r0 * DOT_ROWS,
+                                  self.cols, self.rows)
 
 
 # ---------------------------------------------------------------------------
@@ -250,9 +187,32 @@ class Scene:
     def n_sites(self) -> int:
         return len(self.sites)
 
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    def nearest(self, points: np.ndarray) -> np.ndarray:
+        """The row of ``sites`` nearest each point (k, 2)."""
+        _, rows = self.tree.query(points)
+        return rows
+
+    def site_ids(self) -> np.ndarray | None:
+        """The id of each row of ``sites`` (None: the row number is the id)."""
+        return None
+
+    def site_near(self, x: float, y: float, radius: float) -> int | None:
+        """The id of the site nearest (x, y) within ``radius``, or None."""
+        if self.n_sites == 0:
+            return None
+        distance, k = self.tree.query([x, y], distance_upper_bound=radius)
+        if not np.isfinite(distance):
+            return None
+        ids = self.site_ids()
+        return int(k) if ids is None else int(ids[k])
+
     @classmethod
-    def from_diagram(cls, diagram) -> "Scene":
-        """Collect the segments, marks and cell colours of a diagram."""
+    def from_diagram(cls, diagram, colours: np.ndarray | None = None) -> "Scene":
+        """Collect the segments, marks and cell colours of a diagram (``colours``: given, not computed)."""
         sites = np.asarray(diagram.sites, np.float64)
 
         # every clipped cell ring, point to next point (wrapping round)
@@ -284,7 +244,7 @@ class Scene:
             edges=edges,
             delaunay=delaunay,
             vertices=vertices[inside],
-            colours=cell_colours(diagram),
+            colours=cell_colours(diagram) if colours is None else np.asarray(colours, np.int8),
             bbox=tuple(float(c) for c in diagram.bbox),
         )
 
@@ -305,39 +265,134 @@ class Frame:
     codes : (rows, cols) uint8
         Braille bit patterns (all layers OR-ed).
     mark : (rows, cols) uint8
-        The highest layer with a dot in the character (NO_MARK .. SITE).
+        The highest layer with a dot in the character (NO_MARK .. CURSOR).
     fill : (rows, cols) int16
-        Palette index of the cell that owns the character's centre, -1 outside the box.
+        Fill of the character (see N_FILLS): usually the palette index of the
+        cell that owns the character's centre, -1 outside the box.
+    owner : (rows, cols) int64
+        The row of ``scene.sites`` nearest the character's centre, -1 outside the box.
     """
 
     codes: np.ndarray
     mark: np.ndarray
     fill: np.ndarray
+    owner: np.ndarray
 
 
-def cell_fill(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
-    """The palette index of the cell under each character's centre (-1 outside the box or no sites).
-
-    The nearest site of the centre owns it: that is the Voronoi cell itself,
-    found for all characters at once with the k-d tree.
-    """
-    fill = np.full((rows, cols), -1, np.int16)
-    if scene.n_sites == 0 or cols == 0 or rows == 0:
-        return fill
+def char_centres(view: View, cols: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """World x of each character column's centre (cols,) and y of each row's centre (rows,)."""
     u = (np.arange(cols) + 0.5) * DOT_COLS
     v = (np.arange(rows) + 0.5) * DOT_ROWS
     xs, _ = view.to_world(u, np.zeros_like(u), cols, rows)
     _, ys = view.to_world(np.zeros_like(v), v, cols, rows)
+    return xs, ys
+
+
+def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
+    """The row of ``scene.sites`` whose cell holds each character's centre (-1 outside the box).
+
+    The nearest site of the centre owns it: that is the Voronoi cell itself,
+    found for all characters at once with the k-d tree.
+    """
+    owner = np.full((rows, cols), -1, np.int64)
+    if scene.n_sites == 0 or cols == 0 or rows == 0:
+        return owner
+    xs, ys = char_centres(view, cols, rows)
     xmin, ymin, xmax, ymax = scene.bbox
     in_x = (xs >= xmin) & (xs <= xmax)
     in_y = (ys >= ymin) & (ys <= ymax)
     if not (in_x.any() and in_y.any()):
-        return fill
+        return owner
     gx, gy = np.meshgrid(xs[in_x], ys[in_y])
-    _, nearest = scene.tree.query(np.column_stack([gx.ravel(), gy.ravel()]))
-    block = scene.colours[nearest].astype(np.int16).reshape(gx.shape)
-    fill[np.ix_(np.flatnonzero(in_y), np.flatnonzero(in_x))] = block
+    nearest = scene.nearest(np.column_stack([gx.ravel(), gy.ravel()]))
+    owner[np.ix_(np.flatnonzero(in_y), np.flatnonzero(in_x))] = nearest.reshape(gx.shape)
+    return owner
+
+
+def cell_fill(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
+    """The palette index of the cell under each character's centre (-1 outside the box or no sites)."""
+    return fill_of(scene, cell_owner(scene, view, cols, rows))
+
+
+def fill_of(scene: Scene, owner: np.ndarray) -> np.ndarray:
+    """The palette index of each owner (-1 stays -1)."""
+    fill = np.full(owner.shape, -1, np.int16)
+    inside = owner >= 0
+    fill[inside] = scene.colours[owner[inside]]
     return fill
+
+
+class Painter:
+    """Draws layers of marks into a frame's bit patterns, each layer in its own dot array.
+
+    Layers may come in any order: a character takes the colour of the highest
+    layer with a dot in it.
+    """
+
+    def __init__(self, view: View, cols: int, rows: int) -> None:
+        self.view, self.cols, self.rows = view, cols, rows
+        self.shape = (rows * DOT_ROWS, cols * DOT_COLS)
+        self.codes = np.zeros((rows, cols), np.uint8)
+        self.mark = np.zeros((rows, cols), np.uint8)
+        # the world box the canvas shows, a dot wider each way: marks beyond it are dropped
+        # before any work (NaN coordinates fail these tests too)
+        (x0, x1), (y1, y0) = view.to_world(np.array([-1.0, cols * DOT_COLS + 1.0]),
+                                           np.array([-1.0, rows * DOT_ROWS + 1.0]), cols, rows)
+        self.world = (float(x0), float(y0), float(x1), float(y1))
+
+    def _visible_segments(self, seg: np.ndarray) -> np.ndarray:
+        x0, y0, x1, y1 = self.world
+        sx0, sy0, sx1, sy1 = seg.T
+        keep = ((np.maximum(sx0, sx1) >= x0) & (np.minimum(sx0, sx1) <= x1)
+                & (np.maximum(sy0, sy1) >= y0) & (np.minimum(sy0, sy1) <= y1))
+        return seg if keep.all() else seg[keep]
+
+    def _visible_points(self, xy: np.ndarray) -> np.ndarray:
+        x0, y0, x1, y1 = self.world
+        keep = (xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)
+        return xy if keep.all() else xy[keep]
+
+    def new_dots(self) -> np.ndarray:
+        return np.zeros(self.shape, bool)
+
+    def lay(self, layer: int, dots: np.ndarray) -> None:
+        """Merge a layer's dots into the frame."""
+        packed = pack_braille(dots)
+        self.codes |= packed
+        np.maximum(self.mark, np.where(packed != 0, np.uint8(layer), np.uint8(0)), out=self.mark)
+
+    def to_dots(self, xs, ys):
+        return self.view.to_dots(xs, ys, self.cols, self.rows)
+
+    def segments(self, layer: int, seg: np.ndarray, *, dash: int = 0) -> None:
+        """World segments (k, 4) as x0, y0, x1, y1."""
+        seg = self._visible_segments(np.asarray(seg, np.float64).reshape(-1, 4))
+        if not len(seg):
+            return
+        dots = self.new_dots()
+        u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
+        u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
+        segment_dots(dots, u0, v0, u1, v1, dash=dash)
+        self.lay(layer, dots)
+
+    def points(self, layer: int, xy: np.ndarray, *, block: bool = False) -> None:
+        """World points (k, 2)."""
+        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
+        if not len(xy):
+            return
+        dots = self.new_dots()
+        u, v = self.to_dots(xy[:, 0], xy[:, 1])
+        point_dots(dots, u, v, block=block)
+        self.lay(layer, dots)
+
+    def cross(self, layer: int, x: float, y: float) -> None:
+        """A small cross centred on the world point (x, y)."""
+        dots = self.new_dots()
+        u, v = self.to_dots(x, y)
+        u, v = float(u), float(v)
+        segment_dots(dots, [u - CURSOR_ARM, u], [v, v - CURSOR_ARM - 1], [u + CURSOR_ARM, u],
+                     [v, v + CURSOR_ARM + 1])
+        self.lay(layer, dots)
 
 
 def rasterize(
@@ -348,46 +403,54 @@ def rasterize(
     *,
     delaunay: bool = False,
     vertices: bool = True,
+    overlay=None,
+    cursor: tuple[float, float] | None = None,
+    owner: np.ndarray | None = None,
 ) -> Frame:
-    """Draw a scene into a frame of ``cols x rows`` characters."""
-    shape = (rows * DOT_ROWS, cols * DOT_COLS)
-    codes = np.zeros((rows, cols), np.uint8)
-    mark = np.zeros((rows, cols), np.uint8)
+    """Draw a scene into a frame of ``cols x rows`` characters.
 
-    def lay(layer: int, dots: np.ndarray) -> None:
-        packed = pack_braille(dots)
-        codes[:] |= packed
-        mark[packed != 0] = layer  # layers come in rising precedence
-
+    ``overlay``, if given, draws more layers (``overlay.draw(painter)``) and
+    may change the fills (``overlay.refill(fill, owner, view, cols, rows)``);
+    ``cursor`` is a world point marked with a cross; ``owner`` is the
+    ``cell_owner`` of this scene and view when the caller already has it.
+    """
+    paint = Painter(view, cols, rows)
     if delaunay and len(scene.delaunay):
-        dots = np.zeros(shape, bool)
-        d = scene.delaunay
-        u0, v0 = view.to_dots(d[:, 0], d[:, 1], cols, rows)
-        u1, v1 = view.to_dots(d[:, 2], d[:, 3], cols, rows)
-        segment_dots(dots, u0, v0, u1, v1)
-        lay(DELAUNAY, dots)
-    if len(scene.edges):
-        dots = np.zeros(shape, bool)
-        e = scene.edges
-        u0, v0 = view.to_dots(e[:, 0], e[:, 1], cols, rows)
-        u1, v1 = view.to_dots(e[:, 2], e[:, 3], cols, rows)
-        segment_dots(dots, u0, v0, u1, v1)
-        lay(EDGE, dots)
-    if vertices and len(scene.vertices) and _per_char(len(scene.vertices), scene, view) < VERTEX_MARKS_PER_CHAR:
-        dots = np.zeros(shape, bool)
-        u, v = view.to_dots(scene.vertices[:, 0], scene.vertices[:, 1], cols, rows)
-        point_dots(dots, u, v)
-        lay(VERTEX, dots)
+        paint.segments(DELAUNAY, scene.delaunay)
+    paint.segments(EDGE, scene.edges)
+    if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
+        paint.points(VERTEX, scene.vertices)
     if scene.n_sites:
-        dots = np.zeros(shape, bool)
-        u, v = view.to_dots(scene.sites[:, 0], scene.sites[:, 1], cols, rows)
-        sparse = _per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
-        point_dots(dots, u, v, block=sparse)
-        lay(SITE, dots)
-    return Frame(codes, mark, cell_fill(scene, view, cols, rows))
+        sparse = per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
+        paint.points(SITE, scene.sites, block=sparse)
+    if overlay is not None:
+        overlay.draw(paint)
+    if cursor is not None:
+        paint.cross(CURSOR, *cursor)
+    if owner is None:
+        owner = cell_owner(scene, view, cols, rows)
+    fill = fill_of(scene, owner)
+    if overlay is not None:
+        fill = overlay.refill(fill, owner, view, cols, rows)
+    return Frame(paint.codes, paint.mark, fill, owner)
 
 
-def _per_char(count: int, scene: Scene, view: View) -> float:
+def redraw_part(frame: Frame, scene, view: View, cols: int, rows: int, span, *, owner=None, **options) -> None:
+    """Draw again, in place, the characters ``span`` = (c0, r0, c1, r1) of a frame of this scene and view.
+
+    ``owner`` gives the owners of those characters if the caller has them;
+    ``options`` are those of ``rasterize``. Segments are clipped at the
+    part's border, so a line crossing it may shift by a dot there.
+    """
+    c0, r0, c1, r1 = span
+    part_view = view.window(c0, r0, cols, rows)
+    part = rasterize(scene, part_view, c1 - c0, r1 - r0, owner=owner, **options)
+    for whole, piece in ((frame.codes, part.codes), (frame.mark, part.mark),
+                         (frame.fill, part.fill), (frame.owner, part.owner)):
+        whole[r0:r1, c0:c1] = piece
+
+
+def per_char(count: int, scene, view: View) -> float:
     """About how many of ``count`` marks spread over the box share one character."""
     xmin, ymin, xmax, ymax = scene.bbox
     char_w, char_h = view.scale * DOT_COLS, view.scale * DOT_ROWS
@@ -400,18 +463,28 @@ def _per_char(count: int, scene: Scene, view: View) -> float:
 
 @lru_cache(maxsize=8)
 def style_table(palette: Palette) -> tuple[Style, ...]:
-    """Styles indexed by ``mark * (len(fills) + 1) + fill + 1``."""
+    """Styles indexed by ``mark * len(palette.backgrounds) + fill + 1``."""
     marks = {
         NO_MARK: (None, False),
+        FUTURE: (palette.future, False),
         DELAUNAY: (palette.delaunay, False),
         EDGE: (palette.edge, True),
+        GROWING: (palette.growing, True),
+        CONFLICT: (palette.conflict, True),
+        CIRCLE: (palette.circle, False),
+        BEACH: (palette.beach, True),
+        SWEEP: (palette.sweep, True),
         VERTEX: (palette.vertex, True),
         SITE: (palette.site, True),
+        EVENT: (palette.event, True),
+        CURSOR: (palette.cursor, True),
     }
     table = []
     for m in range(N_MARKS):
         colour, bold = marks[m]
-        for bg in (None, *palette.fills):
+        for bg in palette.backgrounds:
+            if m == CURSOR:  # a block of its own colour, whatever lies under it
+                colour, bg = palette.cursor_text, palette.cursor
             table.append(Style(color=colour, bgcolor=bg, bold=bold or None))
     return tuple(table)
 
@@ -422,7 +495,7 @@ def frame_lines(frame: Frame, palette: Palette) -> list[list[Segment]]:
     rows, cols = frame.codes.shape
     if rows == 0 or cols == 0:
         return [[] for _ in range(rows)]
-    keys = frame.mark.astype(np.int64) * (len(palette.fills) + 1) + (frame.fill.astype(np.int64) + 1)
+    keys = frame.mark.astype(np.int64) * len(palette.backgrounds) + (frame.fill.astype(np.int64) + 1)
     # runs of one style, over the whole frame at once; each row starts a run
     change = np.ones((rows, cols), bool)
     change[:, 1:] = keys[:, 1:] != keys[:, :-1]

@@ -13,9 +13,15 @@ from textual.widgets import Input, Label, Static
 # Mouse gestures, listed in the help beside the keys.
 MOUSE_HELP = (
     ("wheel", "zoom about the pointer"),
-    ("drag", "pan"),
-    ("click", "focus a control; hover for its tooltip"),
+    ("drag", "pan; a site dragged moves (its cell follows)"),
+    ("click", "add a site (empty space); focus a control, hover for its tooltip"),
+    ("timeline", "click or drag to go to a step of the playback"),
 )
+
+
+def _plain(text: str) -> str:
+    """Text shown as it is, not read as markup (keys such as [ and ])."""
+    return text.replace("[", "\\[")
 
 
 class HelpScreen(ModalScreen[None]):
@@ -32,9 +38,9 @@ class HelpScreen(ModalScreen[None]):
     def compose(self) -> ComposeResult:
         width = max((len(k) for k, _ in (*self.keys, *MOUSE_HELP)), default=0)
         lines = ["[b]Keys[/b]"]
-        lines += [f"  [b $accent]{key:<{width}}[/]  {what}" for key, what in self.keys]
+        lines += [f"  [b $accent]{_plain(f'{key:<{width}}')}[/]  {_plain(what)}" for key, what in self.keys]
         lines += ["", "[b]Mouse[/b]"]
-        lines += [f"  [b $accent]{key:<{width}}[/]  {what}" for key, what in MOUSE_HELP]
+        lines += [f"  [b $accent]{_plain(f'{key:<{width}}')}[/]  {_plain(what)}" for key, what in MOUSE_HELP]
         lines += ["", "[dim]In a text field, Esc returns to the diagram; Tab moves between controls.[/dim]"]
         with VerticalScroll(id="help-box") as box:
             box.border_title = "tvoronoi help"

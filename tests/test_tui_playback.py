@@ -1,0 +1,394 @@
+"""Playback of the engines in the terminal UI: keys, timeline, timer, pictures of steps, snapshots."""
+
+import numpy as np
+import pytest
+from textual.widgets import Select
+from textual.widgets._toast import Toast
+
+import tvoronoi
+from test_tui import SIZE, error_toasts, make_app, pilot_test, status_text
+from tvoronoi.generators import generate
+from tvoronoi.tui import playback
+from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
+from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
+from tvoronoi.tui.raster import (
+    BEACH,
+    CIRCLE,
+    CONFLICT,
+    CONFLICT_FILL,
+    EVENT,
+    FUTURE,
+    SITE,
+    SWEEP,
+    TINTED,
+    Scene,
+    View,
+    frame_lines,
+    rasterize,
+)
+
+
+def warning_toasts(app) -> list[str]:
+    return [toast.render().plain for toast in app.screen.query(Toast) if toast.has_class("-warning")]
+
+
+async def start_playback(app, pilot, engine="incremental"):
+    await pilot.pause()
+    if engine != app.built.diagram.engine:
+        app.query_one("#engine", Select).value = engine
+        await pilot.pause()
+        app.canvas.focus()
+    await pilot.press("t")
+    await pilot.pause()
+    assert app.player is not None
+    return app.player
+
+
+def expected_describe(app, k: int) -> str:
+    """What the step k of a fresh trace of the same points and engine says."""
+    built = app.built
+    if built.diagram.engine == "fortune":
+        trace = tvoronoi.fortune_steps(built.points)
+    else:
+        trace = tvoronoi.incremental_steps(built.points, bbox=built.diagram.bbox)
+    return trace.step(k).describe()
+
+
+# -- keys --------------------------------------------------------------------
+
+
+@pilot_test
+async def test_t_starts_and_ends_playback():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        assert player.index == 0 and player.n_steps == 300
+        assert app.timeline.display
+        assert app.timeline.n_steps == 300
+        assert status_text(app) == player.step.describe()
+        assert app.canvas.overlay is not None
+        await pilot.press("t")
+        assert app.player is None
+        assert not app.timeline.display
+        assert app.canvas.scene is app.built.scene and app.canvas.overlay is None
+        assert status_text(app).startswith("300 sites")
+
+
+@pilot_test
+async def test_step_keys_move_one_step_and_to_the_ends():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press("full_stop", "full_stop", "full_stop")
+        assert player.index == 3 and player.step.index == 3
+        await pilot.press("comma")
+        assert player.index == 2
+        await pilot.press("end")
+        assert player.index == player.n_steps
+        await pilot.press("full_stop")  # no step beyond the last
+        assert player.index == player.n_steps
+        await pilot.press("home")
+        assert player.index == 0
+        await pilot.press("comma")  # none before the first
+        assert player.index == 0
+
+
+@pilot_test
+async def test_brackets_and_shift_arrows_move_by_a_tenth():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        tenth = round(0.1 * player.n_steps)
+        await pilot.press("right_square_bracket")
+        assert player.index == tenth
+        await pilot.press("shift+right")
+        assert player.index == 2 * tenth
+        await pilot.press("left_square_bracket", "shift+left", "shift+left")
+        assert player.index == 0
+
+
+@pilot_test
+async def test_status_line_says_what_the_step_did():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        for keys in (["full_stop"], ["right_square_bracket"], ["end"]):
+            await pilot.press(*keys)
+            k = app.player.index
+            assert status_text(app) == expected_describe(app, k)
+        # the last event of Fortune's sweep is a circle event
+        assert status_text(app).startswith("circle event at (")
+        assert "vertex" in status_text(app)
+
+
+@pilot_test
+async def test_incremental_status_names_the_inserted_site():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press(*["full_stop"] * 10)
+        assert status_text(app) == expected_describe(app, 10)
+        assert f"site {player.step.site} inserted at (" in status_text(app)
+
+
+@pilot_test
+async def test_speed_keys_change_the_speed_shown():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        assert player.speed == playback.DEFAULT_SPEED
+        await pilot.press("greater_than_sign")
+        assert player.speed == 50 and app.timeline.speed == 50
+        await pilot.press("less_than_sign", "less_than_sign")
+        assert player.speed == 10
+        assert "10 steps/s" in app.timeline.render().plain
+
+
+@pilot_test
+async def test_playback_keys_do_nothing_outside_playback():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        scene = app.canvas.scene
+        await pilot.press("space", "full_stop", "end", "right_square_bracket")
+        assert app.player is None and app.canvas.scene is scene
+
+
+# -- timeline ------------------------------------------------------------------
+
+
+@pilot_test
+async def test_clicking_the_timeline_scrubs_proportionally():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        timeline = app.timeline
+        start, width = timeline.bar_span()
+        for fraction in (0.0, 0.25, 0.5, 0.8, 1.0):
+            x = start + round(fraction * (width - 1))
+            await pilot.click(timeline, offset=(x, 0))
+            await pilot.pause()
+            # within one column's worth of steps of the fraction clicked
+            assert abs(player.index - fraction * player.n_steps) <= player.n_steps / (width - 1)
+            assert player.index == timeline.step_at(x)
+            assert status_text(app) == player.step.describe()
+        assert player.index == player.n_steps
+
+
+@pilot_test
+async def test_dragging_on_the_timeline_scrubs():
+    from textual.events import MouseMove
+
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        timeline = app.timeline
+        start, width = timeline.bar_span()
+        await pilot.mouse_down(timeline, offset=(start + 2, 0))
+        first = player.index
+        await pilot._post_mouse_events([MouseMove], timeline, offset=(start + width // 2, 0), button=1)
+        await pilot.mouse_up(timeline, offset=(start + width // 2, 0))
+        await pilot.pause()
+        assert first < player.index == timeline.step_at(start + width // 2)
+
+
+# -- time ----------------------------------------------------------------------
+
+
+@pilot_test
+async def test_playing_advances_with_the_clock():
+    app = make_app()
+    now = [100.0]
+    app.playback_clock = lambda: now[0]
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press("space")
+        assert player.playing and app.timeline.playing
+        await pilot.pause(0.1)
+        assert player.index == 0  # the clock has not moved
+        now[0] += 0.5
+        await pilot.pause(0.1)
+        assert player.index == round(0.5 * player.speed)
+        now[0] += 100.0  # far past the end: playback stops at the last step
+        await pilot.pause(0.1)
+        assert player.index == player.n_steps and not player.playing
+        await pilot.press("space")  # playing again from the end starts over
+        assert player.index == 0 and player.playing
+
+
+@pilot_test
+async def test_playing_advances_in_real_time():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press("greater_than_sign", "greater_than_sign")  # 100 steps/s
+        await pilot.press("space")
+        await pilot.pause(0.4)
+        assert player.index > 0
+        await pilot.press("space")
+        paused_at = player.index
+        await pilot.pause(0.2)
+        assert player.index == paused_at
+
+
+# -- large point sets ----------------------------------------------------------------
+
+
+@pilot_test
+async def test_too_many_sites_is_a_warning(monkeypatch):
+    monkeypatch.setattr(playback, "MAX_SITES", 100)
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        await pilot.pause()
+        assert app.player is None
+        assert any("fewer points" in text for text in warning_toasts(app))
+        assert not error_toasts(app)
+
+
+@pilot_test
+async def test_large_point_sets_compute_steps_in_a_worker(monkeypatch):
+    monkeypatch.setattr(playback, "THREAD_MIN_SITES", 100)
+    app = make_app()
+    seen = []
+    async with app.run_test(size=SIZE, message_hook=lambda m: seen.append(type(m).__name__)) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        assert player.threaded
+        await pilot.press(*["full_stop"] * 5, "right_square_bracket")
+        # the timeline already shows the step asked for; the picture follows
+        assert app.timeline.index == player.index == 5 + round(0.1 * player.n_steps)
+        for _ in range(20):
+            await app.workers.wait_for_complete()
+            await pilot.pause()
+            if player.step.index == player.index:
+                break
+        assert "StepReady" in seen
+        assert player.step.index == player.index
+        assert status_text(app) == expected_describe(app, player.index)
+
+
+@pilot_test
+async def test_a_new_diagram_ends_playback():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot)
+        app.query_one("#generate").press()
+        await pilot.pause()
+        assert app.player is None and not app.timeline.display
+
+
+# -- pictures ------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def fortune_case():
+    points = generate("uniform", 200, seed=4)
+    diagram = tvoronoi.voronoi(points)
+    return points, diagram, Scene.from_diagram(diagram)
+
+
+def test_fortune_picture_draws_the_sweep_state(fortune_case):
+    points, diagram, full = fortune_case
+    trace = tvoronoi.fortune_steps(points)
+    k = next(k for k in range(len(trace) // 2, len(trace)) if trace.step(k).kind == "circle"
+             and len(trace.step(k).circles))
+    step = trace.step(k)
+    scene, overlay = fortune_picture(step, points, full.colours, diagram.bbox)
+    # the sites reached and the others
+    assert len(scene.sites) + len(overlay.future) == len(points)
+    assert (scene.sites[:, 1] <= step.sweep_y).all() and (overlay.future[:, 1] >= step.sweep_y).all()
+    view = View.fit(diagram.bbox, 90, 36)
+    frame = rasterize(scene, view, 90, 36, overlay=overlay)
+    for layer in (BEACH, SWEEP, CIRCLE, FUTURE, EVENT, SITE):
+        assert (frame.mark == layer).any(), layer
+    # the fill is the finished diagram's, and only below the beach line
+    xs = np.linspace(0.05, 0.95, 50)
+    heights = beach_heights(step, points, xs)
+    assert (heights[np.isfinite(heights)] <= step.sweep_y + 1e-12).all()
+    assert (frame.fill >= 0).any() and (frame.fill < 0).any()
+    assert len(frame_lines(frame, DARK)) == 36
+
+
+def test_beach_line_passes_through_the_breakpoints(fortune_case):
+    points, _, _ = fortune_case
+    trace = tvoronoi.fortune_steps(points)
+    step = trace.step(len(trace) // 3)
+    bps = step.breakpoints[np.isfinite(step.breakpoints).all(axis=1)]
+    heights = beach_heights(step, points, bps[:, 0])
+    assert np.allclose(heights, bps[:, 1], rtol=1e-6, atol=1e-9)
+
+
+def test_circle_outlines_are_round():
+    segs = circle_segments([[1.0, 2.0, 0.5]], scale=0.01)
+    ends = segs[:, :2]
+    assert np.allclose(np.hypot(ends[:, 0] - 1.0, ends[:, 1] - 2.0), 0.5)
+    # a side is about a dot and a half long
+    assert np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]).max() <= 0.02
+
+
+def test_incremental_picture_shows_the_conflict_region(fortune_case):
+    points, diagram, full = fortune_case
+    trace = tvoronoi.incremental_steps(points, bbox=diagram.bbox)
+    step = trace.step(120)
+    assert len(step.conflict) and len(step.stolen_from)
+    scene, overlay = incremental_picture(step, points, full.colours)
+    assert len(scene.sites) == 120 and len(overlay.future) == 80
+    view = View.fit(diagram.bbox, 90, 36)
+    frame = rasterize(scene, view, 90, 36, overlay=overlay)
+    assert (frame.mark == CONFLICT).any() and (frame.mark == EVENT).any()
+    assert (frame.fill == CONFLICT_FILL).any()
+    assert ((frame.fill >= TINTED) & (frame.fill < CONFLICT_FILL)).any()
+    # neighbours in the partial diagram still differ in colour
+    a, b = cell_adjacency(step.diagram)
+    colours = np.full(len(points), -1, np.int8)
+    colours[step.inserted] = scene.colours
+    assert not (colours[a] == colours[b]).any()
+
+
+def test_the_last_incremental_step_keeps_the_final_colours(fortune_case):
+    """At the end of playback the colours are those of the diagram shown before it."""
+    points, diagram, full = fortune_case
+    trace = tvoronoi.incremental_steps(points, bbox=diagram.bbox)
+    scene, _ = incremental_picture(trace.step(len(trace)), points, full.colours)
+    assert np.array_equal(scene.colours, full.colours)
+
+
+def test_repair_colours_changes_only_clashing_cells():
+    diagram = tvoronoi.voronoi(generate("uniform", 100, seed=2))
+    a, b = cell_adjacency(diagram)
+    colours = np.zeros(100, np.int8)  # every cell the same colour
+    before = colours.copy()
+    neighbours = adjacency_lists(100, a, b)
+    repair_colours(colours, neighbours, range(100))
+    assert not (colours[a] == colours[b]).any()
+    # a valid colouring is left alone
+    again = colours.copy()
+    repair_colours(again, neighbours, range(100))
+    assert np.array_equal(again, colours)
+    assert (colours != before).any()
+
+
+# -- snapshots -----------------------------------------------------------------
+
+
+def test_snapshot_fortune_step(snap_compare):
+    """Fortune's sweep at step 352 of 882: the cells behind the beach line filled, the
+    sweep line, the beach line's arcs below it, pending circle events, growing edges
+    dashed, the new vertex highlighted, the sites not reached dimmed; the timeline
+    and the status line saying what the step did."""
+
+    async def to_step(pilot):
+        pilot.app.query_one("#engine", Select).value = "fortune"
+        await pilot.pause()
+        pilot.app.canvas.focus()
+        await pilot.press("t", *["right_square_bracket"] * 4)
+
+    assert snap_compare(make_app(), run_before=to_step, terminal_size=SIZE)
+
+
+def test_snapshot_incremental_step(snap_compare):
+    """The incremental engine after 150 insertions: the new site highlighted, its conflict
+    region (the destroyed Delaunay triangles) outlined and filled, the cells it took
+    area from tinted, the sites still to come dimmed."""
+    assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)

@@ -1,0 +1,118 @@
+"""Opening point files and saving cells from the UI; the save runs in a worker thread."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual import work
+from textual.message import Message
+from textual.widgets import ProgressBar
+
+import tvoronoi
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.tui.screens import PathDialog
+
+DEFAULT_SAVE_NAME = "cells.geojson"
+
+
+class SaveProgress(Message):
+    """Part of a save is written."""
+
+    def __init__(self, done: int, total: int) -> None:
+        super().__init__()
+        self.done = done
+        self.total = total
+
+
+class SaveFinished(Message):
+    """A save ended, well (error is None) or not."""
+
+    def __init__(self, path: Path, count: int, error: str | None) -> None:
+        super().__init__()
+        self.path = path
+        self.count = count
+        self.error = error
+
+
+class FilesMixin:
+    """The App's part that opens point files and saves the cells as GeoJSON."""
+
+    _saving = False
+
+    def action_open(self) -> None:
+        """Ask for a point file and show its diagram."""
+        self.push_screen(
+            PathDialog("Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv"),
+            self._open_path,
+        )
+
+    def _open_path(self, path: Path | None) -> None:
+        self.canvas.focus()
+        if path is None:
+            return
+        from tvoronoi.readers import read_points
+
+        self._request_build(
+            lambda: None, source=path.name, size=None, read=lambda: read_points(str(path)),
+        )
+
+    def action_save(self) -> None:
+        """Ask for a path and write the cells there as GeoJSON."""
+        if self.built is None:
+            self._fail("there is no diagram to save")
+            return
+        if self._saving:
+            self.notify("a save is still running", severity="warning")
+            return
+        self.push_screen(
+            PathDialog("Save the cells as GeoJSON", value=DEFAULT_SAVE_NAME, confirm_overwrite=True),
+            self._save_path,
+        )
+
+    def _save_path(self, path: Path | None) -> None:
+        self.canvas.focus()
+        if path is None or self.built is None:
+            return
+        try:
+            from tvoronoi.geojson import write_cells
+        except ImportError:
+            self.notify("saving GeoJSON is not available in this build", severity="error")
+            return
+        self._saving = True
+        bar = self.query_one("#progress", ProgressBar)
+        bar.update(total=None, progress=0)
+        bar.display = True
+        live, built = self.live, self.built
+        if live is None:
+            self._save_in_thread(write_cells, lambda: (built.diagram, built.point_set), path)
+        else:
+            # an edited diagram: the live sites, numbered afresh, built in the worker
+            points, engine, bbox = live.points(), built.diagram.engine, live.bbox
+            self._save_in_thread(
+                write_cells, lambda: (tvoronoi.voronoi(points, engine=engine, bbox=bbox), None), path,
+            )
+
+    @work(thread=True, group="save", exit_on_error=False)
+    def _save_in_thread(self, write_cells, what, path: Path) -> None:
+        try:
+            diagram, point_set = what()
+            count = write_cells(
+                diagram, point_set, str(path),
+                progress=lambda done, total: self.post_message(SaveProgress(done, total)),
+                overwrite=True,  # the dialog asked before replacing a file
+            )
+        except (TvoronoiError, OSError) as exc:
+            self.post_message(SaveFinished(path, 0, str(exc)))
+            return
+        self.post_message(SaveFinished(path, count, None))
+
+    def on_save_progress(self, message: SaveProgress) -> None:
+        self.query_one("#progress", ProgressBar).update(total=max(message.total, 1), progress=message.done)
+
+    def on_save_finished(self, message: SaveFinished) -> None:
+        self._saving = False
+        self.query_one("#progress").display = False
+        if message.error is not None:
+            self.notify(message.error, title="Not saved", severity="error", timeout=8, markup=False)
+        else:
+            self.notify(f"{message.count:,} cells written to {message.path}", title="Saved", markup=False)
