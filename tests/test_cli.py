@@ -17,7 +17,6 @@ import tvoronoi
 from conftest import DATASETS
 from test_geojson import check_cells_document, grown_box, hull_size, load, temp_files
 from tvoronoi import cli, geojson
-from tvoronoi.errors import EngineError
 
 ROOT = Path(__file__).resolve().parents[1]
 DUPLICATE_WARNING = (
@@ -232,17 +231,16 @@ def test_bad_bbox_names_the_value(capsys, tmp_path, points_csv, value, why):
     assert f"--bbox {value!r}" in stderr
 
 
-def test_engine_fortune_runs_or_says_not_available(capsys, tmp_path, points_csv):
-    """Until the sweepline lands the CLI must say so (exit 2); once it does, its cells must be valid."""
-    try:
-        tvoronoi.voronoi(SITES, engine="fortune")
-    except EngineError:
-        assert_error(capsys, tmp_path, points_csv, "--engine", "fortune", contains=["not available"])
-    else:
-        out = tmp_path / "cells.geojson"
-        status, _, _ = run(capsys, "batch", points_csv, "-o", out, "--engine", "fortune", "-q")
-        assert status == 0
-        check_cells_document(load(out), SITES, grown_box(SITES))
+def test_engine_fortune_writes_the_same_valid_cells(capsys, tmp_path, points_csv):
+    out = tmp_path / "cells.geojson"
+    status, _, _ = run(capsys, "batch", points_csv, "-o", out, "--engine", "fortune", "-q")
+    assert status == 0
+    doc = load(out)
+    check_cells_document(doc, SITES, grown_box(SITES))
+    ref = tmp_path / "ref.geojson"
+    assert run(capsys, "batch", points_csv, "-o", ref, "-q")[0] == 0
+    rings = [len(f["geometry"]["coordinates"][0]) for f in doc["features"]]
+    assert rings == [len(f["geometry"]["coordinates"][0]) for f in load(ref)["features"]]
 
 
 def test_unknown_engine_is_a_usage_error(capsys, tmp_path, points_csv):
