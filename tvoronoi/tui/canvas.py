@@ -63,7 +63,7 @@ class DiagramCanvas(Widget, can_focus=True):
         Binding("down,j", "pan(0, 1)", "Pan", key_display="↓", group=PAN),
         Binding("plus,equals_sign", "zoom(1)", "Zoom", key_display="+", group=ZOOM),
         Binding("minus", "zoom(-1)", "Zoom", key_display="-", group=ZOOM),
-        Binding("0", "fit", "Fit"),
+        Binding("0", "fit", "Fit", show=False),
     ]
 
     view: reactive[View] = reactive(View, always_update=False)

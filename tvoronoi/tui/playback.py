@@ -36,8 +36,8 @@ JUMP = 0.10
 
 BINDINGS = [
     Binding("t", "toggle_playback", "Playback"),
-    Binding("space", "play_pause", "Play/pause"),
-    Binding("comma", "step(-1)", "Step back", key_display=","),
+    Binding("space", "play_pause", "Play"),
+    Binding("comma", "step(-1)", "Back", key_display=","),
     Binding("full_stop", "step(1)", "Step", key_display="."),
     Binding("home", "step_to('start')", "Start", show=False),
     Binding("end", "step_to('end')", "End", show=False),
