@@ -64,7 +64,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
     cdef int32_t[::1] finite = np.empty(n_tri, np.int32)
     cdef double[:, ::1] vertices
-    cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, g
+    cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, g, merges = 0
     cdef double bx, by, cx, cy, det, bb, cc
 
     with nogil:
@@ -91,8 +91,12 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     g = find(&parent[0], t2)
                     if r != g:
                         parent[g] = r
+                        merges += 1
         # each group's vertex: the circumcentre of its best-conditioned triangle
-        for f in range(n_finite):
+        # (with no cocircular sites, simply one vertex per triangle)
+        if merges == 0:
+            m = n_finite
+        for f in range(n_finite if merges > 0 else 0):
             t = finite[f]
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             det = fabs((xs[b] - xs[a]) * (ys[c] - ys[a]) - (ys[b] - ys[a]) * (xs[c] - xs[a]))
@@ -108,10 +112,14 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     with nogil:
         for f in range(n_finite):
             t = finite[f]
-            r = find(&parent[0], t)
-            tri_vertex[t] = tri_vertex[r]
-            if best_tri[r] != t:
-                continue
+            if merges == 0:
+                r = t
+                tri_vertex[t] = f
+            else:
+                r = find(&parent[0], t)
+                tri_vertex[t] = tri_vertex[r]
+                if best_tri[r] != t:
+                    continue
             # circumcentre relative to a: exact differences keep precision at large offsets
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             bx = xs[b] - xs[a]; by = ys[b] - ys[a]
