@@ -1,7 +1,16 @@
 """Shared test data: a seeded rng and named point sets, degenerate ones included."""
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# CI replays the same examples every run (a red CI then always means a change broke something);
+# a developer's runs keep exploring new ones.
+settings.register_profile("ci", derandomize=True, deadline=None)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 from tvoronoi.generators import clustered, gaussian, uniform
 
