@@ -121,3 +121,13 @@ def test_incremental_steps_grow_one_site_at_a_time(incremental_run):
         cells = sum(len(s.diagram.cell_polygon(i)) > 0 for i in range(s.diagram.n_sites))
         assert cells == s.index
     assert "inserted at" in steps[10].describe()
+
+
+def test_incremental_trace_on_degenerate_sets():
+    for name in ("grid", "collinear", "duplicates", "circle", "two", "one"):
+        pts = DATASETS[name]
+        trace = tvoronoi.incremental_steps(pts)
+        for k in range(len(trace) + 1):
+            s = trace.step(k)
+            assert len(s.inserted) == k
+        assert_same_diagram(trace.step(len(trace)).diagram, tvoronoi.voronoi(pts))

@@ -240,24 +240,27 @@ class IncrementalTrace:
             present = np.zeros(n, bool)
             present[order[:k]] = True
             idx = np.flatnonzero(present)
-            sub = collinear_dcel(self._xs[idx], self._ys[idx]) if len(idx) else collinear_dcel(
-                self._xs[:0], self._ys[:0])
-            out = _lift(sub, idx, n)
+            out = _lift(collinear_dcel(self._xs[idx], self._ys[idx]), idx, n)
             cavity = fan = np.empty((0, 3), np.int32)
             new_site = order[k - 1] if k else -1
         d = assemble(self.points, self.bbox, self._e, self._perm, self._xs, self._ys, out,
                      engine="incremental", present=present)
-        n_inf = n
-        real = lambda tri: tri[np.all(tri != n_inf, axis=1)] if len(tri) else tri.reshape(-1, 3)  # noqa: E731
-        conflict = real(cavity)
-        stolen = np.unique(cavity[cavity != n_inf]) if len(cavity) else np.empty(0, np.int32)
-        stolen = stolen[stolen != new_site] if len(stolen) else stolen
+        # vertex n is the vertex at infinity: the finite triangles are the ones to show
+        conflict = _finite(cavity, n)
+        stolen = np.unique(cavity[cavity != n])
+        stolen = stolen[stolen != new_site]
         to_row = self._perm
         return IncrementalStep(
             index=k, n_steps=n, site=int(to_row[new_site]) if new_site >= 0 else -1,
-            conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[real(fan)].reshape(-1, 3),
+            conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[_finite(fan, n)].reshape(-1, 3),
             stolen_from=to_row[stolen], inserted=np.sort(to_row[present]), diagram=d,
         )
+
+
+def _finite(tri: np.ndarray, inf: int) -> np.ndarray:
+    """The rows of a (k, 3) triangle array that do not use the vertex at infinity."""
+    tri = tri.reshape(-1, 3)
+    return tri[np.all(tri != inf, axis=1)]
 
 
 def _lift(sub: dict, idx: np.ndarray, n: int) -> dict:
