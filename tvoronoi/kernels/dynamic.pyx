@@ -276,7 +276,7 @@ cdef class DynamicMesh:
 
 cdef inline bint ear_ok(Mesh* m, int* poly, int* nextp, int a, int b, int c) noexcept nogil:
     """Triangle (poly[a], poly[b], poly[c]) of consecutive hole vertices is Delaunay among them."""
-    cdef int va = poly[a], vb = poly[b], vc = poly[c], u, w, q, vq, o
+    cdef int va = poly[a], vb = poly[b], vc = poly[c], u = 0, w = 0, q, vq, o
     cdef bint finite = va != m.inf and vb != m.inf and vc != m.inf
     if finite:
         if orient2d(m.x[va], m.y[va], m.x[vb], m.y[vb], m.x[vc], m.y[vc]) <= 0:
