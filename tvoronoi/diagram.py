@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -60,7 +60,6 @@ class Diagram:
     cell_offsets: np.ndarray
     cell_vertices: np.ndarray
     engine: str = "incremental"
-    _extra: dict = field(default_factory=dict, repr=False)
 
     @property
     def n_sites(self) -> int:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import errno
-import gc
 import os
 import secrets
 import stat
@@ -14,6 +13,7 @@ from typing import BinaryIO, Callable, Iterator
 import numpy as np
 import orjson
 
+from tvoronoi.bulk import gc_paused
 from tvoronoi.errors import TvoronoiError
 
 __all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT"]
@@ -174,19 +174,6 @@ def open_output(out, *, overwrite: bool = True) -> Iterator[BinaryIO]:
         target.discard()
         raise
     target.commit()
-
-
-@contextmanager
-def _gc_paused():
-    """Pause the cyclic garbage collector: a chunk's many small objects hold no cycles,
-    and collecting them over and over would cost more than the serialization."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 # ---------------------------------------------------------------------------
@@ -364,7 +351,7 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
     total = int(distinct.sum())
     done = 0
-    with open_output(out, overwrite=overwrite) as stream, _gc_paused():
+    with open_output(out, overwrite=overwrite) as stream, gc_paused():
         bbox = _bbox_member(diagram.bbox) if has_ring.any() else b""
         stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
         if progress is not None:
@@ -409,7 +396,7 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
     """
     triangles = np.asarray(diagram.triangles, dtype=np.int64).reshape(-1, 3)
     total = len(triangles)
-    with open_output(out, overwrite=overwrite) as stream, _gc_paused():
+    with open_output(out, overwrite=overwrite) as stream, gc_paused():
         bbox = b""
         if total:
             used = np.zeros(diagram.n_sites, bool)

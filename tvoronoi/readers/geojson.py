@@ -7,7 +7,9 @@ import math
 import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
-from .pointset import PointSet, _gc_paused
+from tvoronoi.bulk import gc_paused
+
+from .pointset import PointSet
 
 GEOMETRY_TYPES = (
     "Point",
@@ -153,7 +155,7 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
     if not data.strip():
         raise InputFileError(f"{source}: no points found (the file is empty)")
     # a million features are a million dicts: the collector would walk them again and again
-    with _gc_paused():
+    with gc_paused():
         doc = loads(data, source)
         sites = None
         if type(doc) is dict and doc.get("type") == "FeatureCollection" and type(doc.get("features")) is list:

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import gc
 import math
 import re
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -74,19 +72,6 @@ class PointSet:
         if self.records is not None:
             return dict(self.records[i])
         return {name: values[i] for name, values in self.columns.items()}
-
-
-@contextmanager
-def _gc_paused():
-    """Pause the cyclic garbage collector: building a million small row lists otherwise
-    triggers it over and over, for nothing (rows hold no cycles)."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 # ---------------------------------------------------------------------------

@@ -14,7 +14,9 @@ import numpy as np
 
 from ..errors import InputFileError
 from .columns import X_NAMES, Y_NAMES, _as_index, _check_distinct, _col_name, _resolve_column
-from .pointset import PointSet, _convert_column, _gc_paused
+from tvoronoi.bulk import gc_paused
+
+from .pointset import PointSet, _convert_column
 
 LAYOUT_CHARS = 1 << 16
 QUOTE = '"'
@@ -220,7 +222,7 @@ def _fast_table(body: str, kind: str, layout: _Layout):
             return None
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
-    with _gc_paused():
+    with gc_paused():
         if kind == "csv":
             rows = list(csv.reader(io.StringIO(body, newline="")))
         else:
@@ -254,7 +256,7 @@ def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
         next(records)
     line_nos: list[int] = []
     rows: list[list[str]] = []
-    with _gc_paused():
+    with gc_paused():
         for line_no, fields in records:
             if len(fields) != n_cols:
                 # a field spanning lines is quoted: an unclosed quote swallows the lines after it
