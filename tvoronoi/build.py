@@ -10,14 +10,36 @@ from tvoronoi.diagram import Diagram
 from tvoronoi.kernels import clip, dcel, delaunay, fortune
 
 
-def power_of_two_scale(pts: np.ndarray, box) -> int:
-    """Exponent e such that coordinates * 2**-e are at most 1 in magnitude.
+def power_of_two_scale(pts: np.ndarray, box=None) -> int:
+    """Exponent e such that the sites' coordinates * 2**-e are at most 1 in magnitude.
 
     Scaling by a power of two is exact, and keeps the predicates' products
     (degree four in incircle) far from overflow and underflow at any scale.
+    Only the sites set it: the box enters the exact tests linearly (see
+    check_box_scale), so a box far larger than the sites costs no precision.
     """
-    top = max(float(np.abs(pts).max()) if len(pts) else 0.0, *(abs(v) for v in box))
+    top = float(np.abs(pts).max()) if len(pts) else 0.0
     return math.frexp(top)[1] if top > 0 else 0
+
+
+# Box sides in the sites' scaled unit: a product with a coordinate difference (down to 2^-223 in that
+# unit) must neither underflow nor, doubled, overflow.
+BOX_SCALED_MIN = 2.0 ** -700
+BOX_SCALED_MAX = 2.0 ** 1000
+
+
+def check_box_scale(box, e: int) -> None:
+    """Refuse a box whose sides the exact tests could not handle in the sites' scaled unit."""
+    from tvoronoi.errors import TvoronoiError
+
+    for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
+        s = abs(math.ldexp(v, -e))
+        if s != 0.0 and not (BOX_SCALED_MIN <= s <= BOX_SCALED_MAX):
+            raise TvoronoiError(
+                f"bbox {name} = {v!r} is beyond the exact range for these sites (their largest "
+                f"coordinate is about 2^{e}): a box side may be at most 2^1000 and, if not 0, at least "
+                f"2^-700 times that; choose a box nearer the sites' scale"
+            )
 
 
 def first_copies(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
@@ -51,12 +73,12 @@ def collinear_dcel(xs: np.ndarray, ys: np.ndarray) -> dict:
     return out
 
 
-def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: int):
+def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: int, exponent: int = 0):
     """Run the randomized incremental engine on sites in input order.
 
     Returns (perm, out): the engine numbers site k = input site perm[k]
     (insertion order), and out holds its Voronoi DCEL and repeats in that
-    numbering.
+    numbering; its vertices are in the unit 2^exponent times that of xs, ys.
     """
     n = len(xs)
     rng = np.random.default_rng(seed)
@@ -70,7 +92,7 @@ def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: in
     status, tv, opp, dup = delaunay.triangulate(xs, ys, conflict_lists=(insertion == "random"))
     if status != delaunay.STATUS_OK:
         return perm, xs, ys, collinear_dcel(xs, ys)
-    out = dcel.voronoi_from_delaunay(xs, ys, tv, opp)
+    out = dcel.voronoi_from_delaunay(xs, ys, tv, opp, exponent)
     out["dup"] = dup
     return perm, xs, ys, out
 
@@ -85,7 +107,7 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return perm.astype(np.int32)
 
 
-def fortune_dcel(xs: np.ndarray, ys: np.ndarray):
+def fortune_dcel(xs: np.ndarray, ys: np.ndarray, exponent: int = 0):
     """Run Fortune's sweep on sites in input order; returns (perm, xs, ys, out) as incremental_dcel."""
     perm = sweep_order(xs, ys)
     xs = np.ascontiguousarray(xs[perm])
@@ -93,20 +115,21 @@ def fortune_dcel(xs: np.ndarray, ys: np.ndarray):
     result = fortune.sweep(xs, ys)
     if "tv" not in result:
         return perm, xs, ys, collinear_dcel(xs, ys)
-    out = dcel.voronoi_from_delaunay(xs, ys, result["tv"], result["opp"])
+    out = dcel.voronoi_from_delaunay(xs, ys, result["tv"], result["opp"], exponent)
     out["dup"] = result["dup"]
     return perm, xs, ys, out
 
 
 def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int) -> Diagram:
     """Build the Diagram of checked points (n, 2) in the checked box."""
-    e = power_of_two_scale(pts, box)
+    e = power_of_two_scale(pts)
+    check_box_scale(box, e)
     xs = np.ldexp(pts[:, 0], -e)
     ys = np.ldexp(pts[:, 1], -e)
     if engine == "incremental":
-        perm, exs, eys, out = incremental_dcel(xs, ys, insertion=insertion, seed=seed)
+        perm, exs, eys, out = incremental_dcel(xs, ys, insertion=insertion, seed=seed, exponent=e)
     else:
-        perm, exs, eys, out = fortune_dcel(xs, ys)
+        perm, exs, eys, out = fortune_dcel(xs, ys, exponent=e)
     return assemble(pts, box, e, perm, exs, eys, out, engine=engine)
 
 
@@ -116,6 +139,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     Parameters
     ----------
     pts : (n, 2) the input points; box : the box, unscaled; e : the scale exponent
+        (the vertices in ``out`` are already in the user's unit)
     perm : (n,) engine site k is input row perm[k]; exs, eys : scaled sites in engine order
     out : the engine's DCEL dict (with ``dup``)
     present : (n,) bool in engine order, optional -- sites already in the
@@ -126,13 +150,16 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
         (dynamic diagrams, where the oldest copy at a place holds it).
     """
     n = len(pts)
-    sbox = tuple(math.ldexp(v, -e) for v in box)
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
-    points, offsets, ring = clip.clip_cells(
-        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"],
-        out["he_face"], out["face_edge"], first.astype(np.int8), sbox,
+    points, offsets, ring, _n_reflex, status = clip.clip_cells(
+        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
+        out["he_face"], out["face_edge"], first.astype(np.int8), box, e,
     )
+    if status != 0:
+        from tvoronoi.errors import EngineError
+
+        raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
 
     # the cell of a repeated point belongs to the first input row at that place
     root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
@@ -159,7 +186,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     return Diagram(
         sites=pts,
         site_of=site_of,
-        vertices=np.ldexp(out["vertices"], e),
+        vertices=out["vertices"],
         he_origin=out["he_origin"],
         he_twin=out["he_twin"],
         he_next=out["he_next"],
@@ -168,7 +195,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
         face_edge=face_edge,
         triangles=owner[out["triangles"]].astype(np.int32).reshape(-1, 3),
         bbox=tuple(float(v) for v in box),
-        cell_points=np.ldexp(points, e),
+        cell_points=points,
         cell_offsets=cell_offsets,
         cell_vertices=cell_vertices,
         engine=engine,

@@ -312,7 +312,7 @@ class DynamicDiagram:
         if o._mesh is not None:
             tv, opp = o._mesh.export()
             tv = np.where(tv == dynamic.INFINITE, n, tv).astype(np.int32)
-            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp)
+            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp, 0)
         else:
             holders = o._holders()
             sub = collinear_dcel(xs[holders], ys[holders])

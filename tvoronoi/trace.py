@@ -55,12 +55,13 @@ def breakpoint_xy(a, b, sweep_y):
 
 
 def circumcentres(p, q, r):
-    """Circumcentres of triangles (p, q, r), each a (k, 2) array."""
-    bx, by = (q - p).T
-    cx, cy = (r - p).T
-    det = 2.0 * (bx * cy - by * cx)
-    bb, cc = bx * bx + by * by, cx * cx + cy * cy
-    return np.column_stack((p[:, 0] + (cy * bb - by * cc) / det, p[:, 1] + (bx * cc - cx * bb) / det))
+    """Circumcentres of triangles (p, q, r), each a (k, 2) array, correctly rounded (the kernels' construction)."""
+    p, q, r = (np.asarray(a, np.float64).reshape(-1, 2) for a in (p, q, r))
+    k = len(p)
+    xs = np.ascontiguousarray(np.concatenate((p[:, 0], q[:, 0], r[:, 0])))
+    ys = np.ascontiguousarray(np.concatenate((p[:, 1], q[:, 1], r[:, 1])))
+    tri = np.ascontiguousarray(np.arange(3 * k, dtype=np.int32).reshape(3, k).T)
+    return dcel.circumcentres(xs, ys, tri, 0)
 
 
 @dataclass(frozen=True)
@@ -229,7 +230,7 @@ class IncrementalTrace:
             order = trace["order"]
             present = np.zeros(n, bool)
             present[order[:k]] = True
-            out = dcel.voronoi_from_delaunay(self._xs, self._ys, tv, opp)
+            out = dcel.voronoi_from_delaunay(self._xs, self._ys, tv, opp, self._e)
             out["dup"] = dup
             cavity = trace["cavity"] if k > 3 else np.empty((0, 3), np.int32)
             fan = tv.reshape(-1, 3)[trace["fan"]] if k > 3 else tv.reshape(-1, 3)[:1]

@@ -1,29 +1,35 @@
-"""Bounded cells: the Voronoi DCEL clipped to a box, as counter-clockwise rings."""
+"""Bounded cells: the Voronoi DCEL clipped to a box, as counter-clockwise rings (the batch driver of clipper.pxd)."""
 
 import numpy as np
 
 from libc.stdint cimport int32_t, int64_t
-from tvoronoi.kernels.cliplib cimport Box, make_box, on_box, clip_bisector, snap_inside, angular_ring
-from tvoronoi.kernels.distance cimport closer
+from tvoronoi.kernels.clipper cimport (
+    Box, EdgePart, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell, finish_ring,
+)
+from tvoronoi.kernels.predicates cimport orient2d
 
 cdef enum:
-    MAX_RING = 4096     # points of one clipped cell before it is sorted
+    HAS = 1
+    ENTRY = 2
+    EXIT = 4
 
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
                const int32_t[::1] he_origin, const int32_t[::1] he_twin,
-               const int32_t[::1] he_next, const int32_t[::1] he_face,
-               const int32_t[::1] face_edge, const signed char[::1] active, box_tuple):
-    """Clip every cell to the box (xmin, ymin, xmax, ymax).
+               const int32_t[::1] he_next, const int32_t[::1] he_prev, const int32_t[::1] he_face,
+               const int32_t[::1] face_edge, const signed char[::1] active, box_tuple, int e):
+    """Clip every cell to the box (xmin, ymin, xmax, ymax), exactly.
 
-    Each edge is clipped once, so neighbouring cells share bit-identical
-    points; box corners go to the cell that owns them (the nearest site).
+    Each edge is clipped once, so neighbouring cells share their points;
+    every point is an input-exact corner or a correctly rounded construction.
 
     Parameters
     ----------
-    xs, ys : (n,) float64, the sites; vertices : (m, 2) float64
+    xs, ys : (n,) float64, the sites in the scaled unit (user = 2^e * scaled)
+    vertices : (m, 2) float64, the Voronoi vertices, correctly rounded, user unit
     he_* : (h,) int32, the Voronoi DCEL; face_edge : (n,) int32
     active : (n,) int8, 0 for a site without a cell of its own (a repeat)
+    box_tuple : the box, user unit; e : the scale exponent
 
     Returns
     -------
@@ -31,151 +37,154 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         on the box, then the four corners.
     offsets : (n + 1,) int64, ring : (K,) int32 -- cell i is
         points[ring[offsets[i]:offsets[i + 1]]], counter-clockwise, not
-        closed; empty when the cell misses the box.
+        closed, starting at its lowest point; empty when the cell misses the box.
+    n_reflex : int, the number of rings with a right turn after rounding (0 unless
+        an edge is shorter than the rounding).
+    status : int, 0, or 1 if the edges of some cell did not chain (never on a valid DCEL).
     """
     xmin, ymin, xmax, ymax = [float(side) for side in box_tuple]
-    cdef Box box = make_box(xmin, ymin, xmax, ymax)
+    cdef Box box = make_box(xmin, ymin, xmax, ymax, e)
     cdef int n = xs.shape[0], m = vertices.shape[0], n_he = he_origin.shape[0]
     cdef int cap = m + 2 * n_he + 4
     cdef double[:, ::1] pts = np.empty((cap, 2), np.float64)
+    cdef signed char[::1] pt_side = np.full(cap, -1, np.int8)
+    cdef signed char[::1] vcx = np.zeros(max(m, 1), np.int8)
+    cdef signed char[::1] vcy = np.zeros(max(m, 1), np.int8)
+    cdef signed char[::1] tie = np.zeros(max(m, 1), np.int8)
     cdef int32_t[::1] seg_start = np.full(n_he, -1, np.int32)
     cdef int32_t[::1] seg_end = np.full(n_he, -1, np.int32)
+    cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
-    cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n, np.int32)
-    cdef signed char[::1] inside = np.zeros(max(m, 1), np.int8)
-    cdef int n_pts = m, corner0, h, tw, o, d, a, b, v, i, k, count, j
+    cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n + 4, np.int32)
+    counts = np.bincount(np.asarray(he_face), minlength=n) if n_he else np.zeros(max(n, 1), np.int64)
+    cdef int max_deg = int(counts.max()) if len(counts) else 0
+    cdef int32_t[::1] c_start = np.empty(max_deg + 1, np.int32)
+    cdef int32_t[::1] c_end = np.empty(max_deg + 1, np.int32)
+    cdef signed char[::1] c_entry = np.empty(max_deg + 1, np.int8)
+    cdef signed char[::1] c_exit = np.empty(max_deg + 1, np.int8)
+    cdef signed char[::1] c_has = np.empty(max_deg + 1, np.int8)
+    cdef double[::1] nbx = np.empty(max_deg + 1, np.float64)
+    cdef double[::1] nby = np.empty(max_deg + 1, np.float64)
+    cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, n_reflex = 0, status = 0
     cdef int64_t n_ring = 0
-    cdef double bx, by, dx, dy, t0, t1, x, y
-    cdef bint fast, owned
-    cdef int buf[MAX_RING]
-    cdef double ang[MAX_RING]
-    cdef double px[MAX_RING]
-    cdef double py[MAX_RING]
-    cdef double corner_x[4]
-    cdef double corner_y[4]
-    corner_x[:] = [box.xmin, box.xmax, box.xmax, box.xmin]
-    corner_y[:] = [box.ymin, box.ymin, box.ymax, box.ymax]
+    cdef double x, y
+    cdef EdgePart part
+    cdef bint has_o, has_d
 
     with nogil:
+        # vertices against the box: rounded comparisons, exact where a coordinate equals a side
         for v in range(m):
-            # a vertex within rounding of the box counts as inside, put exactly on its edge,
-            # so that no sliver of an edge (or a near-copy of the vertex) is left on the boundary
             x = vertices[v, 0]
             y = vertices[v, 1]
-            inside[v] = snap_inside(&box, &x, &y)
             pts[v, 0] = x
             pts[v, 1] = y
+            if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
+                tie[v] = 1
+            else:
+                vcx[v] = -2 if x < box.xmin else (2 if x > box.xmax else 0)
+                vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
+        for h in range(n_he):
+            v = he_origin[h]
+            if v < 0 or not tie[v]:
+                continue
+            tie[v] = 0
+            # the vertex is the circumcentre of the three cells around it
+            a = he_face[h]
+            b = he_face[he_twin[h]]
+            c = he_face[he_twin[he_prev[h]]]
+            vcx[v] = axis_code(vertices[v, 0], box.xmin, box.xmax, box.sxmin, box.sxmax,
+                               xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], False)
+            vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
+                               xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
+        for v in range(m):
+            if code_in(vcx[v]) and code_in(vcy[v]):
+                pt_side[v] = code_side(vcx[v], vcy[v])
 
-        # clip each edge once, along the half-edge of smaller index
+        # clip each edge once, along the half-edge of smaller index; its twin runs the other way
         for h in range(n_he):
             tw = he_twin[h]
             if tw < h:
                 continue
             o = he_origin[h]
             d = he_origin[tw]
-            if o >= 0 and d >= 0 and inside[o] and inside[d]:
-                seg_start[h] = o
-                seg_end[h] = d
-                seg_start[tw] = d
-                seg_end[tw] = o
-                continue
+            has_o = o >= 0
+            has_d = d >= 0
             a = he_face[h]
             b = he_face[tw]
-            if not clip_bisector(&box, xs[a], ys[a], xs[b], ys[b],
-                                 pts[o, 0] if o >= 0 else 0.0, pts[o, 1] if o >= 0 else 0.0, o >= 0,
-                                 pts[d, 0] if d >= 0 else 0.0, pts[d, 1] if d >= 0 else 0.0, d >= 0,
-                                 &bx, &by, &dx, &dy, &t0, &t1):
+            clip_edge(&box, xs[a], ys[a], xs[b], ys[b],
+                      has_o, vcx[o] if has_o else 0, vcy[o] if has_o else 0,
+                      has_d, vcx[d] if has_d else 0, vcy[d] if has_d else 0, &part)
+            if not part.has:
                 continue
-            # an end inside the box is the vertex itself, shared with its other edges
-            if o >= 0 and inside[o]:
-                seg_start[h] = o
-            else:
-                x = bx + t0 * dx; y = by + t0 * dy
-                on_box(&box, &x, &y)
-                pts[n_pts, 0] = x; pts[n_pts, 1] = y
+            if part.start_at == AT_POINT:
+                pts[n_pts, 0] = part.sx; pts[n_pts, 1] = part.sy
+                pt_side[n_pts] = part.s_side
                 seg_start[h] = n_pts
                 n_pts += 1
-            if d >= 0 and inside[d]:
-                seg_end[h] = d
             else:
-                x = bx + t1 * dx; y = by + t1 * dy
-                on_box(&box, &x, &y)
-                pts[n_pts, 0] = x; pts[n_pts, 1] = y
+                seg_start[h] = o if part.start_at == AT_ORIGIN else d
+            if part.end_at == AT_POINT:
+                pts[n_pts, 0] = part.ex; pts[n_pts, 1] = part.ey
+                pt_side[n_pts] = part.e_side
                 seg_end[h] = n_pts
                 n_pts += 1
+            else:
+                seg_end[h] = o if part.end_at == AT_ORIGIN else d
+            flags[h] = HAS | (ENTRY if part.entry else 0) | (EXIT if part.exit else 0)
             seg_start[tw] = seg_end[h]
             seg_end[tw] = seg_start[h]
+            flags[tw] = HAS | (ENTRY if part.exit else 0) | (EXIT if part.entry else 0)
 
         corner0 = n_pts
         for k in range(4):
-            pts[corner0 + k, 0] = corner_x[k]
-            pts[corner0 + k, 1] = corner_y[k]
+            pts[corner0 + k, 0] = box.kx[k]
+            pts[corner0 + k, 1] = box.ky[k]
+            pt_side[corner0 + k] = k
         n_pts += 4
 
+        # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries
         for i in range(n):
             offsets[i] = n_ring
             if not active[i]:
                 continue
             h = face_edge[i]
-            # an interior cell: its own vertices, already in order
-            fast = h >= 0
-            if fast:
-                while True:
-                    o = he_origin[h]
-                    if o < 0 or not inside[o]:
-                        fast = False
-                        break
-                    h = he_next[h]
-                    if h == face_edge[i]:
-                        break
-            if fast:
-                while True:
-                    ring[n_ring] = he_origin[h]
-                    n_ring += 1
-                    h = he_next[h]
-                    if h == face_edge[i]:
-                        break
-                continue
-
-            # a cell that meets the box edge: the clipped edge points and the
-            # corners it owns, in angular order about their centroid
-            count = 0
-            h = face_edge[i]
-            while h >= 0 and count + 2 <= MAX_RING - 4:
-                if seg_start[h] >= 0:
-                    buf[count] = seg_start[h]
-                    buf[count + 1] = seg_end[h]
-                    count += 2
+            cnt = 0
+            while h >= 0:
+                c_start[cnt] = seg_start[h]
+                c_end[cnt] = seg_end[h]
+                c_has[cnt] = (flags[h] & HAS) != 0
+                c_entry[cnt] = (flags[h] & ENTRY) != 0
+                c_exit[cnt] = (flags[h] & EXIT) != 0
+                b = he_face[he_twin[h]]
+                nbx[cnt] = xs[b]
+                nby[cnt] = ys[b]
+                cnt += 1
                 h = he_next[h]
                 if h == face_edge[i]:
                     break
-            for k in range(4):
-                # the corner is the cell's if no neighbour's site is strictly nearer (exact)
-                owned = True
-                h = face_edge[i]
-                while h >= 0:
-                    j = he_face[he_twin[h]]
-                    if closer(corner_x[k], corner_y[k], xs[i], ys[i], xs[j], ys[j]) > 0:
-                        owned = False
-                        break
-                    h = he_next[h]
-                    if h == face_edge[i]:
-                        break
-                if owned:
-                    buf[count] = corner0 + k
-                    count += 1
-            if count < 3:
+            k = walk_cell(&box, cnt, &c_start[0], &c_end[0], &c_entry[0], &c_exit[0], &c_has[0],
+                          &pts[0, 0], &pt_side[0], corner0, xs[i], ys[i], &nbx[0], &nby[0], &ring[n_ring])
+            if k < 0:
+                status = 1
                 continue
-            for k in range(count):
-                px[k] = pts[buf[k], 0]
-                py[k] = pts[buf[k], 1]
-            j = angular_ring(px, py, buf, ang, count)
-            if j < 3:
-                continue
-            for k in range(j):
-                ring[n_ring] = buf[k]
-                n_ring += 1
+            k = finish_ring(&ring[n_ring], k, &pts[0, 0])
+            if k > 0 and not convex_ring(&ring[n_ring], k, &pts[0, 0]):
+                n_reflex += 1
+            n_ring += k
         offsets[n] = n_ring
 
     return (np.asarray(pts)[:n_pts].copy(), np.asarray(offsets),
-            np.asarray(ring)[:n_ring].copy())
+            np.asarray(ring)[:n_ring].copy(), n_reflex, status)
+
+
+cdef bint convex_ring(const int32_t* ring, int k, const double* pts) noexcept nogil:
+    # no right turn anywhere (exact)
+    cdef int q, p0, p1, p2
+    for q in range(k):
+        p0 = ring[q]
+        p1 = ring[(q + 1) % k]
+        p2 = ring[(q + 2) % k]
+        if orient2d(pts[2 * p0], pts[2 * p0 + 1], pts[2 * p1], pts[2 * p1 + 1],
+                    pts[2 * p2], pts[2 * p2 + 1]) < 0:
+            return False
+    return True

@@ -3,8 +3,8 @@
 import numpy as np
 
 from libc.stdint cimport int32_t
-from libc.math cimport fabs
 
+from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 
@@ -30,7 +30,7 @@ cdef int find(int32_t* parent, int t) noexcept nogil:
 
 
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
-                          const int32_t[::1] tv, const int32_t[::1] opp):
+                          const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -41,6 +41,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     xs, ys : (n,) float64, the sites.
     tv, opp : (3 * n_tri,) int32, the triangulation of delaunay.triangulate
         (vertex n is the vertex at infinity).
+    exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
+        returned in the user's unit, each coordinate correctly rounded.
 
     Returns
     -------
@@ -52,8 +54,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int n_he_d = tv.shape[0], n_tri = n_he_d // 3
     cdef int32_t[::1] parent = np.empty(n_tri, np.int32)
     cdef int32_t[::1] tri_vertex = np.full(n_tri, -1, np.int32)
-    cdef double[::1] best_det = np.zeros(n_tri, np.float64)
-    cdef int32_t[::1] best_tri = np.full(n_tri, -1, np.int32)
+    cdef int32_t[::1] group_tri = np.full(n_tri, -1, np.int32)
     cdef int32_t[::1] vor = np.full(n_he_d, -1, np.int32)      # Delaunay half-edge -> Voronoi half-edge
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
@@ -65,7 +66,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] finite = np.empty(n_tri, np.int32)
     cdef double[:, ::1] vertices
     cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, g, merges = 0
-    cdef double bx, by, cx, cy, det, bb, cc
+    cdef double vx, vy
 
     with nogil:
         # merge the triangles of each cocircular group into one Voronoi vertex
@@ -92,22 +93,17 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     if r != g:
                         parent[g] = r
                         merges += 1
-        # each group's vertex: the circumcentre of its best-conditioned triangle
-        # (with no cocircular sites, simply one vertex per triangle)
+        # each group's vertex: the circumcentre of one of its triangles (all give the same exact
+        # point, hence the same correctly rounded one); with no cocircular sites, one per triangle
         if merges == 0:
             m = n_finite
         for f in range(n_finite if merges > 0 else 0):
             t = finite[f]
-            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            det = fabs((xs[b] - xs[a]) * (ys[c] - ys[a]) - (ys[b] - ys[a]) * (xs[c] - xs[a]))
             r = find(&parent[0], t)
             if tri_vertex[r] == -1:
                 tri_vertex[r] = m
                 m += 1
-                best_det[r] = -1.0
-            if det > best_det[r]:
-                best_det[r] = det
-                best_tri[r] = t
+                group_tri[r] = t
     vertices = np.empty((m, 2), np.float64)
     with nogil:
         for f in range(n_finite):
@@ -118,17 +114,12 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             else:
                 r = find(&parent[0], t)
                 tri_vertex[t] = tri_vertex[r]
-                if best_tri[r] != t:
+                if group_tri[r] != t:
                     continue
-            # circumcentre relative to a: exact differences keep precision at large offsets
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            bx = xs[b] - xs[a]; by = ys[b] - ys[a]
-            cx = xs[c] - xs[a]; cy = ys[c] - ys[a]
-            det = 2.0 * (bx * cy - by * cx)
-            bb = bx * bx + by * by
-            cc = cx * cx + cy * cy
-            vertices[tri_vertex[r], 0] = xs[a] + (cy * bb - by * cc) / det
-            vertices[tri_vertex[r], 1] = ys[a] + (bx * cc - cx * bb) / det
+            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &vx, &vy)
+            vertices[tri_vertex[r], 0] = vx
+            vertices[tri_vertex[r], 1] = vy
 
         # one Voronoi half-edge per Delaunay half-edge between two sites,
         # unless both sides share a vertex (a zero-length edge)
@@ -168,6 +159,18 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         "face_edge": np.asarray(face_edge),
         "triangles": np.ascontiguousarray(tri, dtype=np.int32),
     }
+
+
+def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0):
+    """Correctly rounded circumcentres (k, 2) of triangles tri (k, 3) of sites xs, ys, times 2^e."""
+    cdef Py_ssize_t k, n_tri = tri.shape[0]
+    cdef double[:, ::1] out = np.empty((n_tri, 2), np.float64)
+    cdef int a, b, c
+    with nogil:
+        for k in range(n_tri):
+            a = tri[k, 0]; b = tri[k, 1]; c = tri[k, 2]
+            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], e, &out[k, 0], &out[k, 1])
+    return np.asarray(out)
 
 
 def voronoi_collinear(const double[::1] xs, const double[::1] ys):

@@ -1,0 +1,399 @@
+# The one clipper of Voronoi cells to a box, shared by the batch clip (clip.pyx) and dynamic diagrams
+# (dynamic.pyx); inline functions compiled into each kernel that cimports them.
+#
+# Every decision is exact: which side of a box side a Voronoi vertex lies on (its correctly rounded
+# coordinate compared with the side, the exact test on a tie), where a bisector enters and leaves the
+# box (the signs of its sites' distances to the four corners), and which box corners a cell walks past
+# (the order of points along the box boundary). The points written are Voronoi vertices, crossings of
+# bisectors with the box sides (both correctly rounded, tvoronoi.kernels.construct) and the corners.
+#
+#        K3 ---- side 2 ---- K2        corners K0..K3 counter-clockwise; side k runs from Kk to K(k+1);
+#        |                    |        a point on the boundary has a position (side, t), t growing
+#      side 3              side 1      counter-clockwise (x on side 0, y on 1, -x on 2, -y on 3);
+#        |                    |        a corner Kk is the start of side k
+#        K0 ---- side 0 ---- K1
+#
+# A cell is walked counter-clockwise: each Voronoi edge contributes its part inside the box; where the
+# boundary of the cell leaves the box (an exit) and comes back (the next entry), the ring follows the
+# box boundary from the one to the other, through the corners between them.
+
+from libc.math cimport ldexp
+from libc.stdint cimport int32_t
+
+from tvoronoi.kernels.construct cimport bisector_at, bisector_side, circumcentre_side
+from tvoronoi.kernels.predicates cimport orient2d
+
+cdef struct Box:
+    double xmin, ymin, xmax, ymax            # the user's unit
+    double sxmin, symin, sxmax, symax        # the sites' scaled unit (exact: 2^-e times the above)
+    int e
+    double kx[4]                             # corners, user unit
+    double ky[4]
+    double skx[4]                            # corners, scaled unit
+    double sky[4]
+
+
+cdef inline Box make_box(double xmin, double ymin, double xmax, double ymax, int e) noexcept nogil:
+    cdef Box b
+    cdef double sx0, sx1, sy0, sy1
+    b.xmin = xmin; b.ymin = ymin; b.xmax = xmax; b.ymax = ymax; b.e = e
+    sx0 = ldexp(xmin, -e); sy0 = ldexp(ymin, -e); sx1 = ldexp(xmax, -e); sy1 = ldexp(ymax, -e)
+    b.sxmin = sx0; b.symin = sy0; b.sxmax = sx1; b.symax = sy1
+    b.kx[0] = xmin; b.ky[0] = ymin; b.kx[1] = xmax; b.ky[1] = ymin
+    b.kx[2] = xmax; b.ky[2] = ymax; b.kx[3] = xmin; b.ky[3] = ymax
+    b.skx[0] = sx0; b.sky[0] = sy0; b.skx[1] = sx1; b.sky[1] = sy0
+    b.skx[2] = sx1; b.sky[2] = sy1; b.skx[3] = sx0; b.sky[3] = sy1
+    return b
+
+
+# ---------------------------------------------------------------------------------------------------------
+# vertices against the box: per axis a code -2 (below the min side), -1 (exactly on it), 0 (strictly
+# between), 1 (exactly on the max side), 2 (above it)
+
+cdef inline signed char axis_code(double v, double lo, double hi, double slo, double shi,
+                                  double ax, double ay, double bx, double by, double cx, double cy,
+                                  bint along_y) noexcept nogil:
+    # v is the correctly rounded coordinate of the circumcentre of a, b, c (scaled sites)
+    cdef int s
+    if v < lo:
+        return -2
+    if v > hi:
+        return 2
+    if v == lo:
+        s = circumcentre_side(ax, ay, bx, by, cx, cy, slo, along_y)
+        return -2 if s < 0 else (-1 if s == 0 else 0)
+    if v == hi:
+        s = circumcentre_side(ax, ay, bx, by, cx, cy, shi, along_y)
+        return 2 if s > 0 else (1 if s == 0 else 0)
+    return 0
+
+
+cdef inline bint code_in(signed char c) noexcept nogil:
+    return -1 <= c <= 1
+
+
+cdef inline int code_side(signed char cx, signed char cy) noexcept nogil:
+    """The boundary side of a point in the box from its codes (a corner: the side it starts), or -1."""
+    if cy == -1:
+        return 1 if cx == 1 else 0
+    if cx == 1:
+        return 2 if cy == 1 else 1
+    if cy == 1:
+        return 3 if cx == -1 else 2
+    if cx == -1:
+        return 3
+    return -1
+
+
+cdef inline double boundary_t(int side, double x, double y) noexcept nogil:
+    if side == 0:
+        return x
+    if side == 1:
+        return y
+    if side == 2:
+        return -x
+    return -y
+
+
+# ---------------------------------------------------------------------------------------------------------
+# one Voronoi edge: the part inside the box
+
+cdef enum:
+    AT_ORIGIN = 0         # a part's start or end is the edge's origin vertex,
+    AT_END = 1            # its end vertex,
+    AT_POINT = 2          # or a new point on the box boundary
+
+cdef struct EdgePart:
+    bint has              # some part of the edge lies in the box
+    int start_at          # AT_ORIGIN, AT_END or AT_POINT (then sx, sy)
+    int end_at            # likewise (then ex, ey)
+    bint entry            # the start comes in from the box boundary
+    bint exit             # the end leaves along the box boundary
+    double sx, sy, ex, ey
+    int s_side, e_side    # boundary side of the start (when entry) and of the end (when exit)
+
+
+cdef inline void boundary_point(Box* b, double ix, double iy, double jx, double jy, int side,
+                                bint at_corner, double* x, double* y) noexcept nogil:
+    # where the bisector of i and j meets side `side` (or the corner that starts it), user unit
+    if at_corner:
+        x[0] = b.kx[side]
+        y[0] = b.ky[side]
+    elif side == 0:
+        x[0] = bisector_at(ix, iy, jx, jy, b.symin, True, b.e); y[0] = b.ymin
+    elif side == 1:
+        x[0] = b.xmax; y[0] = bisector_at(ix, iy, jx, jy, b.sxmax, False, b.e)
+    elif side == 2:
+        x[0] = bisector_at(ix, iy, jx, jy, b.symax, True, b.e); y[0] = b.ymax
+    else:
+        x[0] = b.xmin; y[0] = bisector_at(ix, iy, jx, jy, b.sxmin, False, b.e)
+    # the exact crossing is on the side, so its rounding is too; this only guards the bounds
+    if x[0] < b.xmin: x[0] = b.xmin
+    if x[0] > b.xmax: x[0] = b.xmax
+    if y[0] < b.ymin: y[0] = b.ymin
+    if y[0] > b.ymax: y[0] = b.ymax
+
+
+cdef inline bint before_box(signed char cx, signed char cy, int sdx, int sdy) noexcept nogil:
+    # a vertex outside the box, on a line that meets it: does it come before the box along (sdx, sdy)?
+    return ((cx == -2 and sdx > 0) or (cx == 2 and sdx < 0)
+            or (cy == -2 and sdy > 0) or (cy == 2 and sdy < 0))
+
+
+cdef inline void clip_edge(Box* b, double ix, double iy, double jx, double jy,
+                           bint has_o, signed char ocx, signed char ocy,
+                           bint has_d, signed char dcx, signed char dcy, EdgePart* part) noexcept nogil:
+    """The part in the box of the Voronoi edge between cells i (on its left) and j, running from its
+    origin vertex (or infinity) to its end vertex (or infinity); sites in the scaled unit, vertex codes
+    from axis_code."""
+    cdef int sig[4]
+    cdef int k, a, c, n_pos = 0, n_neg = 0, in_side = -1, out_side = -1
+    cdef bint in_corner = False, out_corner = False, chord, o_in, d_in, o_before, d_after
+    # the direction of the edge: i's cell on its left, d = rot90(j - i)
+    cdef int sdx = (iy > jy) - (iy < jy), sdy = (jx > ix) - (jx < ix)
+    part.has = False
+    part.entry = False
+    part.exit = False
+    part.start_at = AT_POINT
+    part.end_at = AT_POINT
+    o_in = has_o and code_in(ocx) and code_in(ocy)
+    d_in = has_d and code_in(dcx) and code_in(dcy)
+    if o_in and d_in:
+        part.has = True
+        part.start_at = AT_ORIGIN
+        part.end_at = AT_END
+        return
+
+    # where the bisector line crosses the boundary: walking the corners counter-clockwise, it enters
+    # the box where i's side (-) gives way to j's (+) and leaves where j's gives way to i's
+    for k in range(4):
+        sig[k] = bisector_side(b.skx[k], b.sky[k], ix, iy, jx, jy)
+        n_pos += sig[k] > 0
+        n_neg += sig[k] < 0
+    chord = n_pos > 0 and n_neg > 0
+    if chord:
+        for k in range(4):
+            a = sig[k]
+            c = sig[(k + 1) % 4]
+            if a < 0 and c > 0:
+                in_side = k
+            elif a > 0 and c < 0:
+                out_side = k
+            elif a == 0:
+                # the line passes through corner k (degenerate case: a site pair's bisector on a corner)
+                if sig[(k + 3) % 4] < 0 and c > 0:
+                    in_side = k; in_corner = True
+                elif sig[(k + 3) % 4] > 0 and c < 0:
+                    out_side = k; out_corner = True
+        if in_side < 0 or out_side < 0:
+            chord = False
+
+    if o_in:
+        # the edge starts inside and leaves; no chord: it only touches the box (along a side or at a
+        # corner, degenerate cases) and leaves at its origin
+        part.has = True
+        part.start_at = AT_ORIGIN
+        part.exit = True
+        if chord:
+            boundary_point(b, ix, iy, jx, jy, out_side, out_corner, &part.ex, &part.ey)
+            part.e_side = out_side
+        else:
+            part.end_at = AT_ORIGIN
+            part.e_side = code_side(ocx, ocy)
+            part.exit = part.e_side >= 0
+        return
+    if d_in:
+        part.has = True
+        part.end_at = AT_END
+        part.entry = True
+        if chord:
+            boundary_point(b, ix, iy, jx, jy, in_side, in_corner, &part.sx, &part.sy)
+            part.s_side = in_side
+        else:
+            part.start_at = AT_END
+            part.s_side = code_side(dcx, dcy)
+            part.entry = part.s_side >= 0
+        return
+    if not chord:
+        return
+    # both ends outside: the edge holds the whole chord, or misses the box
+    o_before = (not has_o) or before_box(ocx, ocy, sdx, sdy)
+    d_after = (not has_d) or not before_box(dcx, dcy, sdx, sdy)
+    if not (o_before and d_after):
+        return
+    part.has = True
+    part.entry = True
+    part.exit = True
+    boundary_point(b, ix, iy, jx, jy, in_side, in_corner, &part.sx, &part.sy)
+    boundary_point(b, ix, iy, jx, jy, out_side, out_corner, &part.ex, &part.ey)
+    part.s_side = in_side
+    part.e_side = out_side
+
+
+# ---------------------------------------------------------------------------------------------------------
+# one cell: the ring
+
+cdef inline bint owns_corner(Box* b, int k, double ix, double iy, const double* nbx, const double* nby,
+                             int m) noexcept nogil:
+    """Corner k lies in the cell of i (closed), given all of i's Voronoi neighbours."""
+    cdef int q
+    for q in range(m):
+        if bisector_side(b.skx[k], b.sky[k], ix, iy, nbx[q], nby[q]) > 0:
+            return False
+    return True
+
+
+cdef inline int walk_gap(Box* b, int p_exit, int p_entry, const double* pts, const signed char* pt_side,
+                         int corner0, int n_gaps, double ix, double iy, const double* nbx, const double* nby,
+                         int m, int32_t* ring, int n) noexcept nogil:
+    # the corners on the box boundary from an exit point counter-clockwise to the next entry point
+    cdef int s1 = pt_side[p_exit], s2 = pt_side[p_entry], count, k
+    cdef double t1, t2
+    if s1 != s2:
+        count = (s2 - s1 + 4) % 4
+    else:
+        t1 = boundary_t(s1, pts[2 * p_exit], pts[2 * p_exit + 1])
+        t2 = boundary_t(s2, pts[2 * p_entry], pts[2 * p_entry + 1])
+        if t2 > t1:
+            count = 0
+        elif t2 < t1:
+            count = 4
+        else:
+            # the two points round to one: the long way round is taken only by a cell that meets the
+            # boundary once and holds the next corner (degenerate case: an excursion thinner than an ulp)
+            count = 4 if n_gaps == 1 and owns_corner(b, (s1 + 1) % 4, ix, iy, nbx, nby, m) else 0
+    for k in range(1, count + 1):
+        ring[n] = corner0 + (s1 + k) % 4
+        n += 1
+    return n
+
+
+cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t* end_pt,
+                          const signed char* entry, const signed char* exit_, const signed char* has,
+                          const double* pts, const signed char* pt_side, int corner0,
+                          double ix, double iy, const double* nbx, const double* nby,
+                          int32_t* ring) noexcept nogil:
+    """The ring of one cell from its m edges in counter-clockwise order (edge q's part runs from point
+    start_pt[q] to end_pt[q] of pts, interleaved x, y; pt_side gives the boundary side of the points
+    that start or end on the boundary). Writes point ids to ring (room for 2 m + 4), returns the count
+    before repeats are dropped, or -1 if the parts do not chain (an inconsistent input)."""
+    cdef int q, q0 = -1, n = 0, n_gaps = 0, k, s1, s2, count, step, last_exit = -1, first_entry = -1
+    cdef double t1, t2
+    cdef bint any_part = False
+    for q in range(m):
+        if has[q]:
+            any_part = True
+            if entry[q]:
+                n_gaps += 1
+                if q0 < 0:
+                    q0 = q
+    if not any_part:
+        # the box lies wholly inside the cell or wholly outside it
+        if owns_corner(b, 0, ix, iy, nbx, nby, m):
+            for k in range(4):
+                ring[k] = corner0 + k
+            return 4
+        return 0
+    if q0 < 0:
+        q0 = 0
+    for step in range(m):
+        q = (q0 + step) % m
+        if not has[q]:
+            continue
+        if entry[q]:
+            if last_exit >= 0:
+                n = walk_gap(b, last_exit, start_pt[q], pts, pt_side, corner0, n_gaps, ix, iy, nbx, nby, m,
+                             ring, n)
+            elif first_entry < 0:
+                first_entry = start_pt[q]
+            last_exit = -1
+        elif last_exit >= 0:
+            return -1
+        ring[n] = start_pt[q]
+        n += 1
+        if exit_[q]:
+            ring[n] = end_pt[q]
+            n += 1
+            last_exit = end_pt[q]
+    if last_exit >= 0:
+        if first_entry < 0:
+            return -1
+        n = walk_gap(b, last_exit, first_entry, pts, pt_side, corner0, n_gaps, ix, iy, nbx, nby, m, ring, n)
+    elif first_entry >= 0:
+        return -1
+    return n
+
+
+cdef inline void reverse(int32_t* a, int lo, int hi) noexcept nogil:
+    cdef int32_t tmp
+    hi -= 1
+    while lo < hi:
+        tmp = a[lo]; a[lo] = a[hi]; a[hi] = tmp
+        lo += 1
+        hi -= 1
+
+
+cdef inline bint same_point(const double* pts, int p, int q) noexcept nogil:
+    return pts[2 * p] == pts[2 * q] and pts[2 * p + 1] == pts[2 * q + 1]
+
+
+cdef inline int sgn(double v) noexcept nogil:
+    return (v > 0.0) - (v < 0.0)
+
+
+cdef inline bint folds_back(const double* pts, int a, int b, int c) noexcept nogil:
+    """a -> b -> c turns back on itself (degenerate case: exact vertices closer than rounding, so a
+    convex turn became a spike): c equals a, or the three are collinear and the path reverses."""
+    if same_point(pts, a, c):
+        return True
+    if orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1]) != 0:
+        return False
+    return (sgn(pts[2 * b] - pts[2 * a]) * sgn(pts[2 * c] - pts[2 * b]) < 0
+            or sgn(pts[2 * b + 1] - pts[2 * a + 1]) * sgn(pts[2 * c + 1] - pts[2 * b + 1]) < 0)
+
+
+cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
+    """Make a ring of rounded points a valid polygon and give it its canonical start.
+
+    Repeated consecutive points (by value) are dropped, and so is the tip of a spike -- a point where
+    the ring folds back on itself: exact vertices closer than doubles can separate round onto one line
+    (the collapse the output documents). The ring then starts at its lowest point (smallest y, then x),
+    so that every engine writes the same ring. Returns the count (0 if fewer than three points remain).
+    """
+    cdef int k, j = 0, start = 0, p, q, guard
+    for k in range(n):
+        p = ring[k]
+        if j > 0 and same_point(pts, ring[j - 1], p):
+            continue
+        while j > 1 and folds_back(pts, ring[j - 2], ring[j - 1], p):
+            j -= 1
+            if same_point(pts, ring[j - 1], p):
+                break
+        if j > 0 and same_point(pts, ring[j - 1], p):
+            continue
+        ring[j] = p
+        j += 1
+    # the same across the ring's closing point
+    for guard in range(n):
+        if j > 1 and same_point(pts, ring[j - 1], ring[0]):
+            j -= 1
+        elif j > 2 and folds_back(pts, ring[j - 2], ring[j - 1], ring[0]):
+            j -= 1
+        elif j > 2 and folds_back(pts, ring[j - 1], ring[0], ring[1]):
+            for k in range(j - 1):
+                ring[k] = ring[k + 1]
+            j -= 1
+        else:
+            break
+    if j < 3:
+        return 0
+    for k in range(1, j):
+        p = ring[k]
+        q = ring[start]
+        if pts[2 * p + 1] < pts[2 * q + 1] or (pts[2 * p + 1] == pts[2 * q + 1] and pts[2 * p] < pts[2 * q]):
+            start = k
+    # rotate left by start (three reversals)
+    reverse(ring, 0, start)
+    reverse(ring, start, j)
+    reverse(ring, 0, j)
+    return j

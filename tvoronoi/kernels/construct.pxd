@@ -1,0 +1,359 @@
+# Correctly rounded constructions and the exact tests that go with them, compiled inline where cimported.
+#
+# Every coordinate tvoronoi writes that is neither an input coordinate nor a box side is made here:
+#
+#   circumcentre(a, b, c)    the Voronoi vertex of three sites
+#   bisector_at_x(a, b, X)   the y where the bisector of sites a and b crosses the vertical line x = X
+#   bisector_at_y(a, b, Y)   the x where it crosses the horizontal line y = Y
+#
+# Sites (and X, Y) are given in a kernel's scaled unit; each result is the double nearest to 2^e times
+# the exact value (ties to even), 2^e mapping the scaled unit back to the user's. A vertex computed
+# by any engine, any tile or any update is therefore the same double, bit for bit.
+#
+# Correct rounding is monotone, so a constructed value compares with any double (a box side) exactly
+# as the exact value does -- except when the two are equal. The sign tests below settle those ties:
+#
+#   circumcentre_side(a, b, c, X, axis)   sign of (exact circumcentre coordinate) - X
+#   bisector_side(Kx, Ky, a, b)           sign of |K - a|^2 - |K - b|^2 (-1: K nearer to a)
+#
+# Method: the exact value is a quotient p / q of two expansions (tvoronoi.kernels.predicates). A double
+# estimate r of it is refined by comparing p with (r +- half a gap) * q exactly until r is the nearest
+# double. The circumcentre first tries plain doubles with a proven error bound and returns at once
+# when the bound shows that the rounding is already correct (nearly always).
+
+from libc.math cimport fabs, frexp, ldexp, nextafter, INFINITY
+from libc.string cimport memcpy
+from libc.stdint cimport uint64_t
+
+from tvoronoi.kernels.predicates cimport (
+    EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_square, expansion_sign, fast_expansion_sum_zeroelim,
+    scale_expansion_zeroelim, expansion_product, negate_expansion, difference_expansion,
+)
+
+cdef enum:
+    # largest expansions met here: a circumcentre's numerator (3 terms of 16) and denominator (3 of 4)
+    P_MAX = 48
+    Q_MAX = 12
+    # a refinement never needs more than a few steps from an estimate within a few ulps; the bound
+    # only guarantees that a loop ends
+    MAX_REFINE = 64
+
+
+cdef inline double estimate(int n, const double* e) noexcept nogil:
+    # the value of an expansion to about one rounding (components summed from the smallest)
+    cdef double s = 0.0
+    cdef int i
+    for i in range(n):
+        s += e[i]
+    return s
+
+
+cdef inline bint is_even(double r) noexcept nogil:
+    cdef uint64_t bits
+    memcpy(&bits, &r, sizeof(double))
+    return (bits & 1) == 0
+
+
+cdef inline int sign_p_minus_mq(int n_p, const double* p, int n_q, const double* q,
+                                double m_hi, double m_lo) noexcept nogil:
+    # sign of p - (m_hi + m_lo) * q, exactly
+    cdef double t_hi[2 * Q_MAX]
+    cdef double t_lo[2 * Q_MAX]
+    cdef double mq[4 * Q_MAX]
+    cdef double d[P_MAX + 4 * Q_MAX]
+    cdef int n_hi = scale_expansion_zeroelim(n_q, q, m_hi, t_hi), n_lo, n_mq
+    if m_lo != 0.0:
+        n_lo = scale_expansion_zeroelim(n_q, q, m_lo, t_lo)
+        n_mq = fast_expansion_sum_zeroelim(n_hi, t_hi, n_lo, t_lo, mq)
+    else:
+        memcpy(mq, t_hi, n_hi * sizeof(double))
+        n_mq = n_hi
+    negate_expansion(n_mq, mq)
+    return expansion_sign(fast_expansion_sum_zeroelim(n_p, p, n_mq, mq, d), d)
+
+
+cdef inline double round_quotient(int n_p, double* p, int n_q, double* q, int e) noexcept nogil:
+    """The double nearest to 2^e * p / q (ties to even); q must not be zero. p and q are scratch:
+    they may be negated in place.
+
+    Beyond the double range the result is an infinity; where the exact value lies so far below the
+    smallest subnormal that a half gap cannot be formed in the scaled unit, the estimate is returned
+    (a value within one subnormal step of the exact one).
+    """
+    cdef int s_q = expansion_sign(n_q, q), s_p, k, ep, eq, s
+    cdef double pa, qa, mp, mq, r, up, down, r_s, half, gap
+    if s_q < 0:
+        negate_expansion(n_p, p)
+        negate_expansion(n_q, q)
+    s_p = expansion_sign(n_p, p)
+    if s_p == 0:
+        return 0.0
+    pa = estimate(n_p, p)
+    qa = estimate(n_q, q)
+    mp = frexp(pa, &ep)
+    mq = frexp(qa, &eq)
+    r = ldexp(mp / mq, ep - eq + e)
+    if r == INFINITY or r == -INFINITY:
+        return r
+    for k in range(MAX_REFINE):
+        r_s = ldexp(r, -e)
+        if ldexp(r_s, e) != r:
+            return r                        # r's scaled form underflows: nothing finer can be formed
+        # is the exact value above the midpoint between r and the next double up?
+        up = nextafter(r, INFINITY)
+        gap = (r - nextafter(r, -INFINITY)) if up == INFINITY else up - r   # past the largest double: the gap below
+        half = ldexp(gap, -e - 1)
+        if ldexp(half, e + 1) != gap:
+            return r                        # half a gap is not representable in the scaled unit
+        s = sign_p_minus_mq(n_p, p, n_q, q, r_s, half)
+        if s > 0:
+            r = up
+            if r == INFINITY:
+                return r
+            continue
+        if s == 0:
+            return r if is_even(r) else up
+        # below the midpoint between the next double down and r?
+        down = nextafter(r, -INFINITY)
+        if down == -INFINITY:
+            return r
+        gap = r - down
+        half = ldexp(gap, -e - 1)
+        if ldexp(half, e + 1) != gap:
+            return r
+        s = sign_p_minus_mq(n_p, p, n_q, q, r_s, -half)
+        if s < 0:
+            r = down
+            continue
+        if s == 0:
+            return r if is_even(r) else down
+        return r
+    return r
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the circumcentre
+#
+#   D  = 2 (ax (by - cy) + bx (cy - ay) + cx (ay - by))
+#   Ux = (|a|^2 (by - cy) + |b|^2 (cy - ay) + |c|^2 (ay - by)) / D
+#   Uy = (|a|^2 (cx - bx) + |b|^2 (ax - cx) + |c|^2 (bx - ax)) / D
+
+cdef inline int lifted_times_diff(double x, double y, double u, double v, double* h) noexcept nogil:
+    # (x^2 + y^2) * (u - v) exactly (h: 16 components)
+    cdef double sq[4]
+    cdef double d[2]
+    cdef double work[16]
+    cdef double scaled[8]
+    cdef double x1, x0, y1, y0, d1, d0
+    cdef double xx[2]
+    cdef double yy[2]
+    cdef int n_sq, n_d
+    x1, x0 = two_square(x)
+    y1, y0 = two_square(y)
+    xx[0] = x0; xx[1] = x1
+    yy[0] = y0; yy[1] = y1
+    n_sq = fast_expansion_sum_zeroelim(2, xx, 2, yy, sq)
+    d1, d0 = two_diff(u, v)
+    n_d = difference_expansion(d1, d0, d)
+    return expansion_product(n_sq, sq, n_d, d, h, work, scaled)
+
+
+cdef inline int coord_times_diff(double x, double u, double v, double* h) noexcept nogil:
+    # x * (u - v) exactly (h: 4 components)
+    cdef double d[2]
+    cdef double d1, d0
+    d1, d0 = two_diff(u, v)
+    cdef int n_d = difference_expansion(d1, d0, d)
+    return scale_expansion_zeroelim(n_d, d, x, h)
+
+
+cdef inline int sum3(int n1, const double* t1, int n2, const double* t2, int n3, const double* t3,
+                     double* h) noexcept nogil:
+    cdef double s12[P_MAX]
+    cdef int n12 = fast_expansion_sum_zeroelim(n1, t1, n2, t2, s12)
+    return fast_expansion_sum_zeroelim(n12, s12, n3, t3, h)
+
+
+cdef inline int circumcentre_denominator(double ax, double ay, double bx, double by, double cx, double cy,
+                                         double* h) noexcept nogil:
+    # D (h: Q_MAX components)
+    cdef double t1[4]
+    cdef double t2[4]
+    cdef double t3[4]
+    cdef int n1 = coord_times_diff(ax, by, cy, t1)
+    cdef int n2 = coord_times_diff(bx, cy, ay, t2)
+    cdef int n3 = coord_times_diff(cx, ay, by, t3)
+    cdef int n = sum3(n1, t1, n2, t2, n3, t3, h), k
+    for k in range(n):
+        h[k] *= 2.0
+    return n
+
+
+cdef inline int circumcentre_numerator(double ax, double ay, double bx, double by, double cx, double cy,
+                                       bint along_y, double* h) noexcept nogil:
+    # the numerator of Ux (along_y false) or of Uy (h: P_MAX components)
+    cdef double t1[16]
+    cdef double t2[16]
+    cdef double t3[16]
+    cdef int n1, n2, n3
+    if not along_y:
+        n1 = lifted_times_diff(ax, ay, by, cy, t1)
+        n2 = lifted_times_diff(bx, by, cy, ay, t2)
+        n3 = lifted_times_diff(cx, cy, ay, by, t3)
+    else:
+        n1 = lifted_times_diff(ax, ay, cx, bx, t1)
+        n2 = lifted_times_diff(bx, by, ax, cx, t2)
+        n3 = lifted_times_diff(cx, cy, bx, ax, t3)
+    return sum3(n1, t1, n2, t2, n3, t3, h)
+
+
+cdef inline void circumcentre_exact(double ax, double ay, double bx, double by, double cx, double cy, int e,
+                                    double* ux, double* uy) noexcept nogil:
+    cdef double num[P_MAX]
+    cdef double den[Q_MAX]
+    cdef int n_num, n_den
+    n_den = circumcentre_denominator(ax, ay, bx, by, cx, cy, den)
+    n_num = circumcentre_numerator(ax, ay, bx, by, cx, cy, False, num)
+    ux[0] = round_quotient(n_num, num, n_den, den, e)
+    n_den = circumcentre_denominator(ax, ay, bx, by, cx, cy, den)
+    n_num = circumcentre_numerator(ax, ay, bx, by, cx, cy, True, num)
+    uy[0] = round_quotient(n_num, num, n_den, den, e)
+
+
+cdef inline bint settled(double a, double u, double err, int e, double* out) noexcept nogil:
+    # a + u with |u - exact| <= err: is the rounding of a + exact known to be fl(a + u)? (then 2^e * it)
+    cdef double s, t, g_hi, g_lo, r
+    s, t = two_sum(a, u)
+    g_hi = nextafter(s, INFINITY) - s
+    g_lo = s - nextafter(s, -INFINITY)
+    # strictly inside the rounding interval of s: no tie, no neighbour
+    if not (t + err < 0.5 * g_hi and t - err > -0.5 * g_lo):
+        return False
+    r = ldexp(s, e)
+    # the scaling back must be exact: no overflow, no subnormal result
+    if not (fabs(r) >= 2.2250738585072014e-308 or r == 0.0) or fabs(r) == INFINITY:
+        return False
+    if r == 0.0 and s != 0.0:
+        return False
+    out[0] = r
+    return True
+
+
+cdef inline void circumcentre(double ax, double ay, double bx, double by, double cx, double cy, int e,
+                              double* ux, double* uy) noexcept nogil:
+    """The circumcentre of a, b, c (not collinear), each coordinate correctly rounded, times 2^e."""
+    cdef double bax = bx - ax, bay = by - ay, cax = cx - ax, cay = cy - ay
+    cdef double l = bax * cay, r = bay * cax
+    cdef double det = l - r, det_sum = fabs(l) + fabs(r)
+    cdef double err_det = CCW_ERRBOUND_A * det_sum
+    cdef double bb, cc, nx, ny, err_nx, err_ny, ex, ey, adet, gap
+    adet = fabs(det)
+    # fast path: relative coordinates in doubles, with a bound on their error (see the module notes);
+    # skipped when the determinant is too close to its error or values could underflow
+    if adet > 8.0 * err_det and det_sum > 1e-280:
+        bb = bax * bax + bay * bay
+        cc = cax * cax + cay * cay
+        nx = cay * bb - bay * cc
+        ny = bax * cc - cax * bb
+        # |n - N| <= 8 eps (|terms|) (seven roundings on each term); |det - D| <= err_det
+        err_nx = 8.0 * EPSILON * (fabs(cay * bb) + fabs(bay * cc))
+        err_ny = 8.0 * EPSILON * (fabs(bax * cc) + fabs(cax * bb))
+        gap = 2.0 * adet * (adet - err_det)
+        # |n/(2 det) - N/(2 D)| <= (|n| err_det + |det| err_n) / (2 |det| (|det| - err_det)), plus the
+        # division's own rounding; a little slack covers the rounding of the bound itself
+        ex = ((fabs(nx) * err_det + adet * err_nx) / gap + EPSILON * fabs(nx / det)) * (1.0 + 1e-6)
+        ey = ((fabs(ny) * err_det + adet * err_ny) / gap + EPSILON * fabs(ny / det)) * (1.0 + 1e-6)
+        if (settled(ax, nx / (2.0 * det), ex, e, ux)
+                and settled(ay, ny / (2.0 * det), ey, e, uy)):
+            return
+    circumcentre_exact(ax, ay, bx, by, cx, cy, e, ux, uy)
+
+
+cdef inline int circumcentre_side(double ax, double ay, double bx, double by, double cx, double cy,
+                                  double t, bint along_y) noexcept nogil:
+    """Sign of (exact circumcentre x, or y when along_y) - t, all in the scaled unit."""
+    cdef double num[P_MAX]
+    cdef double den[Q_MAX]
+    cdef double td[2 * Q_MAX]
+    cdef double diff[P_MAX + 2 * Q_MAX]
+    cdef int n_den = circumcentre_denominator(ax, ay, bx, by, cx, cy, den)
+    cdef int n_num = circumcentre_numerator(ax, ay, bx, by, cx, cy, along_y, num)
+    cdef int s_den = expansion_sign(n_den, den)
+    cdef int n_td = scale_expansion_zeroelim(n_den, den, t, td)
+    negate_expansion(n_td, td)
+    return s_den * expansion_sign(fast_expansion_sum_zeroelim(n_num, num, n_td, td, diff), diff)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the bisector of a and b: points p with 2 p . (b - a) = |b|^2 - |a|^2
+
+cdef inline int bisector_offset(double ax, double ay, double bx, double by, double t, bint along_y,
+                                double* h) noexcept nogil:
+    # |b|^2 - |a|^2 - 2 t (b - a)_x  (along_y false: the line x = t), or with (b - a)_y (h: 16)
+    cdef double sq[8]
+    cdef double lin[4]
+    cdef double a2[4]
+    cdef double b2[4]
+    cdef double p[2]
+    cdef double q[2]
+    cdef double h1, h0
+    cdef int n_a, n_b, n_sq, n_lin, k
+    h1, h0 = two_square(bx); p[0] = h0; p[1] = h1
+    h1, h0 = two_square(by); q[0] = h0; q[1] = h1
+    n_b = fast_expansion_sum_zeroelim(2, p, 2, q, b2)
+    h1, h0 = two_square(ax); p[0] = -h0; p[1] = -h1
+    h1, h0 = two_square(ay); q[0] = -h0; q[1] = -h1
+    n_a = fast_expansion_sum_zeroelim(2, p, 2, q, a2)
+    n_sq = fast_expansion_sum_zeroelim(n_b, b2, n_a, a2, sq)
+    if along_y:
+        n_lin = coord_times_diff(t, by, ay, lin)
+    else:
+        n_lin = coord_times_diff(t, bx, ax, lin)
+    for k in range(n_lin):
+        lin[k] *= -2.0
+    return fast_expansion_sum_zeroelim(n_sq, sq, n_lin, lin, h)
+
+
+cdef inline double bisector_at(double ax, double ay, double bx, double by, double t, bint along_y,
+                               int e) noexcept nogil:
+    """Where the bisector of a and b crosses the line x = t (along_y false: returns its y) or y = t
+    (returns its x), correctly rounded, times 2^e. The bisector must not be parallel to that line."""
+    cdef double num[16]
+    cdef double den[2]
+    cdef double d1, d0
+    cdef int n_num = bisector_offset(ax, ay, bx, by, t, along_y, num), n_den
+    if along_y:
+        d1, d0 = two_diff(bx, ax)
+    else:
+        d1, d0 = two_diff(by, ay)
+    n_den = difference_expansion(2.0 * d1, 2.0 * d0, den)
+    return round_quotient(n_num, num, n_den, den, e)
+
+
+cdef inline int bisector_side(double kx, double ky, double ax, double ay, double bx, double by) noexcept nogil:
+    """Sign of |K - a|^2 - |K - b|^2 = 2 K.(b - a) + |a|^2 - |b|^2: -1 when K is nearer to a, +1 nearer
+    to b, 0 on their bisector. Linear in K, so K may be as large as a box side can be."""
+    cdef double dx = bx - ax, dy = by - ay
+    cdef double tx = kx * dx, ty = ky * dy
+    cdef double aa = ax * ax + ay * ay, bb = bx * bx + by * by
+    cdef double det = 2.0 * (tx + ty) + (aa - bb)
+    cdef double bound = 10.0 * EPSILON * (2.0 * (fabs(tx) + fabs(ty)) + aa + bb)
+    cdef double lin[8]
+    cdef double px[4]
+    cdef double py[4]
+    cdef double sq[16]
+    cdef double total[24]
+    cdef int n_x, n_y, n_lin, n_sq, k
+    if det > bound:
+        return 1
+    if -det > bound:
+        return -1
+    # exact: 2 K.(b - a) - (|b|^2 - |a|^2 - 0) via the bisector offset at 0
+    n_x = coord_times_diff(kx, bx, ax, px)
+    n_y = coord_times_diff(ky, by, ay, py)
+    n_lin = fast_expansion_sum_zeroelim(n_x, px, n_y, py, lin)
+    for k in range(n_lin):
+        lin[k] *= 2.0
+    n_sq = bisector_offset(ax, ay, bx, by, 0.0, False, sq)      # |b|^2 - |a|^2
+    negate_expansion(n_sq, sq)
+    return expansion_sign(fast_expansion_sum_zeroelim(n_lin, lin, n_sq, sq, total), total)
