@@ -152,7 +152,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     n = len(pts)
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
-    points, offsets, ring, _n_reflex, status = clip.clip_cells(
+    points, offsets, ring, status = clip.clip_cells(
         exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
         out["he_face"], out["face_edge"], first.astype(np.int8), box, e,
     )

@@ -3,10 +3,10 @@
 import numpy as np
 
 from libc.stdint cimport int32_t, int64_t
+from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell, finish_ring,
 )
-from tvoronoi.kernels.predicates cimport orient2d
 
 cdef enum:
     HAS = 1
@@ -38,8 +38,6 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     offsets : (n + 1,) int64, ring : (K,) int32 -- cell i is
         points[ring[offsets[i]:offsets[i + 1]]], counter-clockwise, not
         closed, starting at its lowest point; empty when the cell misses the box.
-    n_reflex : int, the number of rings with a right turn after rounding (0 unless
-        an edge is shorter than the rounding).
     status : int, 0, or 1 if the edges of some cell did not chain (never on a valid DCEL).
     """
     xmin, ymin, xmax, ymax = [float(side) for side in box_tuple]
@@ -47,12 +45,12 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int n = xs.shape[0], m = vertices.shape[0], n_he = he_origin.shape[0]
     cdef int cap = m + 2 * n_he + 4
     cdef double[:, ::1] pts = np.empty((cap, 2), np.float64)
-    cdef signed char[::1] pt_side = np.full(cap, -1, np.int8)
-    cdef signed char[::1] vcx = np.zeros(max(m, 1), np.int8)
-    cdef signed char[::1] vcy = np.zeros(max(m, 1), np.int8)
+    cdef signed char[::1] pt_side = np.empty(cap, np.int8)     # read only at exits and entries
+    cdef signed char[::1] vcx = np.empty(max(m, 1), np.int8)
+    cdef signed char[::1] vcy = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] tie = np.zeros(max(m, 1), np.int8)
-    cdef int32_t[::1] seg_start = np.full(n_he, -1, np.int32)
-    cdef int32_t[::1] seg_end = np.full(n_he, -1, np.int32)
+    cdef int32_t[::1] seg_start = np.empty(n_he, np.int32)    # read only where flags say HAS
+    cdef int32_t[::1] seg_end = np.empty(n_he, np.int32)
     cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
     cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n + 4, np.int32)
@@ -65,7 +63,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef signed char[::1] c_has = np.empty(max_deg + 1, np.int8)
     cdef double[::1] nbx = np.empty(max_deg + 1, np.float64)
     cdef double[::1] nby = np.empty(max_deg + 1, np.float64)
-    cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, n_reflex = 0, status = 0
+    cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0
     cdef int64_t n_ring = 0
     cdef double x, y
     cdef EdgePart part
@@ -80,10 +78,13 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             pts[v, 1] = y
             if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
                 tie[v] = 1
+                n_ties += 1
+                vcx[v] = 0
+                vcy[v] = 0
             else:
                 vcx[v] = -2 if x < box.xmin else (2 if x > box.xmax else 0)
                 vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
-        for h in range(n_he):
+        for h in range(n_he if n_ties > 0 else 0):
             v = he_origin[h]
             if v < 0 or not tie[v]:
                 continue
@@ -97,7 +98,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
         for v in range(m):
-            if code_in(vcx[v]) and code_in(vcy[v]):
+            if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
                 pt_side[v] = code_side(vcx[v], vcy[v])
 
         # clip each edge once, along the half-edge of smaller index; its twin runs the other way
@@ -147,6 +148,19 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             offsets[i] = n_ring
             if not active[i]:
                 continue
+            # an interior cell: its vertices, already in order
+            h = face_edge[i]
+            cnt = 0
+            while h >= 0 and flags[h] == HAS and seg_start[h] == he_origin[h]:
+                ring[n_ring + cnt] = seg_start[h]
+                cnt += 1
+                h = he_next[h]
+                if h == face_edge[i]:
+                    break
+            if h == face_edge[i] and cnt > 0:
+                n_ring += finish_ring(&ring[n_ring], cnt, &pts[0, 0])
+                continue
+            # a cell that meets the box boundary
             h = face_edge[i]
             cnt = 0
             while h >= 0:
@@ -167,24 +181,14 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if k < 0:
                 status = 1
                 continue
-            k = finish_ring(&ring[n_ring], k, &pts[0, 0])
-            if k > 0 and not convex_ring(&ring[n_ring], k, &pts[0, 0]):
-                n_reflex += 1
-            n_ring += k
+            n_ring += finish_ring(&ring[n_ring], k, &pts[0, 0])
         offsets[n] = n_ring
 
     return (np.asarray(pts)[:n_pts].copy(), np.asarray(offsets),
-            np.asarray(ring)[:n_ring].copy(), n_reflex, status)
+            np.asarray(ring)[:n_ring].copy(), status)
 
 
-cdef bint convex_ring(const int32_t* ring, int k, const double* pts) noexcept nogil:
-    # no right turn anywhere (exact)
-    cdef int q, p0, p1, p2
-    for q in range(k):
-        p0 = ring[q]
-        p1 = ring[(q + 1) % k]
-        p2 = ring[(q + 2) % k]
-        if orient2d(pts[2 * p0], pts[2 * p0 + 1], pts[2 * p1], pts[2 * p1 + 1],
-                    pts[2 * p2], pts[2 * p2 + 1]) < 0:
-            return False
-    return True
+def bisector_crossing(double ax, double ay, double bx, double by, double t, bint along_y, int e=0) -> float:
+    """Where the bisector of sites a and b crosses the line x = t (returns its y) or, with along_y,
+    the line y = t (returns its x): the correctly rounded value, times 2^e (for tests)."""
+    return bisector_at(ax, ay, bx, by, t, along_y, e)

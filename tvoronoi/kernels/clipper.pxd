@@ -344,12 +344,13 @@ cdef inline int sgn(double v) noexcept nogil:
 cdef inline bint folds_back(const double* pts, int a, int b, int c) noexcept nogil:
     """a -> b -> c turns back on itself (degenerate case: exact vertices closer than rounding, so a
     convex turn became a spike): c equals a, or the three are collinear and the path reverses."""
-    if same_point(pts, a, c):
-        return True
-    if orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1]) != 0:
+    cdef int rx = sgn(pts[2 * b] - pts[2 * a]) * sgn(pts[2 * c] - pts[2 * b])
+    cdef int ry = sgn(pts[2 * b + 1] - pts[2 * a + 1]) * sgn(pts[2 * c + 1] - pts[2 * b + 1])
+    # on a line, going back reverses every coordinate that moves (the signs of differences of doubles
+    # are exact); a convex turn of a ring mostly reverses at most one, so the exact test is rare
+    if not (rx <= 0 and ry <= 0 and (rx < 0 or ry < 0)):
         return False
-    return (sgn(pts[2 * b] - pts[2 * a]) * sgn(pts[2 * c] - pts[2 * b]) < 0
-            or sgn(pts[2 * b + 1] - pts[2 * a + 1]) * sgn(pts[2 * c + 1] - pts[2 * b + 1]) < 0)
+    return orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1]) == 0
 
 
 cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept nogil:

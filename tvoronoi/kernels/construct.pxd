@@ -21,7 +21,7 @@
 # double. The circumcentre first tries plain doubles with a proven error bound and returns at once
 # when the bound shows that the rounding is already correct (nearly always).
 
-from libc.math cimport fabs, frexp, ldexp, nextafter, INFINITY
+from libc.math cimport fabs, fabsl, frexp, ldexp, nextafter, INFINITY
 from libc.string cimport memcpy
 from libc.stdint cimport uint64_t
 
@@ -29,6 +29,14 @@ from tvoronoi.kernels.predicates cimport (
     EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_square, expansion_sign, fast_expansion_sum_zeroelim,
     scale_expansion_zeroelim, expansion_product, negate_expansion, difference_expansion,
 )
+
+cdef extern from *:
+    """
+    #include <float.h>
+    /* the unit roundoff of long double: 2^-64 for x87 extended, 2^-53 where long double is double */
+    #define TVORONOI_LDBL_EPS (LDBL_EPSILON / 2.0L)
+    """
+    const long double LDBL_EPS "TVORONOI_LDBL_EPS"
 
 cdef enum:
     # largest expansions met here: a circumcentre's numerator (3 terms of 16) and denominator (3 of 4)
@@ -229,14 +237,54 @@ cdef inline bint settled(double a, double u, double err, int e, double* out) noe
     # strictly inside the rounding interval of s: no tie, no neighbour
     if not (t + err < 0.5 * g_hi and t - err > -0.5 * g_lo):
         return False
-    r = ldexp(s, e)
-    # the scaling back must be exact: no overflow, no subnormal result
-    if not (fabs(r) >= 2.2250738585072014e-308 or r == 0.0) or fabs(r) == INFINITY:
-        return False
-    if r == 0.0 and s != 0.0:
+    return scaled_back(s, e, out)
+
+
+cdef inline bint scaled_back(double s, int e, double* out) noexcept nogil:
+    # 2^e * s, if exact: no overflow, no subnormal result
+    cdef double r = ldexp(s, e)
+    if fabs(r) == INFINITY or (r != 0.0 and fabs(r) < 2.2250738585072014e-308) or (r == 0.0 and s != 0.0):
         return False
     out[0] = r
     return True
+
+
+cdef inline bint settled_long(double a, long double u, long double err, int e, double* out) noexcept nogil:
+    # as settled, with u and its error bound in long double (x87 extended where the platform has it)
+    cdef long double xl = <long double> a + u
+    cdef double s = <double> xl
+    cdef long double g_hi = <long double> nextafter(s, INFINITY) - s
+    cdef long double g_lo = <long double> s - nextafter(s, -INFINITY)
+    # the sum's own rounding, then the interval against the midpoints (each side formed exactly)
+    err = (err + LDBL_EPS * fabsl(xl)) * (1.0 + 4.0 * LDBL_EPS)
+    if not (xl + err < s + 0.5 * g_hi and xl - err > s - 0.5 * g_lo):
+        return False
+    return scaled_back(s, e, out)
+
+
+cdef inline bint circumcentre_long(double ax, double ay, double bx, double by, double cx, double cy, int e,
+                                   double* ux, double* uy) noexcept nogil:
+    # the fast path again in long double, for the few vertices whose rounding the doubles left open;
+    # the same error analysis with the long double unit roundoff
+    cdef long double bax = <long double> bx - ax, bay = <long double> by - ay
+    cdef long double cax = <long double> cx - ax, cay = <long double> cy - ay
+    cdef long double l = bax * cay, r = bay * cax
+    cdef long double det = l - r, det_sum = fabsl(l) + fabsl(r)
+    cdef long double err_det = (3.0 + 16.0 * LDBL_EPS) * LDBL_EPS * det_sum
+    cdef long double adet = fabsl(det), bb, cc, nx, ny, err_nx, err_ny, gap, ex, ey
+    if not (adet > 8.0 * err_det):
+        return False
+    bb = bax * bax + bay * bay
+    cc = cax * cax + cay * cay
+    nx = cay * bb - bay * cc
+    ny = bax * cc - cax * bb
+    err_nx = 8.0 * LDBL_EPS * (fabsl(cay * bb) + fabsl(bay * cc))
+    err_ny = 8.0 * LDBL_EPS * (fabsl(bax * cc) + fabsl(cax * bb))
+    gap = 2.0 * adet * (adet - err_det)
+    ex = ((fabsl(nx) * err_det + adet * err_nx) / gap + LDBL_EPS * fabsl(nx / det)) * (1.0 + 1e-6)
+    ey = ((fabsl(ny) * err_det + adet * err_ny) / gap + LDBL_EPS * fabsl(ny / det)) * (1.0 + 1e-6)
+    return (settled_long(ax, nx / (2.0 * det), ex, e, ux)
+            and settled_long(ay, ny / (2.0 * det), ey, e, uy))
 
 
 cdef inline void circumcentre(double ax, double ay, double bx, double by, double cx, double cy, int e,
@@ -265,6 +313,8 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
         ey = ((fabs(ny) * err_det + adet * err_ny) / gap + EPSILON * fabs(ny / det)) * (1.0 + 1e-6)
         if (settled(ax, nx / (2.0 * det), ex, e, ux)
                 and settled(ay, ny / (2.0 * det), ey, e, uy)):
+            return
+        if circumcentre_long(ax, ay, bx, by, cx, cy, e, ux, uy):
             return
     circumcentre_exact(ax, ay, bx, by, cx, cy, e, ux, uy)
 

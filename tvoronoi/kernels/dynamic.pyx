@@ -8,8 +8,12 @@ from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport (
     Mesh, nxt, prv, is_infinite, strictly_between, locate, insert_site, find_cavity, fill_cavity,
 )
-from tvoronoi.kernels.cliplib cimport Box, make_box, on_box, clip_bisector, snap_inside, angular_ring
-from tvoronoi.kernels.distance cimport closer
+from libc.stdlib cimport malloc, free
+from tvoronoi.kernels.clipper cimport (
+    Box, EdgePart, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
+    finish_ring,
+)
+from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.fortune cimport sweep_triangles
 
 cdef enum:
@@ -242,18 +246,27 @@ cdef class DynamicMesh:
 
     def cell(self, int site, double xmin, double ymin, double xmax, double ymax):
         """The cell of a site in the mesh, clipped to the box: a (k, 2) ring, counter-clockwise."""
-        cdef double rx[MAX_STAR * 2 + 8]
-        cdef double ry[MAX_STAR * 2 + 8]
-        cdef int k
-        cdef Box box = make_box(xmin, ymin, xmax, ymax)
-        if self.m.vedge[site] < 0:
+        cdef Box box = make_box(xmin, ymin, xmax, ymax, 0)
+        cdef CellBuffers buf
+        cdef int k, star = 0, e0 = self.m.vedge[site], e = e0
+        if e0 < 0:
             return np.empty((0, 2))
+        # the number of triangles around the site sizes the scratch
+        while True:
+            star += 1
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        if not alloc_cell_buffers(&buf, star):
+            free_cell_buffers(&buf)
+            raise MemoryError(f"no memory for the cell of a site with {star} neighbours")
         with nogil:
-            k = cell_ring(&self.m, site, &box, rx, ry)
+            k = cell_ring(&self.m, site, &box, &buf)
         out = np.empty((max(k, 0), 2))
         for i in range(k):
-            out[i, 0] = rx[i]
-            out[i, 1] = ry[i]
+            out[i, 0] = buf.pts[2 * buf.ring[i]]
+            out[i, 1] = buf.pts[2 * buf.ring[i] + 1]
+        free_cell_buffers(&buf)
         return out
 
     def neighbours(self, int site):
@@ -400,138 +413,120 @@ cdef int remove_site(Mesh* m, int v) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # one cell, read locally
 
-cdef void group_centre(Mesh* m, int t, double* cx, double* cy) noexcept nogil:
-    """The Voronoi vertex of triangle t: the circumcentre of the best-conditioned triangle of its
-    cocircular group, so that every cell sharing the vertex computes the same bits."""
-    cdef int group[MAX_GROUP]
-    cdef int n = 1, j = 0, k, e, o, u, best = t, a, b, c, d
-    cdef double det, best_det = -1.0, bx, by, qx, qy, bb, qq
-    group[0] = t
-    while j < n:
-        u = group[j]
-        j += 1
-        a = m.tv[3 * u]; b = m.tv[3 * u + 1]; c = m.tv[3 * u + 2]
-        det = (m.x[b] - m.x[a]) * (m.y[c] - m.y[a]) - (m.y[b] - m.y[a]) * (m.x[c] - m.x[a])
-        if det < 0:
-            det = -det
-        if det > best_det or (det == best_det and u < best):
-            best_det = det
-            best = u
-        for e in range(3 * u, 3 * u + 3):
-            o = m.opp[e]
-            if is_infinite(m, o // 3):
-                continue
-            d = m.tv[prv(o)]
-            if incircle(m.x[a], m.y[a], m.x[b], m.y[b], m.x[c], m.y[c], m.x[d], m.y[d]) != 0:
-                continue
-            for k in range(n):
-                if group[k] == o // 3:
-                    break
-            else:
-                if n < MAX_GROUP:
-                    group[n] = o // 3
-                    n += 1
-    a = m.tv[3 * best]; b = m.tv[3 * best + 1]; c = m.tv[3 * best + 2]
-    bx = m.x[b] - m.x[a]; by = m.y[b] - m.y[a]
-    qx = m.x[c] - m.x[a]; qy = m.y[c] - m.y[a]
-    det = 2.0 * (bx * qy - by * qx)
-    bb = bx * bx + by * by
-    qq = qx * qx + qy * qy
-    cx[0] = m.x[a] + (qy * bb - by * qq) / det
-    cy[0] = m.y[a] + (bx * qq - qx * bb) / det
+cdef struct CellBuffers:
+    # scratch of one cell with `star` triangles around its site (malloc'd: no cap on the star)
+    int32_t* ring          # point ids of the ring, 2 star + 4
+    double* pts            # interleaved x, y: star vertices, 2 star crossings, 4 corners
+    signed char* pt_side
+    signed char* vcx       # per triangle: the vertex's codes against the box
+    signed char* vcy
+    int32_t* c_start       # per edge: its part in the box
+    int32_t* c_end
+    signed char* c_entry
+    signed char* c_exit
+    signed char* c_has
+    double* nbx            # per edge: the neighbour's site
+    double* nby
 
 
-cdef int cell_ring(Mesh* m, int site, Box* box, double* rx, double* ry) noexcept nogil:
-    """The cell of site clipped to the box, counter-clockwise, into rx, ry; returns its length."""
-    cdef int nb[MAX_STAR]
-    cdef int tri[MAX_STAR]
-    cdef double vx[MAX_STAR]
-    cdef double vy[MAX_STAR]
-    cdef bint fin[MAX_STAR]
-    cdef bint ins[MAX_STAR]
-    cdef int ids[MAX_STAR * 2 + 8]
-    cdef double ang[MAX_STAR * 2 + 8]
-    cdef double cxs[4]
-    cdef double cys[4]
-    cdef int e0 = m.vedge[site], e, k = 0, j, p, count = 0, a, c
-    cdef double sx = m.x[site], sy = m.y[site], mx, my, dx, dy, t0, t1, x, y
-    cdef bint fast = True, owned
+cdef bint alloc_cell_buffers(CellBuffers* b, int star) noexcept nogil:
+    b.ring = <int32_t*> malloc((2 * star + 8) * sizeof(int32_t))
+    b.pts = <double*> malloc(2 * (3 * star + 8) * sizeof(double))
+    b.pt_side = <signed char*> malloc(3 * star + 8)
+    b.vcx = <signed char*> malloc(star + 1)
+    b.vcy = <signed char*> malloc(star + 1)
+    b.c_start = <int32_t*> malloc((star + 1) * sizeof(int32_t))
+    b.c_end = <int32_t*> malloc((star + 1) * sizeof(int32_t))
+    b.c_entry = <signed char*> malloc(star + 1)
+    b.c_exit = <signed char*> malloc(star + 1)
+    b.c_has = <signed char*> malloc(star + 1)
+    b.nbx = <double*> malloc((star + 1) * sizeof(double))
+    b.nby = <double*> malloc((star + 1) * sizeof(double))
+    return (b.ring != NULL and b.pts != NULL and b.pt_side != NULL and b.vcx != NULL and b.vcy != NULL
+            and b.c_start != NULL and b.c_end != NULL and b.c_entry != NULL and b.c_exit != NULL
+            and b.c_has != NULL and b.nbx != NULL and b.nby != NULL)
+
+
+cdef void free_cell_buffers(CellBuffers* b) noexcept nogil:
+    free(b.ring); free(b.pts); free(b.pt_side); free(b.vcx); free(b.vcy); free(b.c_start); free(b.c_end)
+    free(b.c_entry); free(b.c_exit); free(b.c_has); free(b.nbx); free(b.nby)
+
+
+cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
+    """The cell of site clipped to the box (clipper.pxd, as for batch cells): point ids of b.pts in
+    b.ring, counter-clockwise from the lowest point; returns the count."""
+    cdef int e0 = m.vedge[site], e, k = 0, q, p, nxq, j, a, c, n_pts, corner0, n_edges = 0, count
+    cdef double sx = m.x[site], sy = m.y[site]
+    cdef EdgePart part
+    cdef bint has_o, has_d
+    # the triangles around the site, counter-clockwise: triangle q is (site, nb q, nb q+1), and its
+    # circumcentre is the cell's vertex q (the same double in every cell that has it)
     e = e0
     while True:
-        if k == MAX_STAR:
-            return 0
-        nb[k] = m.tv[nxt(e)]
-        tri[k] = e // 3
-        fin[k] = not is_infinite(m, tri[k])
-        if fin[k]:
-            group_centre(m, tri[k], &vx[k], &vy[k])
-            ins[k] = snap_inside(box, &vx[k], &vy[k])
+        p = e // 3
+        if is_infinite(m, p):
+            b.vcx[k] = 3                                     # no vertex: a hull gap
         else:
-            ins[k] = False
-        fast = fast and ins[k]
+            a = m.tv[nxt(e)]
+            c = m.tv[prv(e)]
+            circumcentre(sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], 0, &b.pts[2 * k], &b.pts[2 * k + 1])
+            b.vcx[k] = axis_code(b.pts[2 * k], box.xmin, box.xmax, box.sxmin, box.sxmax,
+                                 sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], False)
+            b.vcy[k] = axis_code(b.pts[2 * k + 1], box.ymin, box.ymax, box.symin, box.symax,
+                                 sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], True)
+            if code_in(b.vcx[k]) and code_in(b.vcy[k]):
+                b.pt_side[k] = code_side(b.vcx[k], b.vcy[k])
+        b.c_start[k] = m.tv[nxt(e)]                          # the neighbour of edge k, for now
         k += 1
         e = m.opp[prv(e)]
         if e == e0:
             break
-    if fast:
-        # an interior cell: its vertices in order, each group's vertex once
-        for j in range(k):
-            if count > 0 and vx[j] == rx[count - 1] and vy[j] == ry[count - 1]:
-                continue
-            rx[count] = vx[j]
-            ry[count] = vy[j]
-            count += 1
-        while count > 1 and rx[count - 1] == rx[0] and ry[count - 1] == ry[0]:
-            count -= 1
-        return count
-    # a cell that meets the box edge: clipped edges and owned corners, in angular order
-    for j in range(k):
-        a = nb[j]
-        if a == m.inf:
+    n_pts = k
+    # the edges, counter-clockwise: the edge with neighbour nb q runs from vertex q - 1 to vertex q
+    for q in range(k):
+        j = b.c_start[q]
+        if j == m.inf:
             continue
-        p = j - 1 if j > 0 else k - 1          # the triangle on the right of site->a
-        if fin[p] and fin[j] and vx[p] == vx[j] and vy[p] == vy[j]:
-            continue                             # a zero-length edge of a cocircular group
-        if fin[p] and fin[j] and ins[p] and ins[j]:
-            rx[count] = vx[p]; ry[count] = vy[p]
-            rx[count + 1] = vx[j]; ry[count + 1] = vy[j]
-            count += 2
-            continue
-        if not clip_bisector(box, sx, sy, m.x[a], m.y[a], vx[p], vy[p], fin[p], vx[j], vy[j], fin[j],
-                             &mx, &my, &dx, &dy, &t0, &t1):
-            continue
-        if fin[p] and ins[p]:
-            rx[count] = vx[p]; ry[count] = vy[p]
-        else:
-            x = mx + t0 * dx; y = my + t0 * dy
-            on_box(box, &x, &y)
-            rx[count] = x; ry[count] = y
-        if fin[j] and ins[j]:
-            rx[count + 1] = vx[j]; ry[count + 1] = vy[j]
-        else:
-            x = mx + t1 * dx; y = my + t1 * dy
-            on_box(box, &x, &y)
-            rx[count + 1] = x; ry[count + 1] = y
-        count += 2
-    cxs[0] = box.xmin; cxs[1] = box.xmax; cxs[2] = box.xmax; cxs[3] = box.xmin
-    cys[0] = box.ymin; cys[1] = box.ymin; cys[2] = box.ymax; cys[3] = box.ymax
+        p = q - 1 if q > 0 else k - 1
+        has_o = b.vcx[p] != 3
+        has_d = b.vcx[q] != 3
+        if has_o and has_d and b.pts[2 * p] == b.pts[2 * q] and b.pts[2 * p + 1] == b.pts[2 * q + 1]:
+            continue                  # a zero-length edge (cocircular sites, or closer than rounding)
+        b.nbx[n_edges] = m.x[j]
+        b.nby[n_edges] = m.y[j]
+        clip_edge(box, sx, sy, m.x[j], m.y[j], has_o, b.vcx[p] if has_o else 0, b.vcy[p] if has_o else 0,
+                  has_d, b.vcx[q] if has_d else 0, b.vcy[q] if has_d else 0, &part)
+        b.c_has[n_edges] = part.has
+        b.c_entry[n_edges] = part.entry
+        b.c_exit[n_edges] = part.exit
+        if part.has:
+            if part.start_at == AT_POINT:
+                b.pts[2 * n_pts] = part.sx; b.pts[2 * n_pts + 1] = part.sy
+                b.pt_side[n_pts] = part.s_side
+                b.ring[n_edges] = n_pts            # parked here until the edges are all known
+                n_pts += 1
+            else:
+                b.ring[n_edges] = p if part.start_at == AT_ORIGIN else q
+            if part.end_at == AT_POINT:
+                b.pts[2 * n_pts] = part.ex; b.pts[2 * n_pts + 1] = part.ey
+                b.pt_side[n_pts] = part.e_side
+                b.c_end[n_edges] = n_pts
+                n_pts += 1
+            else:
+                b.c_end[n_edges] = p if part.end_at == AT_ORIGIN else q
+        n_edges += 1
+    for q in range(n_edges):
+        b.c_start[q] = b.ring[q]
+    corner0 = n_pts
     for c in range(4):
-        owned = True
-        for j in range(k):
-            a = nb[j]
-            if a != m.inf and closer(cxs[c], cys[c], sx, sy, m.x[a], m.y[a]) > 0:
-                owned = False
-                break
-        if owned:
-            rx[count] = cxs[c]
-            ry[count] = cys[c]
-            count += 1
-    if count < 3:
+        b.pts[2 * (corner0 + c)] = box.kx[c]
+        b.pts[2 * (corner0 + c) + 1] = box.ky[c]
+        b.pt_side[corner0 + c] = c
+    count = walk_cell(box, n_edges, b.c_start, b.c_end, b.c_entry, b.c_exit, b.c_has, b.pts, b.pt_side,
+                      corner0, sx, sy, b.nbx, b.nby, b.ring)
+    if count <= 0:
         return 0
-    for j in range(count):
-        ids[j] = j
-    count = angular_ring(rx, ry, ids, ang, count)
-    return count if count >= 3 else 0
+    return finish_ring(b.ring, count, b.pts)
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -1,0 +1,121 @@
+"""Constructed coordinates are the doubles nearest to the exact values (checked with Fractions)."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tvoronoi.kernels import clip, dcel
+
+
+def exact_circumcentre(a, b, c):
+    ax, ay, bx, by, cx, cy = (Fraction(v) for v in (*a, *b, *c))
+    d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+    aa, bb, cc = ax * ax + ay * ay, bx * bx + by * by, cx * cx + cy * cy
+    ux = (aa * (by - cy) + bb * (cy - ay) + cc * (ay - by)) / d
+    uy = (aa * (cx - bx) + bb * (ax - cx) + cc * (bx - ax)) / d
+    return ux, uy
+
+
+def rounded(q: Fraction, e: int = 0) -> float:
+    # int / int true division is correctly rounded, ties to even
+    q = q * Fraction(2) ** e
+    return q.numerator / q.denominator
+
+
+def kernel_circumcentres(tris, e=0):
+    tris = np.asarray(tris, np.float64).reshape(-1, 3, 2)
+    xs = np.ascontiguousarray(tris[:, :, 0].ravel())
+    ys = np.ascontiguousarray(tris[:, :, 1].ravel())
+    idx = np.arange(3 * len(tris), dtype=np.int32).reshape(-1, 3)
+    return dcel.circumcentres(xs, ys, idx, e)
+
+
+def collinear(a, b, c):
+    ax, ay, bx, by, cx, cy = (Fraction(v) for v in (*a, *b, *c))
+    return (bx - ax) * (cy - ay) == (by - ay) * (cx - ax)
+
+
+def check_triangles(tris, e=0):
+    got = kernel_circumcentres(tris, e)
+    for k, (a, b, c) in enumerate(np.asarray(tris, np.float64).reshape(-1, 3, 2)):
+        if collinear(a, b, c):
+            continue
+        ux, uy = exact_circumcentre(a, b, c)
+        assert got[k, 0] == rounded(ux, e) and got[k, 1] == rounded(uy, e), (a.tolist(), b.tolist(), c.tolist())
+
+
+def test_random_triangles_are_correctly_rounded():
+    rng = np.random.default_rng(7)
+    check_triangles(rng.random((3000, 3, 2)))
+
+
+def test_nearly_collinear_triangles():
+    # sites on y = 1 + 2x rounded to doubles: the determinant is a few ulps, the vertex far away
+    t = np.linspace(0, 1, 60)
+    pts = np.column_stack((t, 1 + 2 * t))
+    tris = [(pts[i], pts[i + 1], pts[i + 2]) for i in range(58)]
+    check_triangles(tris)
+
+
+def test_perturbed_lattice_and_decimals():
+    rng = np.random.default_rng(8)
+    g = np.array([(i, j) for i in range(8) for j in range(8)], float) + rng.normal(0, 1e-17, (64, 2))
+    idx = rng.integers(0, 64, (800, 3))
+    check_triangles(g[idx])
+    dec = np.round(rng.random((900, 3, 2)), 2)
+    check_triangles(dec)
+
+
+def test_scaled_output_is_rounded_once():
+    # the kernel folds the scale 2^e into the rounding: a subnormal result is still the nearest double
+    rng = np.random.default_rng(9)
+    tris = rng.random((300, 3, 2))
+    check_triangles(tris, e=-1060)
+    check_triangles(tris, e=40)
+
+
+coord = st.one_of(
+    st.integers(-50, 50).map(float),
+    st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False).filter(lambda v: v == 0 or abs(v) > 1e-100),
+    st.decimals(-10, 10, places=2).map(float),
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(coord, min_size=6, max_size=6))
+def test_hypothesis_circumcentres(values):
+    a, b, c = np.array(values).reshape(3, 2)
+    check_triangles([(a, b, c)])
+
+
+def exact_bisector_at(a, b, t, along_y):
+    ax, ay, bx, by, t = (Fraction(v) for v in (*a, *b, t))
+    num = bx * bx + by * by - ax * ax - ay * ay
+    if along_y:          # y = t: returns x
+        return (num - 2 * t * (by - ay)) / (2 * (bx - ax))
+    return (num - 2 * t * (bx - ax)) / (2 * (by - ay))
+
+
+@pytest.mark.parametrize("along_y", [False, True])
+def test_bisector_crossings_are_correctly_rounded(along_y):
+    rng = np.random.default_rng(10)
+    for _ in range(400):
+        a, b = rng.random((2, 2)) * rng.choice([1e-3, 1.0, 1e3])
+        t = float(rng.normal() * rng.choice([1.0, 1e10, 1e-5]))
+        if (a[0] == b[0]) if along_y else (a[1] == b[1]):
+            continue
+        got = clip.bisector_crossing(a[0], a[1], b[0], b[1], t, along_y, 0)
+        assert got == rounded(exact_bisector_at(a, b, t, along_y))
+
+
+def test_ties_round_to_even():
+    # circumcentres exactly halfway between two doubles (x = 2^52 + k + 1/2, where the ulp is 1)
+    big = 2.0 ** 52
+    tris = [((big + k, 0.0), (big + k + 1, 0.0), (big + k, 2.0)) for k in range(0, 12, 2)]
+    tris += [((big + k, 1.0), (big + k + 1, 1.0), (big + k + 1, -3.0)) for k in range(1, 12, 2)]
+    check_triangles(tris)
+    got = kernel_circumcentres(tris[:1])
+    assert got[0, 0] == big        # 2^52 + 1/2 -> the even neighbour, 2^52
