@@ -89,7 +89,7 @@ def _tv_full(engine: str, insertion: str = "brio"):
         from tvoronoi.api import as_points
 
         pts = as_points(pts)
-        e = build.power_of_two_scale(pts, box)
+        e = build.power_of_two_scale(pts)
         xs, ys = np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e)
         if engine == "incremental":
             _, _, _, out = build.incremental_dcel(xs, ys, insertion=insertion, seed=0)

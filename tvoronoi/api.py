@@ -13,10 +13,32 @@ ENGINES = ("incremental", "fortune")
 INSERTION_ORDERS = ("brio", "random")
 # The default box grows the sites' bounding box by this fraction of its larger side.
 BBOX_MARGIN = 0.10
-# The exact predicates multiply up to four coordinate differences; so that no
-# product underflows, a nonzero coordinate may be at most this many times
-# smaller than the largest one (2^170, about 1.5e51).
-DYNAMIC_RANGE = 2.0 ** 170
+# The range rule of every diagram (batch, dynamic, traces): coordinates are scaled by a power of two
+# 2^-e (exact) so that the largest magnitude in play is below 1 -- the sites' for a batch diagram or a
+# trace, the box's and the first sites' for a dynamic one. The exact predicates multiply up to four
+# coordinate differences; so that no product under- or overflows, a nonzero coordinate must lie within
+# 2^170 (about 1.5e51) of 2^e either way.
+RANGE_BITS = 170
+
+
+def scale_exponent(*values) -> int:
+    """The exponent e of the scale 2^e of these coordinates: the largest magnitude is below 2^e."""
+    top = max((float(np.abs(np.asarray(v, np.float64)).max()) for v in values if np.size(v)), default=0.0)
+    return math.frexp(top)[1] if top > 0 else 0
+
+
+def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
+    """Refuse nonzero coordinates more than 2^170 from the scale 2^e (naming the first row at fault)."""
+    mag = np.abs(pts)
+    bad = (pts != 0) & ((mag < math.ldexp(1.0, e - RANGE_BITS)) | (mag > math.ldexp(1.0, e + RANGE_BITS)))
+    if bad.any():
+        row, col = (int(v) for v in np.argwhere(bad.reshape(len(pts), -1))[0])
+        value = float(np.asarray(pts).reshape(len(pts), -1)[row, col])
+        raise TvoronoiError(
+            f"{what} {row} has coordinate {value!r}, over 1e51 times {'smaller' if abs(value) < 2.0 ** e else 'larger'} "
+            f"than the diagram's scale (about {math.ldexp(1.0, e):.3g}): exact arithmetic covers a range of "
+            f"2^170 around it; round such values to 0 or split the data"
+        )
 
 
 def as_points(points) -> np.ndarray:
@@ -42,15 +64,7 @@ def as_points(points) -> np.ndarray:
             f"point {row} is ({pts[row, 0]!r}, {pts[row, 1]!r}): coordinates must be finite "
             f"({int(bad.sum())} such point(s))"
         )
-    top = float(np.abs(pts).max())
-    tiny = (pts != 0) & (np.abs(pts) * DYNAMIC_RANGE < top)
-    if tiny.any():
-        row, col = (int(v) for v in np.argwhere(tiny)[0])
-        raise TvoronoiError(
-            f"point {row} has coordinate {pts[row, col]!r}, over 1e51 times smaller than the largest "
-            f"({top!r}): exact arithmetic covers a range of 2^170 within one point set; "
-            f"round such values to 0 or split the data"
-        )
+    check_range(pts, scale_exponent(pts))
     return np.ascontiguousarray(pts)
 
 
@@ -58,7 +72,9 @@ def default_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
     """The sites' bounding box grown by 10% of its larger side on every side.
 
     A single site, or sites that all coincide, get a margin of 10% of their
-    largest coordinate (1 at the origin), so the box always has area.
+    largest coordinate (1 at the origin). Where the margin is below the
+    coordinates' rounding (sites a few ulps apart, subnormal sites), each side
+    still moves out by at least one double, so the box always has area.
     """
     if len(pts) == 0:
         return (0.0, 0.0, 1.0, 1.0)
@@ -68,8 +84,11 @@ def default_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
     if side > 0:
         margin = BBOX_MARGIN * side
     else:
-        margin = BBOX_MARGIN * float(np.abs(pts).max()) or 1.0
-    return (float(lo[0] - margin), float(lo[1] - margin), float(hi[0] + margin), float(hi[1] + margin))
+        top = float(np.abs(pts).max())
+        margin = BBOX_MARGIN * top if top > 0 else 1.0
+    low = np.minimum(lo - margin, np.nextafter(lo, -np.inf))
+    high = np.maximum(hi + margin, np.nextafter(hi, np.inf))
+    return (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
 
 
 def as_bbox(bbox) -> tuple[float, float, float, float]:

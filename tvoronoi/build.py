@@ -10,7 +10,7 @@ from tvoronoi.diagram import Diagram
 from tvoronoi.kernels import clip, dcel, delaunay, fortune
 
 
-def power_of_two_scale(pts: np.ndarray, box=None) -> int:
+def power_of_two_scale(pts: np.ndarray) -> int:
     """Exponent e such that the sites' coordinates * 2**-e are at most 1 in magnitude.
 
     Scaling by a power of two is exact, and keeps the predicates' products
@@ -33,7 +33,10 @@ def check_box_scale(box, e: int) -> None:
     from tvoronoi.errors import TvoronoiError
 
     for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
-        s = abs(math.ldexp(v, -e))
+        try:
+            s = abs(math.ldexp(v, -e))
+        except OverflowError:
+            s = math.inf
         if s != 0.0 and not (BOX_SCALED_MIN <= s <= BOX_SCALED_MAX):
             raise TvoronoiError(
                 f"bbox {name} = {v!r} is beyond the exact range for these sites (their largest "

@@ -6,29 +6,21 @@ import math
 
 import numpy as np
 
-from tvoronoi.api import ENGINES, as_bbox, as_points, default_bbox
+from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox, scale_exponent
 from tvoronoi.build import assemble, collinear_dcel, sweep_order
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
 from tvoronoi.kernels import dcel, delaunay, dynamic, fortune
 
-# Without a global rescaling, the exact predicates stay exact (no product over- or
-# underflows) for coordinates that are 0 or within this range in magnitude.
-COORD_MIN = 1e-60
-COORD_MAX = 1e60
-
-
-def check_coordinate(x: float, y: float) -> tuple[float, float]:
+def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
+    """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
     try:
         x, y = float(x), float(y)
     except (TypeError, ValueError):
         raise TvoronoiError(f"coordinates must be numbers, got ({x!r}, {y!r})") from None
-    for v in (x, y):
-        if not math.isfinite(v):
-            raise TvoronoiError(f"coordinates must be finite, got ({x!r}, {y!r})")
-        if v != 0 and not COORD_MIN <= abs(v) <= COORD_MAX:
-            raise TvoronoiError(f"coordinate {v!r} is outside the exact range: use 0 or magnitudes "
-                                f"from {COORD_MIN:g} to {COORD_MAX:g}")
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise TvoronoiError(f"coordinates must be finite, got ({x!r}, {y!r})")
+    check_range(np.array([[x, y]]), e, what="new site")
     return x, y
 
 
@@ -66,10 +58,12 @@ class DynamicVoronoi:
         pts = as_points(points)
         if engine not in ENGINES:
             raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
-        for x, y in pts[np.any((pts != 0) & ((np.abs(pts) < COORD_MIN) | (np.abs(pts) > COORD_MAX)), axis=1)]:
-            check_coordinate(x, y)
         self.engine = engine
         self.bbox = default_bbox(pts) if bbox is None else as_bbox(bbox)
+        # the one range rule (tvoronoi.api): the mesh holds sites scaled by 2^-e, e fixed by the box and
+        # the first sites, so later sites anywhere within 2^170 of that scale stay exact
+        self._e = scale_exponent(pts, self.bbox)
+        check_range(pts, self._e)
         n = len(pts)
         self._xy = np.full((max(2 * n, 16), 2), np.nan)
         self._xy[:n] = pts
@@ -120,8 +114,8 @@ class DynamicVoronoi:
         self._copies.clear()
         if len(ids) == 0:
             return
-        xs = np.ascontiguousarray(self._xy[ids, 0])
-        ys = np.ascontiguousarray(self._xy[ids, 1])
+        xs = np.ascontiguousarray(np.ldexp(self._xy[ids, 0], -self._e))
+        ys = np.ascontiguousarray(np.ldexp(self._xy[ids, 1], -self._e))
         if self.engine == "fortune":
             perm = sweep_order(xs, ys)
             sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
@@ -158,7 +152,7 @@ class DynamicVoronoi:
             if holder != int(order_ids[k]):
                 mesh.relabel(int(order_ids[k]), holder)
         for c, p in self._primary.items():
-            mesh.set_site(c, *self._xy[c])
+            mesh.set_site(c, *np.ldexp(self._xy[c], -self._e))
         self._mesh = mesh
 
     def _after_change(self) -> None:
@@ -169,7 +163,7 @@ class DynamicVoronoi:
 
     def insert(self, x, y) -> int:
         """Add a site at (x, y); returns its id."""
-        x, y = check_coordinate(x, y)
+        x, y = check_coordinate(x, y, self._e)
         i = self._new_id()
         self._place(i, x, y)
         return i
@@ -182,10 +176,11 @@ class DynamicVoronoi:
             self._rebuild()
             self.changed = np.union1d(self._holders(), [i]).astype(np.int32)
             return
+        sx, sy = math.ldexp(x, -self._e), math.ldexp(y, -self._e)
         if self.engine == "fortune":
-            held = self._mesh.insert_swept(i, x, y)
+            held = self._mesh.insert_swept(i, sx, sy)
         else:
-            held = self._mesh.insert(i, x, y)
+            held = self._mesh.insert(i, sx, sy)
         if held >= 0:
             # a repeated point: it shares the cell of the site already there
             holder = self._primary.get(held, held)
@@ -238,7 +233,7 @@ class DynamicVoronoi:
     def move(self, i, x, y) -> None:
         """Move site i to (x, y), keeping its id."""
         i = self._check_id(i)
-        x, y = check_coordinate(x, y)
+        x, y = check_coordinate(x, y, self._e)
         gone = self._unplace(i)
         self._alive[i] = False
         self._place(i, x, y)
@@ -285,7 +280,7 @@ class DynamicDiagram:
         if not o._alive[i] or i in o._primary:
             return np.empty((0, 2))
         if o._mesh is not None:
-            return o._mesh.cell(i, *self.bbox)
+            return o._mesh.cell(i, *self.bbox, o._e)
         if o._flat is None:
             o._flat = self.to_diagram()
         return o._flat.cell_polygon(i)
@@ -304,7 +299,8 @@ class DynamicDiagram:
         o = self._owner
         n = o._n_ids
         pts = np.where(o._alive[:n, None], o._xy[:n], 0.0)
-        xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+        xs = np.ascontiguousarray(np.ldexp(pts[:, 0], -o._e))
+        ys = np.ascontiguousarray(np.ldexp(pts[:, 1], -o._e))
         dup = np.full(n, -1, np.int32)
         for c, p in o._primary.items():
             dup[c] = p
@@ -312,7 +308,7 @@ class DynamicDiagram:
         if o._mesh is not None:
             tv, opp = o._mesh.export()
             tv = np.where(tv == dynamic.INFINITE, n, tv).astype(np.int32)
-            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp, 0)
+            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp, o._e)
         else:
             holders = o._holders()
             sub = collinear_dcel(xs[holders], ys[holders])
@@ -322,7 +318,7 @@ class DynamicDiagram:
             face_edge[holders] = sub["face_edge"]
             out["face_edge"] = face_edge
         out["dup"] = dup
-        return assemble(pts, self.bbox, 0, np.arange(n, dtype=np.int32), xs, ys, out,
+        return assemble(pts, self.bbox, o._e, np.arange(n, dtype=np.int32), xs, ys, out,
                         engine=o.engine, present=present, first_row_holds=False)
 
     def delaunay_triangles(self) -> np.ndarray:

@@ -115,8 +115,11 @@ class FortuneTrace:
     def __init__(self, points):
         self.points = as_points(points)
         self._perm = sweep_order(self.points[:, 0], self.points[:, 1])
-        self._xs = np.ascontiguousarray(self.points[self._perm, 0])
-        self._ys = np.ascontiguousarray(self.points[self._perm, 1])
+        # the kernel sweeps sites scaled by 2^-e, as in a batch build (the one range rule); what a
+        # step shows is in the user's unit
+        self._e = power_of_two_scale(self.points)
+        self._xs = np.ascontiguousarray(np.ldexp(self.points[self._perm, 0], -self._e))
+        self._ys = np.ascontiguousarray(np.ldexp(self.points[self._perm, 1], -self._e))
         self.n_steps = int(fortune.sweep(self._xs, self._ys)["steps"])
 
     def __len__(self) -> int:
@@ -126,12 +129,13 @@ class FortuneTrace:
         """The state after k events, 0 <= k <= len(self)."""
         k = max(0, min(int(k), self.n_steps))
         st = fortune.sweep(self._xs, self._ys, k)
-        perm, xs, ys = self._perm, self._xs, self._ys
-        pts = np.column_stack((xs, ys))
-        tri = st["triangles"]
-        centres = circumcentres(pts[tri[:, 0]], pts[tri[:, 1]], pts[tri[:, 2]])
+        perm, e = self._perm, self._e
+        pts = self.points[perm]
+        xs, ys = pts[:, 0], pts[:, 1]
+        tri = np.ascontiguousarray(st["triangles"], dtype=np.int32).reshape(-1, 3)
+        centres = dcel.circumcentres(self._xs, self._ys, tri, e)
         beach = st["beach"]
-        sweep_y = st["sweep_y"]
+        sweep_y = math.ldexp(float(st["sweep_y"]), e)
         bps = np.array([breakpoint_xy(pts[beach[i]], pts[beach[i + 1]], sweep_y)
                         for i in range(len(beach) - 1)]).reshape(-1, 2)
         rec = st["records"]
@@ -139,15 +143,16 @@ class FortuneTrace:
         finished = np.stack((centres[rec["e0"][closed] // 3], centres[rec["e1"][closed] // 3]), axis=1)
         live = st["beach_edges"]
         e0 = rec["e0"][live]
-        starts = np.column_stack((rec["x"][live], rec["y"][live]))
+        starts = np.ldexp(np.column_stack((rec["x"][live], rec["y"][live])), e)
         if len(live):
             starts[e0 >= 0] = centres[e0[e0 >= 0] // 3]
         growing = np.stack((starts, bps), axis=1) if len(live) else np.empty((0, 2, 2))
         events = st["events"]
         if len(events):
             arcs = events[:, 0].astype(int)
-            radius = events[:, 3] - events[:, 2]
-            circles = np.column_stack((events[:, 1], events[:, 2], radius))
+            ev = np.ldexp(events[:, 1:4], e)
+            radius = ev[:, 2] - ev[:, 1]
+            circles = np.column_stack((ev[:, 0], ev[:, 1], radius))
         else:
             arcs, circles = np.empty(0, int), np.empty((0, 3))
         kind, site, t = st["last"]
@@ -206,7 +211,7 @@ class IncrementalTrace:
         self.points = as_points(points)
         self.bbox = default_bbox(self.points) if bbox is None else as_bbox(bbox)
         n = len(self.points)
-        self._e = power_of_two_scale(self.points, self.bbox)
+        self._e = power_of_two_scale(self.points)
         xs = np.ldexp(self.points[:, 0], -self._e)
         ys = np.ldexp(self.points[:, 1], -self._e)
         rng = np.random.default_rng(seed)

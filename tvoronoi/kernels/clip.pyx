@@ -158,7 +158,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 if h == face_edge[i]:
                     break
             if h == face_edge[i] and cnt > 0:
-                n_ring += finish_ring(&ring[n_ring], cnt, &pts[0, 0])
+                n_ring += finish_ring(&ring[n_ring], cnt, &pts[0, 0], e)
                 continue
             # a cell that meets the box boundary
             h = face_edge[i]
@@ -181,7 +181,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if k < 0:
                 status = 1
                 continue
-            n_ring += finish_ring(&ring[n_ring], k, &pts[0, 0])
+            n_ring += finish_ring(&ring[n_ring], k, &pts[0, 0], e)
         offsets[n] = n_ring
 
     return (np.asarray(pts)[:n_pts].copy(), np.asarray(offsets),

@@ -341,19 +341,22 @@ cdef inline int sgn(double v) noexcept nogil:
     return (v > 0.0) - (v < 0.0)
 
 
-cdef inline bint folds_back(const double* pts, int a, int b, int c) noexcept nogil:
+cdef inline bint folds_back(const double* pts, int a, int b, int c, int e) noexcept nogil:
     """a -> b -> c turns back on itself (degenerate case: exact vertices closer than rounding, so a
-    convex turn became a spike): c equals a, or the three are collinear and the path reverses."""
+    convex turn became a spike): c equals a, or the three are collinear and the path reverses.
+    The points are in the user's unit; the orientation is taken on them scaled by 2^-e (exact), where
+    no product underflows."""
     cdef int rx = sgn(pts[2 * b] - pts[2 * a]) * sgn(pts[2 * c] - pts[2 * b])
     cdef int ry = sgn(pts[2 * b + 1] - pts[2 * a + 1]) * sgn(pts[2 * c + 1] - pts[2 * b + 1])
     # on a line, going back reverses every coordinate that moves (the signs of differences of doubles
     # are exact); a convex turn of a ring mostly reverses at most one, so the exact test is rare
     if not (rx <= 0 and ry <= 0 and (rx < 0 or ry < 0)):
         return False
-    return orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1]) == 0
+    return orient2d(ldexp(pts[2 * a], -e), ldexp(pts[2 * a + 1], -e), ldexp(pts[2 * b], -e),
+                    ldexp(pts[2 * b + 1], -e), ldexp(pts[2 * c], -e), ldexp(pts[2 * c + 1], -e)) == 0
 
 
-cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
+cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noexcept nogil:
     """Make a ring of rounded points a valid polygon and give it its canonical start.
 
     Repeated consecutive points (by value) are dropped, and so is the tip of a spike -- a point where
@@ -366,7 +369,7 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
         p = ring[k]
         if j > 0 and same_point(pts, ring[j - 1], p):
             continue
-        while j > 1 and folds_back(pts, ring[j - 2], ring[j - 1], p):
+        while j > 1 and folds_back(pts, ring[j - 2], ring[j - 1], p, e):
             j -= 1
             if same_point(pts, ring[j - 1], p):
                 break
@@ -378,9 +381,9 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
     for guard in range(n):
         if j > 1 and same_point(pts, ring[j - 1], ring[0]):
             j -= 1
-        elif j > 2 and folds_back(pts, ring[j - 2], ring[j - 1], ring[0]):
+        elif j > 2 and folds_back(pts, ring[j - 2], ring[j - 1], ring[0], e):
             j -= 1
-        elif j > 2 and folds_back(pts, ring[j - 1], ring[0], ring[1]):
+        elif j > 2 and folds_back(pts, ring[j - 1], ring[0], ring[1], e):
             for k in range(j - 1):
                 ring[k] = ring[k + 1]
             j -= 1

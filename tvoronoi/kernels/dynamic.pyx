@@ -244,9 +244,11 @@ cdef class DynamicMesh:
         opp_t = new_index[opp // 3] * 3 + opp % 3
         return (tv[live].ravel().copy(), opp_t.reshape(-1, 3)[live].ravel().astype(np.int32))
 
-    def cell(self, int site, double xmin, double ymin, double xmax, double ymax):
-        """The cell of a site in the mesh, clipped to the box: a (k, 2) ring, counter-clockwise."""
-        cdef Box box = make_box(xmin, ymin, xmax, ymax, 0)
+    def cell(self, int site, double xmin, double ymin, double xmax, double ymax, int exponent=0):
+        """The cell of a site in the mesh, clipped to the box: a (k, 2) ring, counter-clockwise.
+
+        The mesh holds sites in a unit 2^-exponent of the user's; the box and the ring are in the user's."""
+        cdef Box box = make_box(xmin, ymin, xmax, ymax, exponent)
         cdef CellBuffers buf
         cdef int k, star = 0, e0 = self.m.vedge[site], e = e0
         if e0 < 0:
@@ -469,7 +471,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
         else:
             a = m.tv[nxt(e)]
             c = m.tv[prv(e)]
-            circumcentre(sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], 0, &b.pts[2 * k], &b.pts[2 * k + 1])
+            circumcentre(sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], box.e, &b.pts[2 * k], &b.pts[2 * k + 1])
             b.vcx[k] = axis_code(b.pts[2 * k], box.xmin, box.xmax, box.sxmin, box.sxmax,
                                  sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], False)
             b.vcy[k] = axis_code(b.pts[2 * k + 1], box.ymin, box.ymax, box.symin, box.symax,
@@ -526,7 +528,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
                       corner0, sx, sy, b.nbx, b.nby, b.ring)
     if count <= 0:
         return 0
-    return finish_ring(b.ring, count, b.pts)
+    return finish_ring(b.ring, count, b.pts, box.e)
 
 
 # ---------------------------------------------------------------------------------------------------------
