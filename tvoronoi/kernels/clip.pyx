@@ -5,7 +5,8 @@ import numpy as np
 from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.clipper cimport (
-    Box, EdgePart, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell, finish_ring,
+    Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
+    finish_ring,
 )
 
 cdef enum:
@@ -46,6 +47,9 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int cap = m + 2 * n_he + 4
     cdef double[:, ::1] pts = np.empty((cap, 2), np.float64)
     cdef signed char[::1] pt_side = np.empty(cap, np.int8)     # read only at exits and entries
+    cdef int32_t[::1] pt_a = np.empty(cap, np.int32)           # how a boundary point was made (Points)
+    cdef int32_t[::1] pt_b = np.empty(cap, np.int32)
+    cdef int32_t[::1] pt_c = np.empty(cap, np.int32)
     cdef signed char[::1] vcx = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] vcy = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] tie = np.zeros(max(m, 1), np.int8)
@@ -67,6 +71,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int64_t n_ring = 0
     cdef double x, y
     cdef EdgePart part
+    cdef Points P
     cdef bint has_o, has_d
 
     with nogil:
@@ -97,6 +102,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], False)
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
+            pt_a[v] = a; pt_b[v] = b; pt_c[v] = c
         for v in range(m):
             if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
                 pt_side[v] = code_side(vcx[v], vcy[v])
@@ -120,6 +126,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if part.start_at == AT_POINT:
                 pts[n_pts, 0] = part.sx; pts[n_pts, 1] = part.sy
                 pt_side[n_pts] = part.s_side
+                pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
                 seg_start[h] = n_pts
                 n_pts += 1
             else:
@@ -127,6 +134,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if part.end_at == AT_POINT:
                 pts[n_pts, 0] = part.ex; pts[n_pts, 1] = part.ey
                 pt_side[n_pts] = part.e_side
+                pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
                 seg_end[h] = n_pts
                 n_pts += 1
             else:
@@ -141,7 +149,16 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             pts[corner0 + k, 0] = box.kx[k]
             pts[corner0 + k, 1] = box.ky[k]
             pt_side[corner0 + k] = k
+            pt_a[corner0 + k] = -1
         n_pts += 4
+        P.xy = &pts[0, 0]
+        P.side = &pt_side[0]
+        P.da = &pt_a[0]
+        P.db = &pt_b[0]
+        P.dc = &pt_c[0]
+        P.sx = &xs[0] if n > 0 else NULL
+        P.sy = &ys[0] if n > 0 else NULL
+        P.corner0 = corner0
 
         # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries
         for i in range(n):
@@ -177,7 +194,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 if h == face_edge[i]:
                     break
             k = walk_cell(&box, cnt, &c_start[0], &c_end[0], &c_entry[0], &c_exit[0], &c_has[0],
-                          &pts[0, 0], &pt_side[0], corner0, xs[i], ys[i], &nbx[0], &nby[0], &ring[n_ring])
+                          &P, xs[i], ys[i], &nbx[0], &nby[0], &ring[n_ring])
             if k < 0:
                 status = 1
                 continue

@@ -20,8 +20,14 @@
 from libc.math cimport ldexp
 from libc.stdint cimport int32_t
 
-from tvoronoi.kernels.construct cimport bisector_at, bisector_side, circumcentre_side
-from tvoronoi.kernels.predicates cimport orient2d
+from tvoronoi.kernels.construct cimport (
+    P_MAX, Q_MAX, bisector_at, bisector_side, bisector_offset, circumcentre_side, circumcentre_numerator,
+    circumcentre_denominator,
+)
+from tvoronoi.kernels.predicates cimport (
+    orient2d, two_diff, difference_expansion, expansion_product, expansion_sign, negate_expansion,
+    fast_expansion_sum_zeroelim,
+)
 
 cdef struct Box:
     double xmin, ymin, xmax, ymax            # the user's unit
@@ -243,55 +249,109 @@ cdef inline bint owns_corner(Box* b, int k, double ix, double iy, const double* 
     return True
 
 
-cdef inline int walk_gap(Box* b, int p_exit, int p_entry, const double* pts, const signed char* pt_side,
-                         int corner0, int n_gaps, double ix, double iy, const double* nbx, const double* nby,
-                         int m, int32_t* ring, int n) noexcept nogil:
+cdef struct Points:
+    # the points a cell's ring is made of, and how each boundary point was made
+    double* xy                 # interleaved x, y, user unit
+    signed char* side          # boundary side of the points that start or end on the boundary
+    int32_t* da                # a corner (da = -1), the crossing of the bisector of sites da, db with
+    int32_t* db                # a box side (dc = -1), or the circumcentre of sites da, db, dc (a vertex
+    int32_t* dc                # exactly on a side); written for boundary points only
+    const double* sx           # the sites, scaled unit
+    const double* sy
+    int corner0                # id of corner 0 (corners k at corner0 + k)
+
+
+cdef inline int position_parts(Points* P, Box* b, int side, int p, double* num, double* den,
+                               int* n_den) noexcept nogil:
+    # the exact position of boundary point p along its side (x on sides 0 and 2, y on 1 and 3) as
+    # num / den, scaled unit; returns the length of num
+    cdef int a = P.da[p], c = P.dc[p], q = P.db[p]
+    cdef bint horizontal = side == 0 or side == 2
+    cdef double d1, d0
+    if a < 0:
+        num[0] = ldexp(P.xy[2 * p] if horizontal else P.xy[2 * p + 1], -b.e)
+        den[0] = 1.0
+        n_den[0] = 1
+        return 1
+    if c < 0:
+        if horizontal:
+            d1, d0 = two_diff(P.sx[q], P.sx[a])
+        else:
+            d1, d0 = two_diff(P.sy[q], P.sy[a])
+        n_den[0] = difference_expansion(2.0 * d1, 2.0 * d0, den)
+        return bisector_offset(P.sx[a], P.sy[a], P.sx[q], P.sy[q],
+                               (b.symin if side == 0 else b.symax) if horizontal
+                               else (b.sxmax if side == 1 else b.sxmin), horizontal, num)
+    n_den[0] = circumcentre_denominator(P.sx[a], P.sy[a], P.sx[q], P.sy[q], P.sx[c], P.sy[c], den)
+    return circumcentre_numerator(P.sx[a], P.sy[a], P.sx[q], P.sy[q], P.sx[c], P.sy[c], not horizontal, num)
+
+
+cdef inline int compare_along(Points* P, Box* b, int side, int p, int q) noexcept nogil:
+    """Sign of (position of p - position of q) along their common side, counter-clockwise, exactly
+    (for two boundary points that round to one double)."""
+    cdef double num_p[P_MAX]
+    cdef double num_q[P_MAX]
+    cdef double den_p[Q_MAX]
+    cdef double den_q[Q_MAX]
+    cdef double left[2 * P_MAX * Q_MAX]
+    cdef double right[2 * P_MAX * Q_MAX]
+    cdef double work[2 * P_MAX * Q_MAX]
+    cdef double scaled[2 * P_MAX]
+    cdef double diff[4 * P_MAX * Q_MAX]
+    cdef int nd_p, nd_q, n_p, n_q, n_l, n_r, s
+    n_p = position_parts(P, b, side, p, num_p, den_p, &nd_p)
+    n_q = position_parts(P, b, side, q, num_q, den_q, &nd_q)
+    # num_p / den_p - num_q / den_q has the sign of num_p den_q - num_q den_p times those of the dens
+    n_l = expansion_product(n_p, num_p, nd_q, den_q, left, work, scaled)
+    n_r = expansion_product(n_q, num_q, nd_p, den_p, right, work, scaled)
+    negate_expansion(n_r, right)
+    s = (expansion_sign(fast_expansion_sum_zeroelim(n_l, left, n_r, right, diff), diff)
+         * expansion_sign(nd_p, den_p) * expansion_sign(nd_q, den_q))
+    # t grows with x on side 0 and y on side 1, against them on sides 2 and 3
+    return s if side < 2 else -s
+
+
+cdef inline int walk_gap(Box* b, Points* P, int p_exit, int p_entry, int32_t* ring, int n) noexcept nogil:
     # the corners on the box boundary from an exit point counter-clockwise to the next entry point
-    cdef int s1 = pt_side[p_exit], s2 = pt_side[p_entry], count, k
+    cdef int s1 = P.side[p_exit], s2 = P.side[p_entry], count, k
     cdef double t1, t2
     if s1 != s2:
         count = (s2 - s1 + 4) % 4
     else:
-        t1 = boundary_t(s1, pts[2 * p_exit], pts[2 * p_exit + 1])
-        t2 = boundary_t(s2, pts[2 * p_entry], pts[2 * p_entry + 1])
-        if t2 > t1:
-            count = 0
-        elif t2 < t1:
-            count = 4
+        t1 = boundary_t(s1, P.xy[2 * p_exit], P.xy[2 * p_exit + 1])
+        t2 = boundary_t(s2, P.xy[2 * p_entry], P.xy[2 * p_entry + 1])
+        if t2 == t1:
+            # the two points round to one double (degenerate case: an excursion of the cell outside
+            # the box, or a wedge inside it, thinner than the rounding): their exact order decides
+            count = 4 if compare_along(P, b, s1, p_entry, p_exit) < 0 else 0
         else:
-            # the two points round to one: the long way round is taken only by a cell that meets the
-            # boundary once and holds the next corner (degenerate case: an excursion thinner than an ulp)
-            count = 4 if n_gaps == 1 and owns_corner(b, (s1 + 1) % 4, ix, iy, nbx, nby, m) else 0
+            count = 0 if t2 > t1 else 4
     for k in range(1, count + 1):
-        ring[n] = corner0 + (s1 + k) % 4
+        ring[n] = P.corner0 + (s1 + k) % 4
         n += 1
     return n
 
 
 cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t* end_pt,
                           const signed char* entry, const signed char* exit_, const signed char* has,
-                          const double* pts, const signed char* pt_side, int corner0,
-                          double ix, double iy, const double* nbx, const double* nby,
+                          Points* P, double ix, double iy, const double* nbx, const double* nby,
                           int32_t* ring) noexcept nogil:
     """The ring of one cell from its m edges in counter-clockwise order (edge q's part runs from point
-    start_pt[q] to end_pt[q] of pts, interleaved x, y; pt_side gives the boundary side of the points
-    that start or end on the boundary). Writes point ids to ring (room for 2 m + 4), returns the count
-    before repeats are dropped, or -1 if the parts do not chain (an inconsistent input)."""
-    cdef int q, q0 = -1, n = 0, n_gaps = 0, k, s1, s2, count, step, last_exit = -1, first_entry = -1
-    cdef double t1, t2
+    start_pt[q] to end_pt[q] of P; nbx, nby are the neighbours' sites). Writes point ids to ring (room
+    for 2 m + 4), returns the count before repeats are dropped, or -1 if the parts do not chain (an
+    inconsistent input)."""
+    cdef int q, q0 = -1, n = 0, k, step, last_exit = -1, first_entry = -1
     cdef bint any_part = False
     for q in range(m):
         if has[q]:
             any_part = True
-            if entry[q]:
-                n_gaps += 1
-                if q0 < 0:
-                    q0 = q
+            if entry[q] and q0 < 0:
+                q0 = q
     if not any_part:
         # the box lies wholly inside the cell or wholly outside it
         if owns_corner(b, 0, ix, iy, nbx, nby, m):
             for k in range(4):
-                ring[k] = corner0 + k
+                ring[k] = P.corner0 + k
             return 4
         return 0
     if q0 < 0:
@@ -302,8 +362,7 @@ cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t*
             continue
         if entry[q]:
             if last_exit >= 0:
-                n = walk_gap(b, last_exit, start_pt[q], pts, pt_side, corner0, n_gaps, ix, iy, nbx, nby, m,
-                             ring, n)
+                n = walk_gap(b, P, last_exit, start_pt[q], ring, n)
             elif first_entry < 0:
                 first_entry = start_pt[q]
             last_exit = -1
@@ -318,7 +377,7 @@ cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t*
     if last_exit >= 0:
         if first_entry < 0:
             return -1
-        n = walk_gap(b, last_exit, first_entry, pts, pt_side, corner0, n_gaps, ix, iy, nbx, nby, m, ring, n)
+        n = walk_gap(b, P, last_exit, first_entry, ring, n)
     elif first_entry >= 0:
         return -1
     return n

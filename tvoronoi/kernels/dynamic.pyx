@@ -10,8 +10,8 @@ from tvoronoi.kernels.mesh cimport (
 )
 from libc.stdlib cimport malloc, free
 from tvoronoi.kernels.clipper cimport (
-    Box, EdgePart, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
-    finish_ring,
+    Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge,
+    walk_cell, finish_ring,
 )
 from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.fortune cimport sweep_triangles
@@ -420,6 +420,9 @@ cdef struct CellBuffers:
     int32_t* ring          # point ids of the ring, 2 star + 4
     double* pts            # interleaved x, y: star vertices, 2 star crossings, 4 corners
     signed char* pt_side
+    int32_t* da            # how each boundary point was made (clipper.Points)
+    int32_t* db
+    int32_t* dc
     signed char* vcx       # per triangle: the vertex's codes against the box
     signed char* vcy
     int32_t* c_start       # per edge: its part in the box
@@ -435,6 +438,9 @@ cdef bint alloc_cell_buffers(CellBuffers* b, int star) noexcept nogil:
     b.ring = <int32_t*> malloc((2 * star + 8) * sizeof(int32_t))
     b.pts = <double*> malloc(2 * (3 * star + 8) * sizeof(double))
     b.pt_side = <signed char*> malloc(3 * star + 8)
+    b.da = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
+    b.db = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
+    b.dc = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
     b.vcx = <signed char*> malloc(star + 1)
     b.vcy = <signed char*> malloc(star + 1)
     b.c_start = <int32_t*> malloc((star + 1) * sizeof(int32_t))
@@ -445,13 +451,15 @@ cdef bint alloc_cell_buffers(CellBuffers* b, int star) noexcept nogil:
     b.nbx = <double*> malloc((star + 1) * sizeof(double))
     b.nby = <double*> malloc((star + 1) * sizeof(double))
     return (b.ring != NULL and b.pts != NULL and b.pt_side != NULL and b.vcx != NULL and b.vcy != NULL
+            and b.da != NULL and b.db != NULL and b.dc != NULL
             and b.c_start != NULL and b.c_end != NULL and b.c_entry != NULL and b.c_exit != NULL
             and b.c_has != NULL and b.nbx != NULL and b.nby != NULL)
 
 
 cdef void free_cell_buffers(CellBuffers* b) noexcept nogil:
     free(b.ring); free(b.pts); free(b.pt_side); free(b.vcx); free(b.vcy); free(b.c_start); free(b.c_end)
-    free(b.c_entry); free(b.c_exit); free(b.c_has); free(b.nbx); free(b.nby)
+    free(b.c_entry); free(b.c_exit); free(b.c_has); free(b.nbx); free(b.nby); free(b.da); free(b.db)
+    free(b.dc)
 
 
 cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
@@ -460,6 +468,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
     cdef int e0 = m.vedge[site], e, k = 0, q, p, nxq, j, a, c, n_pts, corner0, n_edges = 0, count
     cdef double sx = m.x[site], sy = m.y[site]
     cdef EdgePart part
+    cdef Points P
     cdef bint has_o, has_d
     # the triangles around the site, counter-clockwise: triangle q is (site, nb q, nb q+1), and its
     # circumcentre is the cell's vertex q (the same double in every cell that has it)
@@ -478,6 +487,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
                                  sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], True)
             if code_in(b.vcx[k]) and code_in(b.vcy[k]):
                 b.pt_side[k] = code_side(b.vcx[k], b.vcy[k])
+            b.da[k] = site; b.db[k] = a; b.dc[k] = c
         b.c_start[k] = m.tv[nxt(e)]                          # the neighbour of edge k, for now
         k += 1
         e = m.opp[prv(e)]
@@ -505,6 +515,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
             if part.start_at == AT_POINT:
                 b.pts[2 * n_pts] = part.sx; b.pts[2 * n_pts + 1] = part.sy
                 b.pt_side[n_pts] = part.s_side
+                b.da[n_pts] = site; b.db[n_pts] = j; b.dc[n_pts] = -1
                 b.ring[n_edges] = n_pts            # parked here until the edges are all known
                 n_pts += 1
             else:
@@ -512,6 +523,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
             if part.end_at == AT_POINT:
                 b.pts[2 * n_pts] = part.ex; b.pts[2 * n_pts + 1] = part.ey
                 b.pt_side[n_pts] = part.e_side
+                b.da[n_pts] = site; b.db[n_pts] = j; b.dc[n_pts] = -1
                 b.c_end[n_edges] = n_pts
                 n_pts += 1
             else:
@@ -524,8 +536,17 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
         b.pts[2 * (corner0 + c)] = box.kx[c]
         b.pts[2 * (corner0 + c) + 1] = box.ky[c]
         b.pt_side[corner0 + c] = c
-    count = walk_cell(box, n_edges, b.c_start, b.c_end, b.c_entry, b.c_exit, b.c_has, b.pts, b.pt_side,
-                      corner0, sx, sy, b.nbx, b.nby, b.ring)
+        b.da[corner0 + c] = -1
+    P.xy = b.pts
+    P.side = b.pt_side
+    P.da = b.da
+    P.db = b.db
+    P.dc = b.dc
+    P.sx = m.x
+    P.sy = m.y
+    P.corner0 = corner0
+    count = walk_cell(box, n_edges, b.c_start, b.c_end, b.c_entry, b.c_exit, b.c_has, &P, sx, sy, b.nbx,
+                      b.nby, b.ring)
     if count <= 0:
         return 0
     return finish_ring(b.ring, count, b.pts, box.e)
