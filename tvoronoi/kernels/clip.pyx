@@ -6,7 +6,7 @@ from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
-    finish_ring,
+    finish_ring, first_right_turn, turn,
 )
 
 cdef enum:
@@ -67,7 +67,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef signed char[::1] c_has = np.empty(max_deg + 1, np.int8)
     cdef double[::1] nbx = np.empty(max_deg + 1, np.float64)
     cdef double[::1] nby = np.empty(max_deg + 1, np.float64)
-    cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0
+    cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0, n_bent = 0
     cdef int64_t n_ring = 0
     cdef double x, y
     cdef EdgePart part
@@ -175,7 +175,10 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 if h == face_edge[i]:
                     break
             if h == face_edge[i] and cnt > 0:
-                n_ring += finish_ring(&ring[n_ring], cnt, &pts[0, 0], e)
+                k = finish_ring(&ring[n_ring], cnt, &pts[0, 0], e)
+                if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0], e) >= 0:
+                    n_bent += 1
+                n_ring += k
                 continue
             # a cell that meets the box boundary
             h = face_edge[i]
@@ -198,11 +201,156 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if k < 0:
                 status = 1
                 continue
-            n_ring += finish_ring(&ring[n_ring], k, &pts[0, 0], e)
+            k = finish_ring(&ring[n_ring], k, &pts[0, 0], e)
+            if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0], e) >= 0:
+                n_bent += 1
+            n_ring += k
         offsets[n] = n_ring
 
-    return (np.asarray(pts)[:n_pts].copy(), np.asarray(offsets),
-            np.asarray(ring)[:n_ring].copy(), status)
+    points = np.asarray(pts)[:n_pts].copy()
+    rings = np.asarray(ring)[:n_ring].copy()
+    offs = np.asarray(offsets)
+    if n_bent:
+        kind = np.full(n_pts, 2, np.int8)               # an interior vertex
+        on_side = (np.abs(np.asarray(vcx)[:m]) == 1) | (np.abs(np.asarray(vcy)[:m]) == 1)
+        kind[:m][on_side] = 1                            # a vertex on the boundary
+        kind[m:corner0] = 1                              # a crossing
+        kind[corner0:] = 0                               # a corner
+        offs, rings = straighten(points, offs, rings, kind, e)
+    return points, offs, rings, status
+
+
+def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind, int e):
+    """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
+    cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
+    neighbours and an edge of the ring crosses another).
+
+    In a ring that is not simple, each vertex at a right turn is merged with the nearer of its two
+    ring neighbours, in every ring that has it (so neighbouring cells keep matching edges); merges keep
+    the point that is a corner, else one on the box boundary, else the lowest (y, then x), so the
+    result depends on the geometry alone, not on an engine's numbering. Repeats until every ring is
+    simple: every cell is then a simple counter-clockwise polygon, and such a subdivision covers the
+    box exactly once. A cell can vanish (all its vertices merged): a cell thinner than the rounding
+    everywhere.
+
+    Returns the new (offsets, rings).
+    """
+    cdef Py_ssize_t n_pts = points.shape[0]
+    parent_arr = np.arange(n_pts, dtype=np.int32)
+    cdef int32_t[::1] parent = parent_arr
+    cdef const double* xy = &points[0, 0]
+    cdef int32_t[::1] rv
+    cdef int64_t[::1] ov
+    cdef int n_cells = len(offsets) - 1, i, k, cnt, v, u, w, t, ru, rt, changed, guard
+    cdef int64_t lo, hi
+    cdef double du, dw
+    for guard in range(n_pts):
+        rv = rings
+        ov = offsets
+        changed = 0
+        # merge each right-turn vertex with its nearer ring neighbour
+        for i in range(n_cells):
+            lo = ov[i]
+            cnt = <int> (ov[i + 1] - lo)
+            if cnt == 0:
+                continue
+            if first_right_turn(&rv[lo], cnt, xy, e) < 0 or ring_is_simple(&rv[lo], cnt, xy, e):
+                continue
+            for k in range(cnt):
+                v = rv[lo + k]
+                u = rv[lo + (k + cnt - 1) % cnt]
+                w = rv[lo + (k + 1) % cnt]
+                if turn(xy, u, v, w, e) >= 0:
+                    continue
+                du = (xy[2 * u] - xy[2 * v]) ** 2 + (xy[2 * u + 1] - xy[2 * v + 1]) ** 2
+                dw = (xy[2 * w] - xy[2 * v]) ** 2 + (xy[2 * w + 1] - xy[2 * v + 1]) ** 2
+                t = u if (du < dw or (du == dw and before(xy, kind, u, w))) else w
+                ru = find(&parent[0], v)
+                rt = find(&parent[0], t)
+                if ru != rt:
+                    if before(xy, kind, ru, rt):
+                        parent[rt] = ru
+                    else:
+                        parent[ru] = rt
+                    changed += 1
+        if changed == 0:
+            break
+        # every ring through a merged point, again
+        for v in range(n_pts):
+            parent[v] = find(&parent[0], v)
+        rings = parent_arr[rings]
+        new_rings = np.empty_like(rings)
+        new_offsets = np.zeros_like(offsets)
+        rv = rings
+        ov = offsets
+        nv = new_rings
+        cdef_fill(ov, rv, new_offsets, nv, xy, e)
+        offsets = new_offsets
+        rings = new_rings[:new_offsets[-1]].copy()
+    return offsets, rings
+
+
+cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_offsets, int32_t[::1] nv,
+                    const double* xy, int e):
+    cdef int i, k, n_cells = ov.shape[0] - 1
+    cdef int64_t out = 0, lo
+    for i in range(n_cells):
+        new_offsets[i] = out
+        lo = ov[i]
+        k = <int> (ov[i + 1] - lo)
+        for j in range(k):
+            nv[out + j] = rv[lo + j]
+        out += finish_ring(&nv[out], k, xy, e)
+    new_offsets[n_cells] = out
+
+
+cdef bint ring_is_simple(const int32_t* ring, int k, const double* xy, int e) noexcept nogil:
+    # no two edges that do not follow each other meet (exact; rings are small, pairs are checked)
+    cdef int a, b
+    for a in range(k):
+        for b in range(a + 2, k):
+            if a == 0 and b == k - 1:
+                continue
+            if segments_meet(xy, ring[a], ring[(a + 1) % k], ring[b], ring[(b + 1) % k], e):
+                return False
+    return True
+
+
+cdef inline bint on_segment(const double* xy, int p, int q, int r) noexcept nogil:
+    # r, collinear with p and q, lies within their bounding box
+    return (min(xy[2 * p], xy[2 * q]) <= xy[2 * r] <= max(xy[2 * p], xy[2 * q])
+            and min(xy[2 * p + 1], xy[2 * q + 1]) <= xy[2 * r + 1] <= max(xy[2 * p + 1], xy[2 * q + 1]))
+
+
+cdef bint segments_meet(const double* xy, int p, int q, int r, int s, int e) noexcept nogil:
+    cdef int o1 = turn(xy, p, q, r, e), o2 = turn(xy, p, q, s, e)
+    cdef int o3 = turn(xy, r, s, p, e), o4 = turn(xy, r, s, q, e)
+    if o1 * o2 < 0 and o3 * o4 < 0:
+        return True
+    return ((o1 == 0 and on_segment(xy, p, q, r)) or (o2 == 0 and on_segment(xy, p, q, s))
+            or (o3 == 0 and on_segment(xy, r, s, p)) or (o4 == 0 and on_segment(xy, r, s, q)))
+
+
+cdef inline bint before(const double* xy, const signed char[::1] kind, int p, int q) noexcept nogil:
+    # the point kept when p and q merge: a corner, else on the boundary, else the lowest (y, then x)
+    if kind[p] != kind[q]:
+        return kind[p] < kind[q]
+    if xy[2 * p + 1] != xy[2 * q + 1]:
+        return xy[2 * p + 1] < xy[2 * q + 1]
+    if xy[2 * p] != xy[2 * q]:
+        return xy[2 * p] < xy[2 * q]
+    return p < q
+
+
+cdef inline int find(int32_t* parent, int p) noexcept nogil:
+    cdef int root = p, up
+    while parent[root] != root:
+        root = parent[root]
+    while parent[p] != root:
+        up = parent[p]
+        parent[p] = root
+        p = up
+    return root
 
 
 def bisector_crossing(double ax, double ay, double bx, double by, double t, bint along_y, int e=0) -> float:

@@ -400,6 +400,15 @@ cdef inline int sgn(double v) noexcept nogil:
     return (v > 0.0) - (v < 0.0)
 
 
+cdef inline int turn(const double* pts, int a, int b, int c, int e) noexcept nogil:
+    """Exact orientation of three output points, taken in the scaled unit 2^-e where no product under-
+    or overflows (the user's unit itself when e is moderate: scaling changes no sign)."""
+    if -300 < e < 300:
+        return orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1])
+    return orient2d(ldexp(pts[2 * a], -e), ldexp(pts[2 * a + 1], -e), ldexp(pts[2 * b], -e),
+                    ldexp(pts[2 * b + 1], -e), ldexp(pts[2 * c], -e), ldexp(pts[2 * c + 1], -e))
+
+
 cdef inline bint folds_back(const double* pts, int a, int b, int c, int e) noexcept nogil:
     """a -> b -> c turns back on itself (degenerate case: exact vertices closer than rounding, so a
     convex turn became a spike): c equals a, or the three are collinear and the path reverses.
@@ -411,8 +420,7 @@ cdef inline bint folds_back(const double* pts, int a, int b, int c, int e) noexc
     # are exact); a convex turn of a ring mostly reverses at most one, so the exact test is rare
     if not (rx <= 0 and ry <= 0 and (rx < 0 or ry < 0)):
         return False
-    return orient2d(ldexp(pts[2 * a], -e), ldexp(pts[2 * a + 1], -e), ldexp(pts[2 * b], -e),
-                    ldexp(pts[2 * b + 1], -e), ldexp(pts[2 * c], -e), ldexp(pts[2 * c + 1], -e)) == 0
+    return turn(pts, a, b, c, e) == 0
 
 
 cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noexcept nogil:
@@ -460,3 +468,14 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noex
     reverse(ring, start, j)
     reverse(ring, 0, j)
     return j
+
+
+cdef inline int first_right_turn(const int32_t* ring, int n, const double* pts, int e) noexcept nogil:
+    """The position in a finished ring of its first right turn (a vertex that rounding moved across the
+    line of its neighbours: the cell around it is thinner than the rounding there), or -1: every turn
+    is to the left and the ring is convex."""
+    cdef int k
+    for k in range(n):
+        if turn(pts, ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n], e) < 0:
+            return k
+    return -1
