@@ -121,7 +121,11 @@ def _clip(u0, v0, u1, v1, width: int, height: int):
             t0 = np.where(p < 0, np.maximum(t0, r), t0)
             t1 = np.where(p > 0, np.minimum(t1, r), t1)
     keep &= t0 <= t1
-    return keep, t0, t1, u0 + t0 * du, v0 + t0 * dv, u0 + t1 * du, v0 + t1 * dv
+    # an end the clip did not move is returned as given (u0 + 1 * du can differ from u1 by an ulp)
+    start, end = t0 == 0, t1 == 1
+    return (keep, t0, t1,
+            np.where(start, u0, u0 + t0 * du), np.where(start, v0, v0 + t0 * dv),
+            np.where(end, u1, u0 + t1 * du), np.where(end, v1, v0 + t1 * dv))
 
 
 def clip_segments(seg: np.ndarray, bbox) -> np.ndarray:
