@@ -10,7 +10,7 @@ from tvoronoi.api import ENGINES, as_bbox, as_points, default_bbox
 from tvoronoi.build import assemble, collinear_dcel, sweep_order
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
-from tvoronoi.kernels import dcel, delaunay, dynamic, fortune
+from tvoronoi.kernels import dcel, delaunay, dynamic, fortune, order
 
 # Without a global rescaling, the exact predicates stay exact (no product over- or
 # underflows) for coordinates that are 0 or within this range in magnitude.
@@ -129,8 +129,7 @@ class DynamicVoronoi:
             ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
         else:
             # a biased randomized insertion order, as in the batch engine
-            rank = np.random.default_rng(0).permutation(len(ids)).astype(np.int64)
-            perm = np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+            perm = order.brio_order(xs, ys, 0)
             sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
             status, tv, opp, dup = delaunay.triangulate(sx, sy)
             ok = status == delaunay.STATUS_OK
