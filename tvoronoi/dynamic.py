@@ -227,6 +227,8 @@ class DynamicVoronoi:
             self._rebuild()
             return np.append(self._holders(), i).astype(np.int32)
         status = self._mesh.remove_swept(i) if self.engine == "fortune" else self._mesh.remove(i)
+        if status == dynamic.NO_MEMORY:
+            raise MemoryError(f"no memory to remove site {i}: the diagram is unchanged")
         if status != 0:
             # the sites left are collinear (or the hole was beyond the local repair): start again
             self._alive[i] = False
