@@ -231,3 +231,26 @@ def test_out_of_memory_changes_nothing(engine):
     dv._mesh._limit_scratch(-1)
     dv.remove(N)
     assert_cells_match(dv, dv.changed, box)
+
+
+@pytest.mark.xfail(strict=True, reason="cell_ring reads at most 2048 neighbours (MAX_STAR): being rewritten")
+@pytest.mark.parametrize("engine", ENGINES)
+def test_cell_of_a_site_with_10000_neighbours(engine):
+    """The view's cell of the centre of 10,000 sites on a circle: a 10,000-gon. When this passes
+    (strict xfail), drop the marker and CELL_RING_CAP: every check above then reads it too."""
+    pts, r = rounded_circle()
+    box = box_of(r)
+    dv = tvoronoi.DynamicVoronoi(pts, engine=engine, bbox=box)
+    c = dv.insert(0.0, 0.0)
+    assert len(dv.diagram().cell_polygon(c)) == N
+    assert_cells_match(dv, [c], box)
+
+
+@pytest.mark.xfail(strict=True, reason="clip.clip_cells orders at most 4096 points of a cell meeting the box")
+def test_batch_cell_of_a_hull_site_with_10000_edges():
+    """The batch build's cell of the origin below an arc of 10,000 sites: N Voronoi edges
+    (one per neighbour), unbounded, so clipped to the box (its corners below the origin)."""
+    t = np.pi * (np.arange(N) + 0.5) / N
+    pts = np.vstack([[[0.0, 0.0]], np.column_stack([np.cos(t), np.sin(t)])])
+    cell = tvoronoi.voronoi(pts, bbox=box_of(1.0)).cell_polygon(0)
+    assert len(cell) >= N
