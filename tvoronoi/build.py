@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.diagram import Diagram
-from tvoronoi.kernels import clip, dcel, delaunay, fortune
+from tvoronoi.kernels import clip, dcel, delaunay, fortune, order
 
 
 def power_of_two_scale(pts: np.ndarray) -> int:
@@ -83,13 +83,10 @@ def incremental_dcel(xs: np.ndarray, ys: np.ndarray, *, insertion: str, seed: in
     (insertion order), and out holds its Voronoi DCEL and repeats in that
     numbering; its vertices are in the unit 2^exponent times that of xs, ys.
     """
-    n = len(xs)
-    rng = np.random.default_rng(seed)
     if insertion == "brio":
-        rank = rng.permutation(n).astype(np.int64)
-        perm = np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+        perm = order.brio_order(xs, ys, seed)
     else:
-        perm = rng.permutation(n).astype(np.int32)
+        perm = np.random.default_rng(seed).permutation(len(xs)).astype(np.int32)
     xs = np.ascontiguousarray(xs[perm])
     ys = np.ascontiguousarray(ys[perm])
     status, tv, opp, dup = delaunay.triangulate(xs, ys, conflict_lists=(insertion == "random"))

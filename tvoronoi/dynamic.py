@@ -10,7 +10,7 @@ from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox,
 from tvoronoi.build import assemble, collinear_dcel, sweep_order
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
-from tvoronoi.kernels import dcel, delaunay, dynamic, fortune
+from tvoronoi.kernels import dcel, delaunay, dynamic, fortune, order
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
     """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
@@ -123,8 +123,7 @@ class DynamicVoronoi:
             ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
         else:
             # a biased randomized insertion order, as in the batch engine
-            rank = np.random.default_rng(0).permutation(len(ids)).astype(np.int64)
-            perm = np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
+            perm = order.brio_order(xs, ys, 0)
             sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
             status, tv, opp, dup = delaunay.triangulate(sx, sy)
             ok = status == delaunay.STATUS_OK
@@ -223,6 +222,8 @@ class DynamicVoronoi:
             self._rebuild()
             return np.append(self._holders(), i).astype(np.int32)
         status = self._mesh.remove_swept(i) if self.engine == "fortune" else self._mesh.remove(i)
+        if status == dynamic.NO_MEMORY:
+            raise MemoryError(f"no memory to remove site {i}: the diagram is unchanged")
         if status != 0:
             # the sites left are collinear (or the hole was beyond the local repair): start again
             self._alive[i] = False

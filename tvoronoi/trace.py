@@ -14,7 +14,7 @@ import numpy as np
 from tvoronoi.api import as_points, default_bbox, as_bbox
 from tvoronoi.build import assemble, collinear_dcel, power_of_two_scale, sweep_order
 from tvoronoi.diagram import Diagram
-from tvoronoi.kernels import dcel, delaunay, fortune
+from tvoronoi.kernels import dcel, delaunay, fortune, order
 
 KIND_NAMES = {0: "site", 1: "circle", 2: "repeat"}
 
@@ -214,10 +214,8 @@ class IncrementalTrace:
         self._e = power_of_two_scale(self.points)
         xs = np.ldexp(self.points[:, 0], -self._e)
         ys = np.ldexp(self.points[:, 1], -self._e)
-        rng = np.random.default_rng(seed)
-        rank = rng.permutation(n).astype(np.int64)
-        self._perm = (np.argsort(delaunay.brio_keys(xs, ys, rank), kind="stable").astype(np.int32)
-                      if n else np.empty(0, np.int32))
+        # the batch engine's insertion order (build.incremental_dcel)
+        self._perm = order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed)
         self._xs = np.ascontiguousarray(xs[self._perm])
         self._ys = np.ascontiguousarray(ys[self._perm])
         self.n_steps = n

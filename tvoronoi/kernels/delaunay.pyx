@@ -2,8 +2,7 @@
 
 import numpy as np
 
-from libc.stdint cimport int32_t, int64_t, uint32_t
-from libc.math cimport floor
+from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.predicates cimport orient2d
 from tvoronoi.kernels.mesh cimport Mesh, locate, list_site, insert_site
@@ -12,8 +11,6 @@ cdef enum:
     # status codes returned to the API layer
     OK = 0
     COLLINEAR = 1       # fewer than three non-collinear sites: no triangle exists
-    # bits per coordinate of the Hilbert curve that orders each insertion round
-    HILBERT_BITS = 16
 
 STATUS_OK = OK
 STATUS_COLLINEAR = COLLINEAR
@@ -182,65 +179,3 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
         return result + (trace,)
     return result
 
-
-cdef inline uint32_t hilbert_key(uint32_t x, uint32_t y, int bits) noexcept nogil:
-    """Index of cell (x, y) along a Hilbert curve over a 2^bits grid."""
-    cdef uint32_t side = (<uint32_t>1) << bits, s = side >> 1, rx, ry, d = 0, t
-    while s > 0:
-        rx = 1 if (x & s) else 0
-        ry = 1 if (y & s) else 0
-        d += s * s * ((3 * rx) ^ ry)
-        # turn the quadrant so that the curve's pattern repeats inside it
-        if ry == 0:
-            if rx == 1:
-                x = side - 1 - x
-                y = side - 1 - y
-            t = x
-            x = y
-            y = t
-        s >>= 1
-    return d
-
-
-def brio_keys(const double[::1] xs, const double[::1] ys, const int64_t[::1] rank):
-    """Sort keys of a biased randomized insertion order.
-
-    A site of random rank r goes to round floor(log2(r + 1)) (rounds double in
-    size); within a round, sites follow a Hilbert curve over their bounding box.
-
-    Parameters
-    ----------
-    xs, ys : (n,) float64
-    rank : (n,) int64, a random permutation of 0..n-1
-
-    Returns
-    -------
-    keys : (n,) int64, to be argsorted.
-    """
-    cdef Py_ssize_t n = xs.shape[0], i
-    cdef int64_t[::1] keys = np.empty(n, np.int64)
-    if n == 0:
-        return np.asarray(keys)
-    cdef double xmin = xs[0], xmax = xs[0], ymin = ys[0], ymax = ys[0], scale, side
-    cdef uint32_t cells = ((<uint32_t>1) << HILBERT_BITS) - 1, hx, hy
-    cdef int64_t r, rnd
-    with nogil:
-        for i in range(n):
-            xmin = min(xmin, xs[i]); xmax = max(xmax, xs[i])
-            ymin = min(ymin, ys[i]); ymax = max(ymax, ys[i])
-        side = max(xmax - xmin, ymax - ymin)
-        scale = cells / side if side > 0 else 0.0
-        for i in range(n):
-            hx = <uint32_t>floor((xs[i] - xmin) * scale)
-            hy = <uint32_t>floor((ys[i] - ymin) * scale)
-            if hx > cells:
-                hx = cells
-            if hy > cells:
-                hy = cells
-            r = rank[i] + 1
-            rnd = 0
-            while r > 1:
-                r >>= 1
-                rnd += 1
-            keys[i] = (rnd << 32) | <int64_t>hilbert_key(hx, hy, HILBERT_BITS)
-    return np.asarray(keys)

@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from libc.stdint cimport int8_t, int32_t
+from libc.stdint cimport int8_t, int32_t, int64_t, uint64_t
+from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport (
@@ -18,15 +19,31 @@ from tvoronoi.kernels.fortune cimport sweep_triangles
 
 cdef enum:
     INF_VERTEX = 0x7FFFFFFE  # the vertex at infinity of a dynamic mesh (site ids stay below it)
-    MAX_STAR = 2048         # neighbours of one site handled by remove() and cell()
-    MAX_GROUP = 64          # triangles of one cocircular group looked at for its vertex
-    MAX_REGION = 256        # sites swept for one local update by Fortune's engine
-    MAX_HOLE = 64           # hole size filled by a sweep (larger holes are filled by ears)
+    EAR_LIMIT = 64          # holes of up to this many sides are filled ear by ear (O(k^2) tests);
+                            # larger ones by the Delaunay triangles of their sites, spliced in
+    SWEEP_WORTH = 8         # a swept insertion's region is worth sweeping up to this many sites
+    SWEEP_SLACK = 64        #   per cavity edge, plus this many; beyond, the cavity fan is exact and cheaper
+    SMALL_SORT = 32         # up to this many sites are sorted by insertion, more by heap sort
     STATUS_DONE = 0
     STATUS_FLAT = 1         # the sites left are collinear: no triangle remains
+    STATUS_NO_MEMORY = 2    # scratch memory could not grow: the mesh is unchanged
+    STATUS_NOT_SWEPT = 3    # the sweep's triangles do not tile the hole: fill it by ears instead
+    STATUS_STUCK = -1       # no Delaunay ear (impossible with exact predicates): the mesh must be rebuilt
 
 
 INFINITE = INF_VERTEX
+NO_MEMORY = STATUS_NO_MEMORY
+
+
+# scratch memory of one update (a hole, a swept region), kept by the mesh and grown on demand
+cdef struct Scratch:
+    int32_t* ints
+    Py_ssize_t n_ints
+    double* reals
+    Py_ssize_t n_reals
+    int64_t* keys
+    Py_ssize_t n_keys
+    Py_ssize_t limit        # tests only: requests above this many entries fail (-1: no limit)
 
 
 cdef class DynamicMesh:
@@ -45,6 +62,21 @@ cdef class DynamicMesh:
     cdef int32_t mark_epoch
     cdef int32_t* nextb             # scratch: the boundary edge leaving each site
     cdef int cap_v, cap_t
+    cdef Scratch scratch            # scratch of one update, grown to the largest hole or region met
+
+    def __cinit__(self):
+        self.scratch.ints = NULL
+        self.scratch.n_ints = 0
+        self.scratch.reals = NULL
+        self.scratch.n_reals = 0
+        self.scratch.keys = NULL
+        self.scratch.n_keys = 0
+        self.scratch.limit = -1
+
+    def __dealloc__(self):
+        free(self.scratch.ints)
+        free(self.scratch.reals)
+        free(self.scratch.keys)
 
     def __init__(self, int capacity):
         self.cap_v = 0
@@ -167,11 +199,17 @@ cdef class DynamicMesh:
         return -1
 
     def remove(self, int site):
-        """Take a site out and fill its hole with the Delaunay triangles of its neighbours."""
-        cdef int status
+        """Take a site out and fill its hole with the Delaunay triangles of its neighbours:
+        ear by ear, or for a large hole (a site with many neighbours) the Delaunay triangles
+        of the neighbours spliced in. Returns STATUS_DONE, STATUS_FLAT (the sites left are
+        collinear), STATUS_NO_MEMORY (nothing changed) or STATUS_STUCK (rebuild the mesh)."""
+        cdef int status = STATUS_NOT_SWEPT
         self._reserve(site)
         with nogil:
-            status = remove_site(&self.m, site)
+            if star_size(&self.m, site) > EAR_LIMIT:
+                status = remove_by_sweep(&self.m, site, &self.scratch)
+            if status == STATUS_NOT_SWEPT or status == STATUS_NO_MEMORY:
+                status = remove_site(&self.m, site, &self.scratch)
         return status
 
     # -- the same updates the way of Fortune's engine: sweep the changed region, splice the result --
@@ -180,8 +218,9 @@ cdef class DynamicMesh:
         """Insert a site as Fortune's engine does: find the region whose cells the site takes
         (its conflict region), sweep the region's sites with the ring around them, and splice
         the sweep's triangles around the new site in. Returns as insert(). (Where cocircular
-        sites let the sweep's star differ from the region's boundary, the exact cavity fan is
-        spliced instead; swept_ok says which happened.)"""
+        sites let the sweep's star differ from the region's boundary, or the region is far
+        larger than the cavity, e.g. next to a site with thousands of neighbours, the exact
+        cavity fan is spliced instead; swept_ok says which happened.)"""
         cdef int status
         self._reserve(site)
         self.wx[site] = x
@@ -190,7 +229,7 @@ cdef class DynamicMesh:
         self.m.n_changed = 0
         self.mark_epoch += 1
         with nogil:
-            status = insert_by_sweep(&self.m, site, self.vmark, self.mark_epoch, self.nextb)
+            status = insert_by_sweep(&self.m, site, self.vmark, self.mark_epoch, self.nextb, &self.scratch)
         if status == -2:
             return self.m.dup[site]
         self.swept_ok = status == 1
@@ -200,16 +239,18 @@ cdef class DynamicMesh:
 
     def remove_swept(self, int site):
         """Remove a site as Fortune's engine does: sweep the sites around the hole and splice
-        the sweep's triangles inside the hole in (ear filling where the hole is open to
-        infinity, or the sweep's triangles do not fit it exactly). Returns as remove()."""
+        the sweep's triangles inside the hole in (ear filling where the sweep's triangles do
+        not fit it exactly, or its sites are collinear). Returns as remove()."""
         cdef int status
+        cdef bint swept = True
         self._reserve(site)
         with nogil:
-            status = remove_by_sweep(&self.m, site)
-        self.swept_ok = status == 1
-        if status == 1:
-            return STATUS_DONE
-        return self.remove(site)
+            status = remove_by_sweep(&self.m, site, &self.scratch)
+            if status == STATUS_NOT_SWEPT or status == STATUS_NO_MEMORY:
+                swept = False
+                status = remove_site(&self.m, site, &self.scratch)
+        self.swept_ok = swept
+        return status
 
     def relabel(self, int old, int new):
         """Give the vertex of site old to site new (a repeated point taking over its place)."""
@@ -226,6 +267,11 @@ cdef class DynamicMesh:
                 break
         self.m.vedge[new] = e0
         self.m.vedge[old] = -1
+
+    def _limit_scratch(self, Py_ssize_t entries):
+        """Tests only: make scratch requests above this many entries fail as if memory ran out
+        (-1: no limit)."""
+        self.scratch.limit = entries
 
     def changed(self):
         """Sites whose cells the last insert or remove changed."""
@@ -287,7 +333,68 @@ cdef class DynamicMesh:
 
 
 # ---------------------------------------------------------------------------------------------------------
-# removal: the hole is filled ear by ear, each ear a Delaunay triangle of the hole's vertices
+# scratch memory of one update: grown to the largest hole or region met, kept by the mesh
+
+cdef bint reserve(Scratch* s, Py_ssize_t n_ints, Py_ssize_t n_reals, Py_ssize_t n_keys) noexcept nogil:
+    """Room for n_ints int32, n_reals doubles and n_keys int64 (contents are not kept);
+    False when memory runs out (the buffers there are left as they were)."""
+    cdef void* p
+    if s.limit >= 0 and (n_ints > s.limit or n_reals > s.limit or n_keys > s.limit):
+        return False
+    if n_ints > s.n_ints:
+        n_ints = max(n_ints, 2 * s.n_ints)
+        p = malloc(n_ints * sizeof(int32_t))
+        if p == NULL:
+            return False
+        free(s.ints)
+        s.ints = <int32_t*>p
+        s.n_ints = n_ints
+    if n_reals > s.n_reals:
+        n_reals = max(n_reals, 2 * s.n_reals)
+        p = malloc(n_reals * sizeof(double))
+        if p == NULL:
+            return False
+        free(s.reals)
+        s.reals = <double*>p
+        s.n_reals = n_reals
+    if n_keys > s.n_keys:
+        n_keys = max(n_keys, 2 * s.n_keys)
+        p = malloc(n_keys * sizeof(int64_t))
+        if p == NULL:
+            return False
+        free(s.keys)
+        s.keys = <int64_t*>p
+        s.n_keys = n_keys
+    return True
+
+
+# ---------------------------------------------------------------------------------------------------------
+# removal: the hole is filled ear by ear, each ear a Delaunay triangle of the hole's vertices;
+# a large hole by the Delaunay triangles of its vertices, spliced in (see remove_by_sweep)
+
+cdef int star_size(Mesh* m, int v) noexcept nogil:
+    """Triangles around site v (its neighbours, the vertex at infinity included)."""
+    cdef int e0 = m.vedge[v], e = e0, k = 0
+    while True:
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            return k
+
+
+cdef void collect_hole(Mesh* m, int v, int32_t* poly, int32_t* outs, int32_t* slots) noexcept nogil:
+    """The hole that v leaves, counter-clockwise: its vertices poly (the ends of v's edges), the
+    half-edges outs outside each side poly[q] -> poly[q + 1], and the star's triangles slots."""
+    cdef int e0 = m.vedge[v], e = e0, k = 0
+    while True:
+        poly[k] = m.tv[nxt(e)]
+        outs[k] = m.opp[nxt(e)]
+        slots[k] = e // 3
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            return
+
 
 cdef inline bint ear_ok(Mesh* m, int* poly, int* nextp, int a, int b, int c) noexcept nogil:
     """Triangle (poly[a], poly[b], poly[c]) of consecutive hole vertices is Delaunay among them."""
@@ -343,31 +450,43 @@ cdef int new_triangle(Mesh* m, int a, int b, int c, int o_ab, int o_bc, int o_ca
     return T
 
 
-cdef int remove_site(Mesh* m, int v) noexcept nogil:
-    cdef int poly[MAX_STAR]
-    cdef int out[MAX_STAR]
-    cdef int nextp[MAX_STAR]
-    cdef int prevp[MAX_STAR]
-    cdef int e0 = m.vedge[v], e, ne, k = 0, q, t, a, b, c, j, tries, remaining, T
+cdef void repair_last(Mesh* m, int v, const int32_t* outs, int k) noexcept nogil:
+    """If the walks' starting triangle went with the hole of v, take the finite one beyond a side."""
+    cdef int q
+    if m.last < 0 or is_infinite(m, m.last) or m.tv[3 * m.last] == v or m.tv[3 * m.last + 1] == v \
+            or m.tv[3 * m.last + 2] == v:
+        for q in range(k):
+            if outs[q] >= 0 and not is_infinite(m, outs[q] // 3):
+                m.last = outs[q] // 3
+                break
+
+
+cdef int remove_site(Mesh* m, int v, Scratch* sc) noexcept nogil:
+    """Remove site v and fill its hole ear by ear. Returns STATUS_DONE, STATUS_FLAT,
+    STATUS_NO_MEMORY (before any change) or STATUS_STUCK."""
+    cdef int k = star_size(m, v), q, t, a, b, c, j, tries, remaining, T
+    cdef int32_t* poly
+    cdef int32_t* out
+    cdef int32_t* nextp
+    cdef int32_t* prevp
+    cdef int32_t* slots
     cdef bint found
-    m.n_changed = 0
+    if not reserve(sc, 5 * k, 0, 0):
+        return STATUS_NO_MEMORY
+    poly = sc.ints
+    out = poly + k
+    nextp = out + k
+    prevp = nextp + k
+    slots = prevp + k
     # the star of v: its triangles go, the edges opposite v bound the hole (counter-clockwise)
-    e = e0
-    while True:
-        t = e // 3
-        if k == MAX_STAR:
-            return -1
+    collect_hole(m, v, poly, out, slots)
+    m.n_changed = 0
+    for q in range(k):
+        t = slots[q]
         if not is_infinite(m, t):
             m.n_finite -= 1
-        ne = nxt(e)
-        poly[k] = m.tv[ne]
-        out[k] = m.opp[ne]
         m.free_tri[m.n_free] = t
         m.n_free += 1
-        k += 1
-        e = m.opp[prv(e)]
-        if e == e0:
-            break
     m.vedge[v] = -1
     for q in range(k):
         nextp[q] = q + 1 if q + 1 < k else 0
@@ -375,19 +494,20 @@ cdef int remove_site(Mesh* m, int v) noexcept nogil:
         if poly[q] != m.inf:
             m.changed[m.n_changed] = poly[q]
             m.n_changed += 1
+    # cut ears until a triangle is left
     remaining = k
     j = 0
     while remaining > 3:
         found = False
         tries = 0
         while tries < remaining:
-            if ear_ok(m, poly, nextp, prevp[j], j, nextp[j]):
+            if ear_ok(m, <int*>poly, <int*>nextp, prevp[j], j, nextp[j]):
                 found = True
                 break
             j = nextp[j]
             tries += 1
         if not found:
-            return -1
+            return STATUS_STUCK
         a = prevp[j]
         c = nextp[j]
         T = new_triangle(m, poly[a], poly[j], poly[c], out[a], out[j], -1)
@@ -402,13 +522,110 @@ cdef int remove_site(Mesh* m, int v) noexcept nogil:
     new_triangle(m, poly[a], poly[b], poly[c], out[a], out[b], out[c])
     if m.n_finite == 0:
         return STATUS_FLAT
-    if m.last < 0 or is_infinite(m, m.last) or m.tv[3 * m.last] == v or m.tv[3 * m.last + 1] == v \
-            or m.tv[3 * m.last + 2] == v:
-        # the walks' starting triangle went with the hole: take the finite one beyond a new hull edge
-        for q in range(k):
-            if out[q] >= 0 and not is_infinite(m, out[q] // 3):
-                m.last = out[q] // 3
-                break
+    repair_last(m, v, out, k)
+    return STATUS_DONE
+
+
+cdef inline Py_ssize_t slot_of(const int64_t* keys, Py_ssize_t mask, int64_t key) noexcept nogil:
+    """The slot of a hash table (linear probing, -1 for empty) that holds key, or where it goes."""
+    cdef uint64_t h = <uint64_t>key * <uint64_t>0x9E3779B97F4A7C15
+    cdef Py_ssize_t i = <Py_ssize_t>((h ^ (h >> 29)) & <uint64_t>mask)
+    while keys[i] != -1 and keys[i] != key:
+        i = (i + 1) & mask
+    return i
+
+
+cdef int splice_hole(Mesh* m, int v, int k, const int32_t* poly, const int32_t* outs,
+                     const int32_t* slots, const int32_t* tvl, int nt, const int32_t* pos, int n_local,
+                     int32_t* inside, int64_t* keys, int32_t* half, Py_ssize_t mask) noexcept nogil:
+    """Fill the hole of v (k sides, from collect_hole) with those of the nt triangles tvl that
+    lie inside it, when they tile it exactly; returns STATUS_DONE, STATUS_FLAT, or
+    STATUS_NOT_SWEPT with the mesh unchanged.
+
+    tvl is a Delaunay triangulation of the hole's sites: local vertex j is the hole's vertex
+    pos[j], local vertex n_local the vertex at infinity (pos[n_local]: its place in the hole,
+    or -1 when the hole is closed). Scratch: inside (3k), and a hash table keys, half of
+    mask + 1 slots (at least twice 3k) from half-edges x -> y (hole positions) to half-edges.
+    """
+    cdef int q, j, x, y, z, n_in = 0, T, pa, pb, pc
+    cdef int64_t key
+    cdef Py_ssize_t h
+    # the triangles inside the hole meet its vertices in its own cyclic order
+    for q in range(nt):
+        pa = pos[tvl[3 * q]]
+        pb = pos[tvl[3 * q + 1]]
+        pc = pos[tvl[3 * q + 2]]
+        if pa < 0 or pb < 0 or pc < 0:
+            continue                # an infinite triangle of the sites, the hole being closed
+        if (pb - pa + k) % k + (pc - pb + k) % k + (pa - pc + k) % k == k:
+            if n_in == k - 2:
+                return STATUS_NOT_SWEPT
+            inside[3 * n_in] = pa
+            inside[3 * n_in + 1] = pb
+            inside[3 * n_in + 2] = pc
+            n_in += 1
+    if n_in != k - 2:
+        return STATUS_NOT_SWEPT
+    # every half-edge once, every side of the hole among them, every other one with its twin
+    for h in range(mask + 1):
+        keys[h] = -1
+    for q in range(3 * n_in):
+        x = inside[q]
+        y = inside[q - q % 3 + (q % 3 + 1) % 3]
+        key = <int64_t>x * k + y
+        h = slot_of(keys, mask, key)
+        if keys[h] == key:
+            return STATUS_NOT_SWEPT
+        keys[h] = key
+        half[h] = q
+    for q in range(k):
+        key = <int64_t>q * k + (q + 1) % k
+        if keys[slot_of(keys, mask, key)] != key:
+            return STATUS_NOT_SWEPT     # a side is missing: cocircular sites triangulated another way
+    for q in range(3 * n_in):
+        x = inside[q]
+        y = inside[q - q % 3 + (q % 3 + 1) % 3]
+        if y != (x + 1) % k:
+            key = <int64_t>y * k + x
+            if keys[slot_of(keys, mask, key)] != key:
+                return STATUS_NOT_SWEPT
+    # splice: the star's slots are freed, the new triangles take them
+    m.n_changed = 0
+    for q in range(k):
+        if not is_infinite(m, slots[q]):
+            m.n_finite -= 1
+        m.free_tri[m.n_free] = slots[q]
+        m.n_free += 1
+        if poly[q] != m.inf:
+            m.changed[m.n_changed] = poly[q]
+            m.n_changed += 1
+    m.vedge[v] = -1
+    for q in range(n_in):
+        m.n_free -= 1
+        T = m.free_tri[m.n_free]
+        for j in range(3):
+            x = inside[3 * q + j]
+            y = inside[3 * q + (j + 1) % 3]
+            z = poly[x]
+            m.tv[3 * T + j] = z
+            if z != m.inf:
+                m.vedge[z] = 3 * T + j
+            half[slot_of(keys, mask, <int64_t>x * k + y)] = 3 * T + j
+        if not is_infinite(m, T):
+            m.n_finite += 1
+            m.last = T
+    for q in range(3 * n_in):
+        x = inside[q]
+        y = inside[q - q % 3 + (q % 3 + 1) % 3]
+        h = half[slot_of(keys, mask, <int64_t>x * k + y)]
+        if y == (x + 1) % k:
+            m.opp[h] = outs[x]
+            m.opp[outs[x]] = h
+        else:
+            m.opp[h] = half[slot_of(keys, mask, <int64_t>y * k + x)]
+    if m.n_finite == 0:
+        return STATUS_FLAT
+    repair_last(m, v, outs, k)
     return STATUS_DONE
 
 
@@ -555,10 +772,47 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # local updates by Fortune's sweep
 
-cdef void sort_by_sweep(int* ids, double* xs, double* ys, int n) noexcept nogil:
-    """Sort sites by y, then x (insertion sort: a region has a few dozen sites)."""
-    cdef int k, j, v
+cdef inline bint sweeps_first(const double* xs, const double* ys, int a, int b) noexcept nogil:
+    """Site a comes before site b in the sweep: by y, then x."""
+    return ys[a] < ys[b] or (ys[a] == ys[b] and xs[a] < xs[b])
+
+
+cdef inline void swap_sites(int32_t* ids, double* xs, double* ys, int a, int b) noexcept nogil:
+    cdef int32_t i = ids[a]
+    cdef double t = xs[a]
+    ids[a] = ids[b]; ids[b] = i
+    xs[a] = xs[b]; xs[b] = t
+    t = ys[a]; ys[a] = ys[b]; ys[b] = t
+
+
+cdef void sift_down(int32_t* ids, double* xs, double* ys, int root, int end) noexcept nogil:
+    """Restore the max-heap (in sweep order) below root, in sites [0, end)."""
+    cdef int child
+    while True:
+        child = 2 * root + 1
+        if child >= end:
+            return
+        if child + 1 < end and sweeps_first(xs, ys, child, child + 1):
+            child += 1
+        if not sweeps_first(xs, ys, root, child):
+            return
+        swap_sites(ids, xs, ys, root, child)
+        root = child
+
+
+cdef void sort_by_sweep(int32_t* ids, double* xs, double* ys, int n) noexcept nogil:
+    """Sort sites by y, then x, carrying ids along (insertion sort for a few dozen sites,
+    heap sort for more: no scratch memory either way)."""
+    cdef int k, j
+    cdef int32_t v
     cdef double x, y
+    if n > SMALL_SORT:
+        for k in range(n // 2 - 1, -1, -1):
+            sift_down(ids, xs, ys, k, n)
+        for k in range(n - 1, 0, -1):
+            swap_sites(ids, xs, ys, 0, k)
+            sift_down(ids, xs, ys, 0, k)
+        return
     for k in range(1, n):
         v = ids[k]; x = xs[k]; y = ys[k]
         j = k - 1
@@ -568,17 +822,30 @@ cdef void sort_by_sweep(int* ids, double* xs, double* ys, int n) noexcept nogil:
         ids[j + 1] = v; xs[j + 1] = x; ys[j + 1] = y
 
 
-cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_t* nextb) noexcept nogil:
-    """1: the sweep's star was spliced; 0: the cavity fan was (cocircular or large region); -2: a repeat."""
-    cdef int ids[MAX_REGION]
-    cdef double xs[MAX_REGION]
-    cdef double ys[MAX_REGION]
-    cdef int32_t tvl[6 * MAX_REGION]
-    cdef int n = 0, q, a, b, e0, e, nt, k, j, lp = -1, matched = 0, nextb_inf = -1
+cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_t* nextb,
+                         Scratch* sc) noexcept nogil:
+    """1: the sweep's star was spliced; 0: the cavity fan was (cocircular sites, a region far
+    larger than the cavity, or no memory to sweep it: the fan needs none); -2: a repeat."""
+    cdef int32_t* ids
+    cdef int32_t* tvl
+    cdef double* xs
+    cdef double* ys
+    cdef int n = 0, q, a, b, e0, e, nt, k, j, lp = -1, matched = 0, nextb_inf = -1, bound = 1
     cdef bint ok = True
     cdef int t0 = locate(m, m.last, m.x[site], m.y[site])
     if not find_cavity(m, site, t0):
         return -2
+    # the region's size, at most: the new site, each boundary site and its neighbours
+    for q in range(m.n_bnd):
+        if m.bnd_a[q] != m.inf:
+            bound += 1 + star_size(m, m.bnd_a[q])
+    if bound > SWEEP_WORTH * m.n_bnd + SWEEP_SLACK or not reserve(sc, bound + 3 * (2 * bound + 2), 2 * bound, 0):
+        fill_cavity(m, site)
+        return 0
+    ids = sc.ints
+    tvl = ids + bound
+    xs = sc.reals
+    ys = xs + bound
     # the region: the new site, the sites whose cells it takes (the cavity's boundary) and their ring
     ids[n] = site
     n += 1
@@ -590,9 +857,6 @@ cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_
             nextb_inf = m.bnd_b[q]
             continue
         if mark[a] != epoch:
-            if n == MAX_REGION:
-                ok = False
-                break
             mark[a] = epoch
             ids[n] = a
             n += 1
@@ -603,9 +867,6 @@ cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_
         while True:
             b = m.tv[nxt(e)]
             if b != m.inf and mark[b] != epoch:
-                if n == MAX_REGION:
-                    ok = False
-                    break
                 mark[b] = epoch
                 nextb[b] = -1
                 ids[n] = b
@@ -613,15 +874,12 @@ cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_
             e = m.opp[prv(e)]
             if e == e0:
                 break
-        if not ok:
-            break
-    if ok:
-        for k in range(n):
-            xs[k] = m.x[ids[k]]
-            ys[k] = m.y[ids[k]]
-        sort_by_sweep(ids, xs, ys, n)
-        nt = sweep_triangles(xs, ys, n, tvl, 2 * MAX_REGION)
-        ok = nt > 0
+    for k in range(n):
+        xs[k] = m.x[ids[k]]
+        ys[k] = m.y[ids[k]]
+    sort_by_sweep(ids, xs, ys, n)
+    nt = sweep_triangles(xs, ys, n, tvl, 2 * bound + 2)
+    ok = nt > 0
     if ok:
         for k in range(n):
             if ids[k] == site:
@@ -644,92 +902,49 @@ cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_
     return 1 if ok else 0
 
 
-cdef int remove_by_sweep(Mesh* m, int site) noexcept nogil:
-    """1 when the hole was filled with the sweep's triangles; 0 when the caller must use ears."""
-    cdef int poly[MAX_HOLE]
-    cdef int outs[MAX_HOLE]
-    cdef int slots[MAX_HOLE]
-    cdef int ids[MAX_HOLE]
-    cdef int pos_of[MAX_HOLE]
-    cdef double xs[MAX_HOLE]
-    cdef double ys[MAX_HOLE]
-    cdef int32_t tvl[6 * MAX_HOLE]
-    cdef int inside[3 * MAX_HOLE]
-    cdef int32_t half[MAX_HOLE * MAX_HOLE]
-    cdef int e0 = m.vedge[site], e, k = 0, q, j, nt, n_in = 0, pa, pb, pc, T, x, y, h
-    e = e0
-    while True:
-        if k == MAX_HOLE:
-            return 0
-        poly[k] = m.tv[nxt(e)]
-        if poly[k] == m.inf:
-            return 0
-        outs[k] = m.opp[nxt(e)]
-        slots[k] = e // 3
-        k += 1
-        e = m.opp[prv(e)]
-        if e == e0:
-            break
+cdef int remove_by_sweep(Mesh* m, int site, Scratch* sc) noexcept nogil:
+    """Remove a site, filling its hole with the triangles of a sweep over the hole's sites.
+    Returns STATUS_DONE or STATUS_FLAT; STATUS_NOT_SWEPT when the sweep's triangles do not
+    tile the hole (cocircular sites triangulated another way, collinear sites) and
+    STATUS_NO_MEMORY, both with the mesh unchanged: the caller fills the hole by ears."""
+    cdef int k = star_size(m, site), q, nf = 0, nt, p_inf = -1
+    cdef Py_ssize_t size = 1
+    cdef int32_t* poly
+    cdef int32_t* outs
+    cdef int32_t* slots
+    cdef int32_t* ids
+    cdef int32_t* tvl
+    cdef int32_t* inside
+    cdef int32_t* half
+    cdef double* xs
+    cdef double* ys
+    # the hash table of the splice: a power of two, at least twice the half-edges
+    while size < 6 * k:
+        size *= 2
+    if not reserve(sc, 5 * k + 1 + 3 * (2 * k + 2) + 3 * k + size, 2 * k, size):
+        return STATUS_NO_MEMORY
+    poly = sc.ints
+    outs = poly + k
+    slots = outs + k
+    ids = slots + k                 # hole position of each site swept, then the vertex at infinity
+    tvl = ids + k + 1
+    inside = tvl + 3 * (2 * k + 2)
+    half = inside + 3 * k
+    xs = sc.reals
+    ys = xs + k
+    collect_hole(m, site, poly, outs, slots)
+    # the hole's sites, in sweep order
     for q in range(k):
-        ids[q] = q
-        xs[q] = m.x[poly[q]]
-        ys[q] = m.y[poly[q]]
-    sort_by_sweep(ids, xs, ys, k)
-    nt = sweep_triangles(xs, ys, k, tvl, 2 * MAX_HOLE)
-    if nt <= 0:
-        return 0
-    # the sweep's triangles inside the hole meet its vertices in their own cyclic order
-    for q in range(nt):
-        if tvl[3 * q] == k or tvl[3 * q + 1] == k or tvl[3 * q + 2] == k:
+        if poly[q] == m.inf:
+            p_inf = q
             continue
-        pa = ids[tvl[3 * q]]; pb = ids[tvl[3 * q + 1]]; pc = ids[tvl[3 * q + 2]]
-        if (pb - pa + k) % k + (pc - pb + k) % k + (pa - pc + k) % k == k:
-            if n_in == k - 2:
-                return 0
-            inside[3 * n_in] = pa; inside[3 * n_in + 1] = pb; inside[3 * n_in + 2] = pc
-            n_in += 1
-    if n_in != k - 2:
-        return 0
-    for q in range(k * k):
-        half[q] = -1
-    for q in range(3 * n_in):
-        x = inside[q]
-        y = inside[q - q % 3 + (q % 3 + 1) % 3]
-        if half[x * k + y] != -1:
-            return 0
-        half[x * k + y] = -2
-    for q in range(k):
-        if half[q * k + (q + 1) % k] != -2:
-            return 0            # a side of the hole is missing: cocircular sites triangulated another way
-    # splice: the star's slots are freed, the sweep's triangles take them
-    for q in range(k):
-        if not is_infinite(m, slots[q]):
-            m.n_finite -= 1
-        m.free_tri[m.n_free] = slots[q]
-        m.n_free += 1
-    m.vedge[site] = -1
-    for q in range(n_in):
-        m.n_free -= 1
-        T = m.free_tri[m.n_free]
-        for j in range(3):
-            x = inside[3 * q + j]
-            y = inside[3 * q + (j + 1) % 3]
-            m.tv[3 * T + j] = poly[x]
-            m.vedge[poly[x]] = 3 * T + j
-            half[x * k + y] = 3 * T + j
-        m.n_finite += 1
-        m.last = T
-    for q in range(3 * n_in):
-        x = inside[q]
-        y = inside[q - q % 3 + (q % 3 + 1) % 3]
-        h = half[x * k + y]
-        if y == (x + 1) % k:
-            m.opp[h] = outs[x]
-            m.opp[outs[x]] = h
-        else:
-            m.opp[h] = half[y * k + x]
-    m.n_changed = 0
-    for q in range(k):
-        m.changed[m.n_changed] = poly[q]
-        m.n_changed += 1
-    return 1
+        ids[nf] = q
+        xs[nf] = m.x[poly[q]]
+        ys[nf] = m.y[poly[q]]
+        nf += 1
+    sort_by_sweep(ids, xs, ys, nf)
+    ids[nf] = p_inf
+    nt = sweep_triangles(xs, ys, nf, tvl, 2 * k + 2)
+    if nt <= 0:
+        return STATUS_NOT_SWEPT
+    return splice_hole(m, site, k, poly, outs, slots, tvl, nt, ids, nf, inside, sc.keys, half, size - 1)
