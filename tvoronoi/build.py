@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.diagram import Diagram
+from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import clip, dcel, delaunay, fortune
 
 
@@ -91,6 +92,11 @@ def fortune_dcel(xs: np.ndarray, ys: np.ndarray):
     xs = np.ascontiguousarray(xs[perm])
     ys = np.ascontiguousarray(ys[perm])
     result = fortune.sweep(xs, ys)
+    if result["status"] != fortune.STATUS_OK:
+        raise TvoronoiError(
+            f"{fortune.STATUS_MESSAGES[result['status']]} on {len(xs)} points; "
+            "build with engine='incremental' instead, and please report the input"
+        )
     if "tv" not in result:
         return perm, xs, ys, collinear_dcel(xs, ys)
     out = dcel.voronoi_from_delaunay(xs, ys, result["tv"], result["opp"])

@@ -9,6 +9,8 @@ from libc.stdlib cimport malloc, free
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.parabola cimport parabola_order
 from tvoronoi.kernels.mesh cimport nxt, prv
+from tvoronoi.kernels.circle_events cimport circle_top
+from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
 
 # The sweep line y = L moves upwards; sites are numbered in event order
 # (by y, then x). Each arc of the beach line is a node of an AVL tree (in
@@ -23,17 +25,42 @@ from tvoronoi.kernels.mesh cimport nxt, prv
 # hull). dcel.voronoi_from_delaunay turns it into the Voronoi DCEL.
 #
 # Every decision is exact: which arc a site falls on (parabola_order and
-# coordinate comparisons), whether three arcs converge (orient2d). Event
-# positions are rounded doubles; where rounding could order two events that
-# are equal up to an ulp the wrong way (cocircular and nearly cocircular
-# sites), a final pass of exact Lawson flips restores the Delaunay property,
-# so the diagram is exact on every input.
+# coordinate comparisons), whether three arcs converge (orient2d), and the
+# order of events (circle_events.pxd: a rounded top of each circle with a
+# proven error bound, exact integer arithmetic when two bounds overlap). At an
+# exact tie a site comes before a circle event, and circle events with equal
+# tops go by their rounded centre x: events at one height with different
+# centres share no arc and commute, events at one centre are cocircular sites,
+# any order of which gives a triangulation of their group (the dual merges
+# it). A final pass of exact Lawson flips stays as a guard; it finds nothing
+# to flip when the order is exact.
+#
+# The kernel never trusts its own state blindly: every array has its bound
+# checked before a write, and an inconsistent state (which exact decisions
+# should make impossible) stops the sweep with a status code that the Python
+# layer turns into a TvoronoiError.
 
 cdef enum:
     NONE = -1
     EVENT_SITE = 0
     EVENT_CIRCLE = 1
     EVENT_REPEAT = 2      # a site at the same place as an earlier one
+
+cdef enum:
+    OK = 0
+    BROKEN = 1            # an inconsistent state: a capacity exceeded, an arc without neighbours, ...
+    NO_MEMORY = 2         # the exact fallback could not allocate
+    NO_REPAIR = 3         # the exact repair did not converge within its bound
+
+STATUS_OK = OK
+STATUS_BROKEN = BROKEN
+STATUS_NO_MEMORY = NO_MEMORY
+STATUS_NO_REPAIR = NO_REPAIR
+STATUS_MESSAGES = {
+    BROKEN: "Fortune's sweep reached an inconsistent state",
+    NO_MEMORY: "Fortune's sweep ran out of memory in its exact arithmetic",
+    NO_REPAIR: "Fortune's sweep: the exact repair did not converge",
+}
 
 
 cdef struct Sweep:
@@ -55,8 +82,11 @@ cdef struct Sweep:
     int first_arc
     int32_t* free_arcs     # slots of removed arcs, reused so the live beach line stays in cache
     int n_free
-    # circle events: position (top of the circle), centre, arc; a binary heap of their ids
+    # circle events: position (top of the circle, rounded, and an interval that surely holds it),
+    # centre, arc; a binary heap of their ids
     double* ev_y
+    double* ev_lo
+    double* ev_hi
     double* ev_x
     double* ev_cy
     int32_t* ev_arc
@@ -87,6 +117,14 @@ cdef struct Sweep:
     int last_site
     int last_tri
     double sweep_y
+    # capacities of the arrays, what went wrong, and how often the exact fallback ran
+    int cap_arcs
+    int cap_ev
+    int cap_rec
+    int cap_tri
+    int status
+    long n_exact_site
+    long n_exact_circle
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -287,8 +325,60 @@ cdef int locate_arc(Sweep* s, double px, double py) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # circle events
 
+cdef inline void event_sites(Sweep* s, int ev, double* tri) noexcept nogil:
+    """The coordinates of the three sites of event ev (the arc and its two neighbours, counter-clockwise)."""
+    cdef int arc = s.ev_arc[ev]
+    cdef int a = s.arc_site[s.arc_prev[arc]], b = s.arc_site[arc], c = s.arc_site[s.arc_next[arc]]
+    tri[0] = s.x[a]; tri[1] = s.y[a]
+    tri[2] = s.x[b]; tri[3] = s.y[b]
+    tri[4] = s.x[c]; tri[5] = s.y[c]
+
+
+cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
+    """Sign of top(i) - top(j), exactly (the intervals of the two events overlap)."""
+    cdef double ti[6]
+    cdef double tj[6]
+    cdef int c
+    event_sites(s, i, ti)
+    event_sites(s, j, tj)
+    s.n_exact_circle += 1
+    c = tvb_top_order(ti, tj)
+    if c == 2:
+        s.status = NO_MEMORY
+        return 0
+    return c
+
+
 cdef inline bint ev_less(Sweep* s, int i, int j) noexcept nogil:
-    return s.ev_y[i] < s.ev_y[j] or (s.ev_y[i] == s.ev_y[j] and s.ev_x[i] < s.ev_x[j])
+    """Event i comes before event j: by the top of its circle (exact), then by the centre's rounded x."""
+    cdef int c
+    if s.ev_hi[i] < s.ev_lo[j]:
+        return True
+    if s.ev_hi[j] < s.ev_lo[i]:
+        return False
+    c = top_order_exact(s, i, j)
+    if c != 0:
+        return c < 0
+    # equal tops: different centres share no arc (the events commute), one centre is a cocircular group
+    return s.ev_x[i] < s.ev_x[j]
+
+
+cdef bint site_first(Sweep* s, int i, int ev) noexcept nogil:
+    """Site i comes before circle event ev: y_i <= top(ev), exactly (a site first at a tie)."""
+    cdef double yi = s.y[i]
+    cdef double tri[6]
+    cdef int r
+    if yi <= s.ev_lo[ev]:
+        return True
+    if yi > s.ev_hi[ev]:
+        return False
+    event_sites(s, ev, tri)
+    s.n_exact_site += 1
+    r = tvb_site_first(yi, tri)
+    if r < 0:
+        s.status = NO_MEMORY
+        return True
+    return r == 1
 
 
 cdef inline void heap_set(Sweep* s, int k, int ev) noexcept nogil:
@@ -352,7 +442,6 @@ cdef inline void cancel_event(Sweep* s, int arc) noexcept nogil:
 cdef void check_circle(Sweep* s, int arc) noexcept nogil:
     """Schedule the circle event of arc if its two breakpoints converge."""
     cdef int l = s.arc_prev[arc], r = s.arc_next[arc], a, b, c, ev
-    cdef double bx, by, cx, cy, det, bb, cc, ux, uy
     if l == NONE or r == NONE:
         return
     a = s.arc_site[l]
@@ -360,23 +449,18 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
     c = s.arc_site[r]
     if a == c or orient2d(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c]) <= 0:
         return
-    # the circumcentre, relative to a; the event is where the sweep line touches the circle's top
-    bx = s.x[b] - s.x[a]; by = s.y[b] - s.y[a]
-    cx = s.x[c] - s.x[a]; cy = s.y[c] - s.y[a]
-    det = 2.0 * (bx * cy - by * cx)
-    bb = bx * bx + by * by
-    cc = cx * cx + cy * cy
-    ux = (cy * bb - by * cc) / det
-    uy = (bx * cc - cx * bb) / det
     if s.n_free_ev > 0:
         s.n_free_ev -= 1
         ev = s.free_events[s.n_free_ev]
-    else:
+    elif s.n_events < s.cap_ev:
         ev = s.n_events
         s.n_events += 1
-    s.ev_x[ev] = s.x[a] + ux
-    s.ev_cy[ev] = s.y[a] + uy
-    s.ev_y[ev] = s.ev_cy[ev] + sqrt(ux * ux + uy * uy)
+    else:
+        s.status = BROKEN
+        return
+    # the event is where the sweep line touches the circle's top: rounded, with an interval that holds it
+    circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c],
+               &s.ev_y[ev], &s.ev_lo[ev], &s.ev_hi[ev], &s.ev_x[ev], &s.ev_cy[ev])
     s.ev_arc[ev] = arc
     s.arc_event[arc] = ev
     heap_push(s, ev)
@@ -425,12 +509,19 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
         # degenerate case: the first row of sites (equal y); their breakpoints are
         # vertical lines coming up from infinity, in order of x
         b = s.row_last
+        if s.n_free + (s.cap_arcs - s.n_arcs) < 1 or s.n_recs >= s.cap_rec:
+            s.status = BROKEN
+            return
         p = new_arc(s, i)
         insert_after(s, b, p)
         s.arc_edge[b] = new_record(s, s.arc_site[b], i, 0.5 * (s.x[s.arc_site[b]] + px), -INFINITY)
         s.row_last = p
         return
     s.row_mode = False
+    if s.n_free + (s.cap_arcs - s.n_arcs) < 2 or s.n_recs >= s.cap_rec:
+        s.status = BROKEN           # more arcs or edges than n sites can make
+        return
+    # find the arc above the site and split it in two around a new arc
     b = locate_arc(s, px, py)
     site_b = s.arc_site[b]
     cancel_event(s, b)
@@ -451,7 +542,13 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
 
 cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     cdef int arc = s.ev_arc[ev], l = s.arc_prev[arc], r = s.arc_next[arc]
-    cdef int a = s.arc_site[l], b = s.arc_site[arc], c = s.arc_site[r], t, rec
+    cdef int a, b, c, t, rec
+    if l == NONE or r == NONE or s.n_tri >= s.cap_tri or s.n_recs >= s.cap_rec:
+        s.status = BROKEN           # an event of an arc at the end of the beach line, or too many
+        return
+    a = s.arc_site[l]
+    b = s.arc_site[arc]
+    c = s.arc_site[r]
     s.sweep_y = s.ev_y[ev]
     # the Voronoi vertex: triangle (a, b, c), counter-clockwise
     t = s.n_tri
@@ -482,7 +579,9 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
     """Process the next event; 0 when there is none left."""
     cdef int i, ev
     i = next_site[0]
-    if i < s.n and (s.n_heap == 0 or s.y[i] <= s.ev_y[s.heap[0]]):
+    if s.status != OK:
+        return 0
+    if i < s.n and (s.n_heap == 0 or site_first(s, i, s.heap[0])):
         # sites come before circle events at the same position
         next_site[0] = i + 1
         if i > 0 and s.x[i] == s.x[i - 1] and s.y[i] == s.y[i - 1]:
@@ -502,16 +601,24 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # closing the hull, and the exact repair
 
-cdef void close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
-    """An infinite triangle beyond each edge that has a triangle on one side only."""
-    cdef int r, e, u, w, t, first = s.n_tri
+cdef int close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
+    """An infinite triangle beyond each edge that has a triangle on one side only; OK or BROKEN.
+
+    vmap (n + 1 entries) is scratch. Every twin link is checked afterwards, so
+    the repair and the Python layer never follow a link that was not written.
+    """
+    cdef int r, e, u, w, t, k, o, first = s.n_tri
+    for k in range(s.n + 1):
+        vmap[k] = NONE
+    # an infinite triangle (w, u, inf) beyond each finite half-edge u->w without a twin
     for r in range(s.n_recs):
         e = s.rec_e0[r]
         if e == NONE or s.rec_e1[r] != NONE:
             continue
-        # the finite side has half-edge u->w; beyond it lies (w, u, inf)
         u = s.tv[e]
         w = s.tv[nxt(e)]
+        if s.n_tri >= s.cap_tri or vmap[w] != NONE:
+            return BROKEN           # more hull edges than sites, or two hull edges leaving w
         t = s.n_tri
         s.n_tri += 1
         s.tv[3 * t] = w
@@ -519,20 +626,36 @@ cdef void close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
         s.tv[3 * t + 2] = s.n
         s.opp[3 * t] = e
         s.opp[e] = 3 * t
+        s.opp[3 * t + 1] = NONE
+        s.opp[3 * t + 2] = NONE
         vmap[w] = t
+    # link the infinite triangles around the hull: (w, u, inf) has edge u->inf, the twin of inf->u in
+    # the infinite triangle that starts at u
     for t in range(first, s.n_tri):
-        # (w, u, inf): its edge u->inf is the twin of inf->u in the triangle that starts at u
         u = s.tv[3 * t + 1]
+        if vmap[u] == NONE:
+            return BROKEN           # the hull is not a closed cycle
         s.opp[3 * t + 1] = 3 * vmap[u] + 2
         s.opp[3 * vmap[u] + 2] = 3 * t + 1
+    # every half-edge has a twin that points back at it, with the same two ends
+    for e in range(3 * s.n_tri):
+        o = s.opp[e]
+        if o < 0 or o >= 3 * s.n_tri or s.opp[o] != e or s.tv[o] != s.tv[nxt(e)] or s.tv[nxt(o)] != s.tv[e]:
+            return BROKEN
+    return OK
 
 
 cdef bint is_infinite(Sweep* s, int t) noexcept nogil:
     return s.tv[3 * t] == s.n or s.tv[3 * t + 1] == s.n or s.tv[3 * t + 2] == s.n
 
 
-cdef int repair(Sweep* s, int32_t* stack, int8_t* queued) noexcept nogil:
-    """Lawson flips until every edge is locally Delaunay (exact incircle). Returns the flip count."""
+cdef int repair(Sweep* s, int32_t* stack, int8_t* queued, int max_flips) noexcept nogil:
+    """Lawson flips until every edge is locally Delaunay (exact incircle).
+
+    Returns the flip count, or -1 when more than max_flips were needed (an
+    input that was not a triangulation; each flip is exact, so on a valid
+    triangulation the flips end).
+    """
     cdef int n_he = 3 * s.n_tri, top = 0, e, o, e1, e2, o1, o2, a, b, c, d, A, B, flips = 0, k
     cdef int quad[4]
     for e in range(n_he):
@@ -551,6 +674,8 @@ cdef int repair(Sweep* s, int32_t* stack, int8_t* queued) noexcept nogil:
         a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
         if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
             continue
+        if flips >= max_flips:
+            return -1
         # flip a-b to c-d: (a, b, c) + (b, a, d) become (d, b, c) + (c, a, d)
         A = s.opp[e2]
         B = s.opp[o2]
@@ -582,10 +707,12 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
 
     Returns
     -------
-    dict: ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation (vertex n
-    at infinity; only when the sweep finished and some triangle exists),
-    ``dup`` (n,) int32, ``steps`` (events processed), ``flips`` (exact
-    repairs), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    dict: ``status`` (STATUS_OK, or the code of an inconsistent state, with
+    STATUS_MESSAGES), ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation
+    (vertex n at infinity; only when the sweep finished without trouble and
+    some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
+    ``flips`` (exact repairs), ``exact_tests`` (site and circle comparisons
+    the filter left to exact arithmetic), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
@@ -600,6 +727,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
         "arc_edge": np.empty(cap_arcs, np.int32),
         "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
+        "ev_lo": np.empty(cap_ev, np.float64), "ev_hi": np.empty(cap_ev, np.float64),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
@@ -616,6 +744,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] free_arcs = arrays["free_arcs"]
     cdef int32_t[::1] arc_event = arrays["arc_event"], arc_edge = arrays["arc_edge"]
     cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
+    cdef double[::1] ev_lo = arrays["ev_lo"], ev_hi = arrays["ev_hi"]
     cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
@@ -630,6 +759,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
+    s.ev_lo = &ev_lo[0]; s.ev_hi = &ev_hi[0]
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
     s.free_events = &free_events[0]; s.n_free_ev = 0
     s.free_arcs = &free_arcs[0]; s.n_free = 0
@@ -639,15 +769,21 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.dup = &dup[0] if n else NULL
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
+    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
+    # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
     with nogil:
         while stop_after < 0 or steps < stop_after:
             if not step(&s, &next_site):
                 break
             steps += 1
-    out = {"dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
-           "last": (s.last_kind, s.last_site, s.last_tri)}
+    out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
+           "last": (s.last_kind, s.last_site, s.last_tri),
+           "exact_tests": (s.n_exact_site, s.n_exact_circle)}
+    if s.status != OK:
+        return out
     cdef bint finished = next_site == n and s.n_heap == 0
     if not finished or stop_after >= 0:
         out.update(_state(&s, arrays))
@@ -657,17 +793,29 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] stack
     cdef int8_t[::1] queued
     if s.n_tri > 0:
+        # close the hull with triangles at infinity, then the exact repair (a guard: no flips expected)
         vmap = np.empty(n + 1, np.int32)
         with nogil:
-            close_hull(&s, &vmap[0])
+            s.status = close_hull(&s, &vmap[0])
+        if s.status != OK:
+            out["status"] = s.status
+            return out
         stack = np.empty(3 * s.n_tri, np.int32)
         queued = np.zeros(3 * s.n_tri, np.int8)
         with nogil:
-            flips = repair(&s, &stack[0], &queued[0])
+            flips = repair(&s, &stack[0], &queued[0], max_repair_flips(s.n_tri))
+        if flips < 0:
+            out["status"] = NO_REPAIR
+            return out
         out["tv"] = arrays["tv"][:3 * s.n_tri]
         out["opp"] = arrays["opp"][:3 * s.n_tri]
     out["flips"] = flips
     return out
+
+
+cdef inline int max_repair_flips(int n_tri) noexcept nogil:
+    """A bound on the flips of the guard repair: none are expected; a wrong sweep is reported, not looped on."""
+    return 3 * n_tri + 1024
 
 
 cdef dict _state(Sweep* s, dict arrays):
@@ -717,7 +865,7 @@ def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_
     s.opp = &opp[0]
     s.n_tri = n_he // 3
     with nogil:
-        flips = repair(&s, &stack[0], &queued[0])
+        flips = repair(&s, &stack[0], &queued[0], 2_000_000_000)
     return flips
 
 
@@ -726,12 +874,13 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
 
     Writes the Delaunay triangles, vertex n at infinity, into tv_out (room for
     cap triangles) and returns their number; -1 when no triangle exists (the
-    sites are collinear) or cap is too small. No Python objects: scratch
+    sites are collinear), cap is too small, memory ran out or the sweep met an
+    inconsistent state. No Python objects: scratch
     memory comes from malloc.
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
     cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
-    cdef int n_f64 = 3 * cap_ev + 2 * cap_rec
+    cdef int n_f64 = 5 * cap_ev + 2 * cap_rec
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
     cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri) * sizeof(int8_t))
@@ -771,22 +920,26 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.ev_y = q; q += cap_ev
     s.ev_x = q; q += cap_ev
     s.ev_cy = q; q += cap_ev
+    s.ev_lo = q; q += cap_ev
+    s.ev_hi = q; q += cap_ev
     s.rec_x = q; q += cap_rec
     s.rec_y = q
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0; s.n_free = 0; s.n_recs = 0; s.n_tri = 0
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
+    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):
         pass
-    if s.n_tri > 0:
-        close_hull(&s, vmap)
+    if s.n_tri > 0 and s.status == OK:
+        s.status = close_hull(&s, vmap)
+    if s.n_tri > 0 and s.status == OK:
         for k in range(3 * s.n_tri):
             queued[k] = 0
-        repair(&s, stack, queued)
-        if s.n_tri <= cap:
+        if repair(&s, stack, queued, max_repair_flips(s.n_tri)) >= 0 and s.n_tri <= cap:
             for k in range(3 * s.n_tri):
                 tv_out[k] = s.tv[k]
             result = s.n_tri
@@ -794,3 +947,37 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     free(fb)
     free(bb)
     return result
+
+
+def circle_event_top(double ax, double ay, double bx, double by, double cx, double cy):
+    """The circle event of sites a, b, c (counter-clockwise), for tests: (top, lo, hi, centre x, centre y).
+
+    ``top`` is rounded; the exact top of the circle lies in [lo, hi].
+    """
+    cdef double top, lo, hi, centre_x, centre_y
+    circle_top(ax, ay, bx, by, cx, cy, &top, &lo, &hi, &centre_x, &centre_y)
+    return top, lo, hi, centre_x, centre_y
+
+
+def site_before_event(double y, double ax, double ay, double bx, double by, double cx, double cy):
+    """Exact: a site at height y comes before the circle event of a, b, c (y <= top), for tests."""
+    cdef double tri[6]
+    tri[0] = ax; tri[1] = ay; tri[2] = bx; tri[3] = by; tri[4] = cx; tri[5] = cy
+    cdef int r = tvb_site_first(y, tri)
+    if r < 0:
+        raise MemoryError("exact event order")
+    return r == 1
+
+
+def event_top_order(t1, t2):
+    """Exact sign of top(t1) - top(t2) for two counter-clockwise triples (ax, ay, bx, by, cx, cy), for tests."""
+    cdef double a[6]
+    cdef double b[6]
+    cdef int k, r
+    for k in range(6):
+        a[k] = t1[k]
+        b[k] = t2[k]
+    r = tvb_top_order(a, b)
+    if r == 2:
+        raise MemoryError("exact event order")
+    return r
