@@ -284,11 +284,52 @@ def test_filter_interval_holds_the_exact_top(scale_y):
     rng = np.random.default_rng(SEED)
     from decimal import Decimal
     for tri in _ccw_triples(rng, 200, scale_y):
-        top, lo, hi, _, _ = fortune.circle_event_top(*tri)
+        top, lo, hi, base, rise, rise_err, _, _ = fortune.circle_event_top(*tri)
         exact = _exact_top(tri)
         if math.isfinite(lo):
             assert Decimal(lo) <= exact <= Decimal(hi)
             assert lo <= top <= hi
+        if math.isfinite(rise_err):
+            assert abs(Decimal(base) + Decimal(rise) - exact) <= Decimal(rise_err)
+
+
+def _family_triples():
+    """Counter-clockwise triples of neighbouring sites from the hard families."""
+    rng = np.random.default_rng(SEED + 2)
+    sets = [parallel_lines(200, 1.0, 1e-16, SEED), parallel_lines(200, 1.0, 1e-12, SEED),
+            near_line(200, 1 / 3, 0.7, SEED), near_line(200, 2.0, 0.0, SEED), near_line(200, 1e6, 3.0, SEED),
+            near_line(200, 0.0, 1e-18, SEED), lattice(12, "square", 0.1, 1e-12, SEED),
+            offset_cloud(200, 1e12, 1.0, SEED), lattice(12, "triangular", 0.0, 0.0, SEED)]
+    out = []
+    for pts in sets:
+        pts = np.unique(pts, axis=0)
+        for _ in range(150):
+            i = rng.integers(len(pts))
+            near = np.argsort(np.hypot(*(pts - pts[i]).T))[1:8]
+            j, k = rng.choice(near, 2, replace=False)
+            t = tuple(float(v) for v in (*pts[i], *pts[j], *pts[k]))
+            o = _orient(*[(Fraction(t[2 * m]), Fraction(t[2 * m + 1])) for m in range(3)])
+            if o != 0:
+                out.append(t if o > 0 else t[2:4] + t[0:2] + t[4:6])
+    return out
+
+
+def test_filters_hold_the_exact_top_on_hard_families():
+    from decimal import Decimal
+    decided = 0
+    for tri in _family_triples():
+        exact = _exact_top(tri)
+        top, lo, hi, base, rise, rise_err, _, _ = fortune.circle_event_top(*tri)
+        if math.isfinite(lo):
+            assert Decimal(lo) <= exact <= Decimal(hi)
+        if math.isfinite(rise_err):
+            assert abs(Decimal(base) + Decimal(rise) - exact) <= Decimal(rise_err)
+        fine = fortune.circle_event_top_fine(*tri)
+        if fine is not None:
+            head, tail, err = fine
+            assert abs(Decimal(head) + Decimal(tail) - exact) <= Decimal(err)
+            decided += 1
+    assert decided > 100
 
 
 @pytest.mark.parametrize("scale_y", [1.0, 1e-9, 1e-18])

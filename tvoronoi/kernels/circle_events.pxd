@@ -31,7 +31,7 @@
 from libc.math cimport fabs, sqrt, INFINITY
 
 from tvoronoi.kernels.predicates cimport (
-    EPSILON, CCW_ERRBOUND_A, two_product, two_two_diff, fast_expansion_sum_zeroelim,
+    EPSILON, CCW_ERRBOUND_A, two_product, two_diff, two_sum, fast_two_sum,
 )
 
 cdef extern from *:
@@ -59,53 +59,117 @@ cdef inline bint usable_coordinate(double v) noexcept nogil:
     return v == 0.0 or fabs(v) >= EVENT_TINY_COORD
 
 
+cdef inline int grow_expansion_zeroelim(int elen, const double* e, double b, double* h) noexcept nogil:
+    """h = e + b for a nonoverlapping expansion e (Shewchuk's Grow-Expansion): nonoverlapping again."""
+    cdef double q = b, hh
+    cdef int i, hlen = 0
+    for i in range(elen):
+        q, hh = two_sum(q, e[i])
+        if hh != 0.0:
+            h[hlen] = hh
+            hlen += 1
+    if q != 0.0 or hlen == 0:
+        h[hlen] = q
+        hlen += 1
+    return hlen
+
+
+cdef inline double compressed_head(int elen, double* e) noexcept nogil:
+    """The largest component of e after Shewchuk's Compress: within an ulp of the expansion's value."""
+    cdef double q, q_new, small
+    cdef int i, bottom = elen - 1, top = 0
+    q = e[bottom]
+    for i in range(elen - 2, -1, -1):
+        q_new, small = fast_two_sum(q, e[i])
+        if small != 0.0:
+            e[bottom] = q_new
+            bottom -= 1
+            q = small
+        else:
+            q = q_new
+    for i in range(bottom + 1, elen):
+        q_new, small = fast_two_sum(e[i], q)
+        if small != 0.0:
+            e[top] = small
+            top += 1
+        q = q_new
+    return q
+
+
 cdef inline double orient_rounded(double ax, double ay, double bx, double by, double cx, double cy) noexcept nogil:
-    """(b - a) x (c - a) within a relative 2.001 u: the largest component of its exact expansion.
+    """(b - a) x (c - a) within a relative 2^-52: the head of its exact expansion, compressed.
 
     The determinant is the sum of three 2x2 minors of the coordinates themselves (bx cy - by cx,
-    by ax - bx ay, ay cx - ax cy), each two exact products: 12 components, summed without error. The
-    components of a nonoverlapping expansion below its largest add up to less than that one's last
-    bit. Callers make sure no product underflows (every nonzero coordinate at least 2^-500).
+    by ax - bx ay, ay cx - ax cy): twelve exact product halves, grown one by one into a nonoverlapping
+    expansion (Grow-Expansion needs nothing more of its input), then compressed; the largest component
+    of a compressed expansion is within an ulp of its value (Shewchuk 1997, Theorem 23). Callers make
+    sure no product underflows (every nonzero coordinate at least 2^-500).
     """
-    cdef double p1, p0, q1, q0
-    cdef double m1[4]
-    cdef double m2[4]
-    cdef double m3[4]
-    cdef double m12[8]
-    cdef double det[12]
-    cdef int n12, n
-    p1, p0 = two_product(bx, cy)
-    q1, q0 = two_product(by, cx)
-    two_two_diff(p1, p0, q1, q0, m1)
-    p1, p0 = two_product(by, ax)
-    q1, q0 = two_product(bx, ay)
-    two_two_diff(p1, p0, q1, q0, m2)
-    p1, p0 = two_product(ay, cx)
-    q1, q0 = two_product(ax, cy)
-    two_two_diff(p1, p0, q1, q0, m3)
-    n12 = fast_expansion_sum_zeroelim(4, m1, 4, m2, m12)
-    n = fast_expansion_sum_zeroelim(n12, m12, 4, m3, det)
-    return det[n - 1]
+    cdef double parts[12]
+    cdef double e[13]
+    cdef double f[13]
+    cdef double* cur = e
+    cdef double* nxt_buf = f
+    cdef double* swap
+    cdef int k, n = 0
+    parts[0], parts[1] = two_product(bx, cy)
+    parts[2], parts[3] = two_product(-by, cx)
+    parts[4], parts[5] = two_product(by, ax)
+    parts[6], parts[7] = two_product(-bx, ay)
+    parts[8], parts[9] = two_product(ay, cx)
+    parts[10], parts[11] = two_product(-ax, cy)
+    for k in range(12):
+        if parts[k] != 0.0:
+            n = grow_expansion_zeroelim(n, cur, parts[k], nxt_buf)
+            swap = cur
+            cur = nxt_buf
+            nxt_buf = swap
+    if n == 0:
+        return 0.0
+    return compressed_head(n, cur)
 
 
 cdef inline void circle_top(double ax, double ay, double bx, double by, double cx, double cy,
-                            double* top, double* lo, double* hi,
+                            double* top, double* lo, double* hi, double* base, double* rise, double* rise_err,
                             double* centre_x, double* centre_y) noexcept nogil:
-    """The top of the circle through a, b, c (counter-clockwise): rounded, and an interval that holds it."""
+    """The top of the circle through a, b, c (counter-clockwise): rounded, and an interval that holds it.
+
+    Also the top as base + rise, base the highest site's y, with |rise - exact rise| <= rise_err: near
+    ties between tops (or a top and a site) much closer than an ulp of the top itself are often settled
+    by the rises, whose error is a few u of the rise, not of the top (relative_sign below).
+    """
     cdef double u = EPSILON
-    cdef double bdx = bx - ax, bdy = by - ay, cdx = cx - ax, cdy = cy - ay
-    cdef double p1 = bdx * cdy, p2 = bdy * cdx
-    cdef double det = 2.0 * (p1 - p2)
-    cdef double e_det = 2.0 * CCW_ERRBOUND_A * (fabs(p1) + fabs(p2))
+    cdef double sx, sy, ab, bc, ca, kx, ky, dkx, dky, wx, wy, e_wx, e_wy
+    cdef double bdx, bdy, cdx, cdy, p1, p2, det, e_det
     cdef double bb, cc, t1, t2, t3, t4, ux, uy, r, h, t, e_x, e_y, e_r, e_s, e_h, e_t, margin
     cdef double s = 0.0
+    # the origin: the site opposite the longest side (a cyclic turn keeps the triple counter-clockwise);
+    # the centre's offsets from it are then computed without cancellation
+    ab = (bx - ax) * (bx - ax) + (by - ay) * (by - ay)
+    bc = (cx - bx) * (cx - bx) + (cy - by) * (cy - by)
+    ca = (ax - cx) * (ax - cx) + (ay - cy) * (ay - cy)
+    if ca > bc and ca >= ab:
+        sx = ax; sy = ay; ax = bx; ay = by; bx = cx; by = cy; cx = sx; cy = sy
+    elif ab > bc and ab > ca:
+        sx = cx; sy = cy; cx = bx; cy = by; bx = ax; by = ay; ax = sx; ay = sy
+    # the highest site: the rise is measured from it
+    kx = ax; ky = ay
+    if by > ky:
+        kx = bx; ky = by
+    if cy > ky:
+        kx = cx; ky = cy
+    base[0] = ky
+    bdx = bx - ax; bdy = by - ay; cdx = cx - ax; cdy = cy - ay
+    p1 = bdx * cdy; p2 = bdy * cdx
+    det = 2.0 * (p1 - p2)
+    e_det = 2.0 * CCW_ERRBOUND_A * (fabs(p1) + fabs(p2))
     # a nearly collinear triple gets its determinant to within 2 ulps (else the bound below is loose)
     if not (e_det < EVENT_REFINE * det) and (
             usable_coordinate(ax) and usable_coordinate(ay) and usable_coordinate(bx)
             and usable_coordinate(by) and usable_coordinate(cx) and usable_coordinate(cy)):
         det = 2.0 * orient_rounded(ax, ay, bx, by, cx, cy)
         e_det = 2.001 * u * fabs(det)
-    # the centre, relative to a
+    # the centre, relative to a, and relative to the highest site
     bb = bdx * bdx + bdy * bdy
     cc = cdx * cdx + cdy * cdy
     t1 = cdy * bb; t2 = bdy * cc; t3 = bdx * cc; t4 = cdx * bb
@@ -114,33 +178,41 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
     r = sqrt(ux * ux + uy * uy)
     centre_x[0] = ax + ux
     centre_y[0] = ay + uy
-    # the top: uy + r, or without cancellation when the centre lies below a
-    if uy >= 0.0:
-        h = uy + r
+    dkx = ax - kx; dky = ay - ky
+    wx = dkx + ux
+    wy = dky + uy
+    # the rise above the highest site: wy + r, or without cancellation when the centre lies below it
+    if wy >= 0.0:
+        h = wy + r
     else:
-        s = r - uy
-        h = ux * ux / s
-    t = ay + h
+        s = r - wy
+        h = wx * wx / s
+    t = ky + h
     top[0] = t
-    # its error bound
+    rise[0] = h
+    rise_err[0] = INFINITY
+    # the error bounds
     margin = det - e_det
     if not (margin > 0.0) or not (usable_difference(bdx) and usable_difference(bdy)
-                                  and usable_difference(cdx) and usable_difference(cdy)):
+                                  and usable_difference(cdx) and usable_difference(cdy)
+                                  and usable_difference(dkx) and usable_difference(dky)):
         lo[0] = -INFINITY
         hi[0] = INFINITY
         return
     e_x = (u * fabs(ux) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t1) + fabs(t2)) + fabs(ux) * e_det) / margin
     e_y = (u * fabs(uy) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t3) + fabs(t4)) + fabs(uy) * e_det) / margin
     e_r = 2.01 * u * r + e_x + e_y
-    if uy >= 0.0:
-        e_h = e_y + e_r + u * h
+    e_wx = e_x + u * fabs(dkx) * (1.0 + u) + u * fabs(wx)
+    e_wy = e_y + u * fabs(dky) * (1.0 + u) + u * fabs(wy)
+    if wy >= 0.0:
+        e_h = e_wy + e_r + u * h
     else:
-        e_s = e_r + e_y + u * s
+        e_s = e_r + e_wy + u * s
         if not (s > e_s):
             lo[0] = -INFINITY
             hi[0] = INFINITY
             return
-        e_h = ((u * h * s * (1.0 + 2.0 * u) + e_x * (2.0 * fabs(ux) + e_x) + u * ux * ux + h * e_s)
+        e_h = ((u * h * s * (1.0 + 2.0 * u) + e_wx * (2.0 * fabs(wx) + e_wx) + u * wx * wx + h * e_s)
                / (s - e_s))
     # the slack: with every nonzero difference >= 2^-250 the radius is >= 2^-251, so at most the squares
     # of a centre offset below 2^-511 underflow, each by <= 2^-1074, and nothing divides them by less
@@ -152,3 +224,130 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
         return
     lo[0] = t - e_t
     hi[0] = t + e_t
+    rise_err[0] = e_h * (1.0 + 1e-6) + EVENT_SLACK
+
+
+cdef inline int relative_sign(double base_i, double rise_i, double err_i,
+                              double base_j, double rise_j, double err_j) noexcept nogil:
+    """Sign of (base_i + rise_i) - (base_j + rise_j) for exact rises within err_i, err_j of these; 0: unsure.
+
+    The bases (site coordinates) are subtracted exactly (two_diff), so only the rises' errors and
+    three roundings count. A site is the case rise_j = err_j = 0.
+    """
+    cdef double d1, d0, dh, s1, tot, err
+    d1, d0 = two_diff(base_i, base_j)
+    dh = rise_i - rise_j
+    s1 = d0 + dh
+    tot = d1 + s1
+    err = (err_i + err_j + EPSILON * (fabs(dh) + fabs(s1) + fabs(tot))) * (1.0 + 1e-6) + EVENT_SLACK
+    if tot > err:
+        return 1
+    if -tot > err:
+        return -1
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the second filter, for near ties: the same top in binary128 (quad precision, u = 2^-113)
+#
+# Sites within 1e-16 of a line give circle events whose tops differ from each other and from the next
+# sites by less than a double's ulp; exact integer arithmetic for each of those comparisons would cost
+# ~10 us. The same computation in quad precision (libgcc's correctly rounded soft-float, about 1 us)
+# separates them. Its error bound repeats the one above with u = 2^-113, except:
+#   - no underflow or overflow: quad's exponent range holds any product of six doubles;
+#   - the square root is one Newton step from the double square root: relative error below
+#     e0^2 / 2 + 3 u with e0 < 2^-52, so |r - R| <= 2^-103 r + Ex + Ey;
+#   - the determinant is bounded by its permanent, 4 u (|p1| + |p2|) (each product rounded once, the
+#     differences checked exact); when that is not small against det the filter gives up (integers);
+#   - the bound is computed in quad too (about 30 operations: a factor 1 + 2^-60 covers them).
+
+cdef extern from *:
+    """
+    /* 2^-113, 2^-103, 2^-60 as exact double constants */
+    #define TVORONOI_QUAD_EPS 9.6296497219361792652798897129246E-35
+    #define TVORONOI_QUAD_SQRT_ERR 9.8607613152626475676466070660348E-32
+    #define TVORONOI_QUAD_BOUND_SLACK 8.6736173798840354720596224069595E-19
+    """
+    ctypedef long double quad "__float128"
+    const double QUAD_EPS "TVORONOI_QUAD_EPS"
+    const double QUAD_SQRT_ERR "TVORONOI_QUAD_SQRT_ERR"
+    const double QUAD_BOUND_SLACK "TVORONOI_QUAD_BOUND_SLACK"
+
+
+cdef inline quad qabs(quad v) noexcept nogil:
+    return -v if v < 0 else v
+
+
+cdef inline bint quad_difference(double a, double b, quad* d) noexcept nogil:
+    """d = a - b in quad; True when that is exact (the two-sum tail, in quad, is zero)."""
+    cdef quad qa = a, qb = b
+    cdef quad x = qa - qb
+    cdef quad b_virtual = qa - x
+    cdef quad a_virtual = x + b_virtual
+    d[0] = x
+    return (b_virtual - qb) + (qa - a_virtual) == 0
+
+
+cdef inline bint circle_top_fine(double ax, double ay, double bx, double by, double cx, double cy,
+                                 quad* top, quad* err) noexcept nogil:
+    """The top of the circle through a, b, c (counter-clockwise) in quad precision, |exact - top| <= err.
+
+    False when this filter cannot bound it (inexact differences, a nearly collinear triple).
+    """
+    cdef quad u = QUAD_EPS
+    cdef quad bdx, bdy, cdx, cdy, p1, p2, det, e_det, bb, cc, t1, t2, t3, t4, ux, uy, x, r
+    cdef quad h, t, e_x, e_y, e_r, e_s, e_h, margin
+    cdef quad s = 0
+    cdef double r0
+    if not (quad_difference(bx, ax, &bdx) and quad_difference(by, ay, &bdy)
+            and quad_difference(cx, ax, &cdx) and quad_difference(cy, ay, &cdy)):
+        return False
+    p1 = bdx * cdy
+    p2 = bdy * cdx
+    det = 2 * (p1 - p2)
+    e_det = 8 * u * (qabs(p1) + qabs(p2))
+    margin = det - e_det
+    if not (margin > det / 2):
+        return False
+    # the centre, relative to a, and the radius (one Newton step from the double square root)
+    bb = bdx * bdx + bdy * bdy
+    cc = cdx * cdx + cdy * cdy
+    t1 = cdy * bb; t2 = bdy * cc; t3 = bdx * cc; t4 = cdx * bb
+    ux = (t1 - t2) / det
+    uy = (t3 - t4) / det
+    x = ux * ux + uy * uy
+    r0 = sqrt(<double>x)
+    if not (r0 > 1e-150 and r0 < INFINITY):      # (a subnormal double would not give 52 bits)
+        return False
+    r = (r0 + x / r0) / 2
+    # the top, without cancellation when the centre lies below a
+    if uy >= 0:
+        h = uy + r
+    else:
+        s = r - uy
+        h = ux * ux / s
+    t = ay + h
+    # its error bound
+    e_x = (u * qabs(ux) * det * (1 + 2 * u) + 8 * u * (qabs(t1) + qabs(t2)) + qabs(ux) * e_det) / margin
+    e_y = (u * qabs(uy) * det * (1 + 2 * u) + 8 * u * (qabs(t3) + qabs(t4)) + qabs(uy) * e_det) / margin
+    e_r = QUAD_SQRT_ERR * r + e_x + e_y
+    if uy >= 0:
+        e_h = e_y + e_r + u * h
+    else:
+        e_s = e_r + e_y + u * s
+        if not (s > e_s):
+            return False
+        e_h = (u * h * s * (1 + 2 * u) + e_x * (2 * qabs(ux) + e_x) + u * ux * ux + h * e_s) / (s - e_s)
+    top[0] = t
+    err[0] = (e_h + u * qabs(t)) * (1 + QUAD_BOUND_SLACK) + 2 * u * qabs(t)
+    return True
+
+
+cdef inline int fine_sign(quad d, quad slack) noexcept nogil:
+    """Sign of an exact value within slack of the quad value d; 0 when the slack hides it."""
+    slack = slack * (1 + QUAD_BOUND_SLACK) + QUAD_EPS * 4 * qabs(d)
+    if d > slack:
+        return 1
+    if -d > slack:
+        return -1
+    return 0

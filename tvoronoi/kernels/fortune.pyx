@@ -9,7 +9,7 @@ from libc.stdlib cimport malloc, free
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.parabola cimport parabola_order
 from tvoronoi.kernels.mesh cimport nxt, prv
-from tvoronoi.kernels.circle_events cimport circle_top
+from tvoronoi.kernels.circle_events cimport circle_top, relative_sign, circle_top_fine, fine_sign, quad
 from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
 
 # The sweep line y = L moves upwards; sites are numbered in event order
@@ -45,6 +45,11 @@ cdef enum:
     EVENT_SITE = 0
     EVENT_CIRCLE = 1
     EVENT_REPEAT = 2      # a site at the same place as an earlier one
+
+cdef enum:
+    FINE_UNKNOWN = 0
+    FINE_OK = 1
+    FINE_NONE = 2         # the quad filter cannot bound this event's top
 
 cdef enum:
     OK = 0
@@ -89,6 +94,11 @@ cdef struct Sweep:
     double* ev_hi
     double* ev_x
     double* ev_cy
+    double* ev_base         # the top as base + rise: the y of the event's first site,
+    double* ev_rise         # the rise above it (rounded),
+    double* ev_rise_err     # and a bound on the rise's error
+    quad* ev_fine           # the top in quad precision and its bound (2 per event), for near ties
+    int8_t* ev_fine_state   # FINE_UNKNOWN, FINE_OK, FINE_NONE
     int32_t* ev_arc
     int32_t* heap
     int32_t* ev_pos        # where each pending event sits in the heap
@@ -125,6 +135,8 @@ cdef struct Sweep:
     int status
     long n_exact_site
     long n_exact_circle
+    long n_fine_tops
+    long n_fine_tests
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -334,11 +346,34 @@ cdef inline void event_sites(Sweep* s, int ev, double* tri) noexcept nogil:
     tri[4] = s.x[c]; tri[5] = s.y[c]
 
 
+cdef bint fine_top(Sweep* s, int ev) noexcept nogil:
+    """The quad-precision top of event ev (computed once, when first needed); False if unavailable."""
+    cdef double tri[6]
+    if s.ev_fine_state[ev] == FINE_UNKNOWN:
+        s.n_fine_tops += 1
+        event_sites(s, ev, tri)
+        if circle_top_fine(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5],
+                           &s.ev_fine[2 * ev], &s.ev_fine[2 * ev + 1]):
+            s.ev_fine_state[ev] = FINE_OK
+        else:
+            s.ev_fine_state[ev] = FINE_NONE
+    return s.ev_fine_state[ev] == FINE_OK
+
+
 cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     """Sign of top(i) - top(j), exactly (the intervals of the two events overlap)."""
     cdef double ti[6]
     cdef double tj[6]
     cdef int c
+    # near tie: the rises above the sites, the quad filter, then exact integers
+    c = relative_sign(s.ev_base[i], s.ev_rise[i], s.ev_rise_err[i], s.ev_base[j], s.ev_rise[j], s.ev_rise_err[j])
+    if c != 0:
+        return c
+    s.n_fine_tests += 1
+    if fine_top(s, i) and fine_top(s, j):
+        c = fine_sign(s.ev_fine[2 * i] - s.ev_fine[2 * j], s.ev_fine[2 * i + 1] + s.ev_fine[2 * j + 1])
+        if c != 0:
+            return c
     event_sites(s, i, ti)
     event_sites(s, j, tj)
     s.n_exact_circle += 1
@@ -372,6 +407,15 @@ cdef bint site_first(Sweep* s, int i, int ev) noexcept nogil:
         return True
     if yi > s.ev_hi[ev]:
         return False
+    # near tie: the rise above the event's site, the quad filter, then exact integers
+    r = relative_sign(s.ev_base[ev], s.ev_rise[ev], s.ev_rise_err[ev], yi, 0.0, 0.0)
+    if r != 0:
+        return r > 0
+    s.n_fine_tests += 1
+    if fine_top(s, ev):
+        r = fine_sign(s.ev_fine[2 * ev] - <quad>yi, s.ev_fine[2 * ev + 1])
+        if r != 0:
+            return r > 0
     event_sites(s, ev, tri)
     s.n_exact_site += 1
     r = tvb_site_first(yi, tri)
@@ -459,8 +503,9 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
         s.status = BROKEN
         return
     # the event is where the sweep line touches the circle's top: rounded, with an interval that holds it
-    circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c],
-               &s.ev_y[ev], &s.ev_lo[ev], &s.ev_hi[ev], &s.ev_x[ev], &s.ev_cy[ev])
+    circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev], &s.ev_lo[ev], &s.ev_hi[ev],
+               &s.ev_base[ev], &s.ev_rise[ev], &s.ev_rise_err[ev], &s.ev_x[ev], &s.ev_cy[ev])
+    s.ev_fine_state[ev] = FINE_UNKNOWN
     s.ev_arc[ev] = arc
     s.arc_event[arc] = ev
     heap_push(s, ev)
@@ -711,8 +756,9 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     STATUS_MESSAGES), ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation
     (vertex n at infinity; only when the sweep finished without trouble and
     some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
-    ``flips`` (exact repairs), ``exact_tests`` (site and circle comparisons
-    the filter left to exact arithmetic), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
+    left to the quad one, events whose quad top was computed), ``exact_tests``
+    (site and circle comparisons left to exact integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
@@ -728,6 +774,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         "arc_edge": np.empty(cap_arcs, np.int32),
         "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
         "ev_lo": np.empty(cap_ev, np.float64), "ev_hi": np.empty(cap_ev, np.float64),
+        "ev_fine_state": np.empty(cap_ev, np.int8), "ev_base": np.empty(cap_ev, np.float64),
+        "ev_rise": np.empty(cap_ev, np.float64), "ev_rise_err": np.empty(cap_ev, np.float64),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
@@ -745,6 +793,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] arc_event = arrays["arc_event"], arc_edge = arrays["arc_edge"]
     cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
     cdef double[::1] ev_lo = arrays["ev_lo"], ev_hi = arrays["ev_hi"]
+    cdef int8_t[::1] ev_fine_state = arrays["ev_fine_state"]
+    cdef double[::1] ev_base = arrays["ev_base"], ev_rise = arrays["ev_rise"], ev_rise_err = arrays["ev_rise_err"]
     cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
@@ -760,6 +810,11 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
     s.ev_lo = &ev_lo[0]; s.ev_hi = &ev_hi[0]
+    s.ev_fine_state = &ev_fine_state[0]
+    s.ev_base = &ev_base[0]; s.ev_rise = &ev_rise[0]; s.ev_rise_err = &ev_rise_err[0]
+    s.ev_fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
+    if s.ev_fine == NULL:
+        raise MemoryError("Fortune's sweep: event buffers")
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
     s.free_events = &free_events[0]; s.n_free_ev = 0
     s.free_arcs = &free_arcs[0]; s.n_free = 0
@@ -770,18 +825,22 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
     s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
     # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
-    with nogil:
-        while stop_after < 0 or steps < stop_after:
-            if not step(&s, &next_site):
-                break
-            steps += 1
+    try:
+        with nogil:
+            while stop_after < 0 or steps < stop_after:
+                if not step(&s, &next_site):
+                    break
+                steps += 1
+    finally:
+        free(s.ev_fine)
+        s.ev_fine = NULL
     out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
            "last": (s.last_kind, s.last_site, s.last_tri),
-           "exact_tests": (s.n_exact_site, s.n_exact_circle)}
+           "near_ties": (s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle)}
     if s.status != OK:
         return out
     cdef bint finished = next_site == n and s.n_heap == 0
@@ -880,16 +939,17 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
     cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
-    cdef int n_f64 = 5 * cap_ev + 2 * cap_rec
+    cdef int n_f64 = 8 * cap_ev + 2 * cap_rec
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
-    cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri) * sizeof(int8_t))
+    cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
+    cdef quad* fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
     cdef int32_t* p = ib
     cdef double* q = fb
     cdef Sweep s
     cdef int next_site = 0, k, result = -1
-    if ib == NULL or fb == NULL or bb == NULL:
-        free(ib); free(fb); free(bb)
+    if ib == NULL or fb == NULL or bb == NULL or fine == NULL:
+        free(ib); free(fb); free(bb); free(fine)
         return -1
     s.x = x; s.y = y; s.n = n
     s.arc_site = p; p += cap_arcs
@@ -917,11 +977,16 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     cdef int32_t* stack = p
     s.height = bb
     cdef int8_t* queued = bb + cap_arcs
+    s.ev_fine_state = bb + cap_arcs + 3 * cap_tri
+    s.ev_fine = fine
     s.ev_y = q; q += cap_ev
     s.ev_x = q; q += cap_ev
     s.ev_cy = q; q += cap_ev
     s.ev_lo = q; q += cap_ev
     s.ev_hi = q; q += cap_ev
+    s.ev_base = q; q += cap_ev
+    s.ev_rise = q; q += cap_ev
+    s.ev_rise_err = q; q += cap_ev
     s.rec_x = q; q += cap_rec
     s.rec_y = q
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
@@ -929,7 +994,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
     s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):
@@ -946,17 +1011,33 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     free(ib)
     free(fb)
     free(bb)
+    free(fine)
     return result
 
 
 def circle_event_top(double ax, double ay, double bx, double by, double cx, double cy):
-    """The circle event of sites a, b, c (counter-clockwise), for tests: (top, lo, hi, centre x, centre y).
+    """The circle event of sites a, b, c (counter-clockwise), for tests.
 
-    ``top`` is rounded; the exact top of the circle lies in [lo, hi].
+    Returns (top, lo, hi, base, rise, rise_err, centre x, centre y): ``top``
+    is rounded; the exact top lies in [lo, hi] and within rise_err of
+    base + rise.
     """
-    cdef double top, lo, hi, centre_x, centre_y
-    circle_top(ax, ay, bx, by, cx, cy, &top, &lo, &hi, &centre_x, &centre_y)
-    return top, lo, hi, centre_x, centre_y
+    cdef double top, lo, hi, base, rise, rise_err, centre_x, centre_y
+    circle_top(ax, ay, bx, by, cx, cy, &top, &lo, &hi, &base, &rise, &rise_err, &centre_x, &centre_y)
+    return top, lo, hi, base, rise, rise_err, centre_x, centre_y
+
+
+def circle_event_top_fine(double ax, double ay, double bx, double by, double cx, double cy):
+    """The quad-precision filter's top of the circle through a, b, c, for tests: None when it gives up,
+    else (head, tail, err): the exact top lies within err of head + tail (err rounded up to a double)."""
+    cdef quad top, err
+    cdef double head, tail
+    if not circle_top_fine(ax, ay, bx, by, cx, cy, &top, &err):
+        return None
+    head = <double>top
+    tail = <double>(top - <quad>head)
+    # (head + tail holds 106 of the 113 bits: the tail's rounding joins the bound)
+    return head, tail, (np.nextafter(<double>err, np.inf) + abs(tail) * 2.0 ** -52) * (1 + 2.0 ** -50)
 
 
 def site_before_event(double y, double ax, double ay, double bx, double by, double cx, double cy):
