@@ -42,6 +42,8 @@ cdef extern from *:
     #define TVORONOI_EVENT_SLACK 1.4996968138956309548176444376647E-241
     /* 2^-500: smallest nonzero coordinate the exact determinant accepts (its products stay normal) */
     #define TVORONOI_EVENT_TINY_COORD 3.0549363634996046820519793932137E-151
+    /* 2^-36: a fast bound looser than this, relative to the top and radius, is redone carefully */
+    #define TVORONOI_EVENT_LOOSE 1.4551915228366851806640625E-11
     /* 2^-30: a determinant known to less than this relative accuracy is recomputed exactly */
     #define TVORONOI_EVENT_REFINE 9.3132257461547851562500000000000E-10
     """
@@ -49,6 +51,7 @@ cdef extern from *:
     const double EVENT_SLACK "TVORONOI_EVENT_SLACK"
     const double EVENT_TINY_COORD "TVORONOI_EVENT_TINY_COORD"
     const double EVENT_REFINE "TVORONOI_EVENT_REFINE"
+    const double EVENT_LOOSE "TVORONOI_EVENT_LOOSE"
 
 
 cdef inline bint usable_difference(double d) noexcept nogil:
@@ -129,6 +132,45 @@ cdef inline double orient_rounded(double ax, double ay, double bx, double by, do
     return compressed_head(n, cur)
 
 
+cdef inline bint circle_top_fast(double ax, double ay, double bx, double by, double cx, double cy,
+                                 double* top, double* lo, double* hi,
+                                 double* centre_x, double* centre_y) noexcept nogil:
+    """The common case of circle_top, with fewer operations and no data-dependent branch: the centre
+    relative to a, top = ay + uy + r, and a looser bound (2 (Ex + Ey) + 2.01 u r + u |uy + r| for the
+    rise, the terms as in circle_top, Ex + Ey summed in one expression). False when the determinant is
+    not known to half its size or a difference is too small: circle_top then does the careful work.
+    """
+    cdef double u = EPSILON
+    cdef double bdx = bx - ax, bdy = by - ay, cdx = cx - ax, cdy = cy - ay
+    cdef double p1 = bdx * cdy, p2 = bdy * cdx
+    cdef double det = 2.0 * (p1 - p2)
+    cdef double e_det = 2.0 * CCW_ERRBOUND_A * (fabs(p1) + fabs(p2))
+    cdef double bb = bdx * bdx + bdy * bdy, cc = cdx * cdx + cdy * cdy
+    cdef double t1 = cdy * bb, t2 = bdy * cc, t3 = bdx * cc, t4 = cdx * bb
+    cdef double inv_det, ux, uy, r, h, t, e_xy, e_t
+    if not (e_det <= 0.5 * det) or not (usable_difference(bdx) and usable_difference(bdy)
+                                        and usable_difference(cdx) and usable_difference(cdy)):
+        return False
+    inv_det = 1.0 / det
+    ux = (t1 - t2) * inv_det
+    uy = (t3 - t4) * inv_det
+    r = sqrt(ux * ux + uy * uy)
+    h = uy + r
+    t = ay + h
+    centre_x[0] = ax + ux
+    centre_y[0] = ay + uy
+    top[0] = t
+    # Ex + Ey, then the rise's bound 2 (Ex + Ey) + 2.01 u r + u |h|, then the top's
+    e_xy = ((2.0 * u * (1.0 + 2.0 * u)) * (fabs(ux) + fabs(uy)) * det
+            + 8.0 * u * (fabs(t1) + fabs(t2) + fabs(t3) + fabs(t4)) + (fabs(ux) + fabs(uy)) * e_det) * (2.0 * inv_det)
+    e_t = (2.0 * e_xy + 2.01 * u * r + u * fabs(h) + u * fabs(t)) * (1.0 + 1e-6) + 2.0 * u * fabs(t) + EVENT_SLACK
+    if not (e_t < INFINITY) or not (fabs(t) < INFINITY) or e_t > EVENT_LOOSE * (fabs(t) + r):
+        return False                # (a loose bound: a thin triangle, which circle_top bounds better)
+    lo[0] = t - e_t
+    hi[0] = t + e_t
+    return True
+
+
 cdef inline void circle_top(double ax, double ay, double bx, double by, double cx, double cy,
                             double* top, double* lo, double* hi, double* base, double* rise, double* rise_err,
                             double* centre_x, double* centre_y) noexcept nogil:
@@ -139,19 +181,19 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
     by the rises, whose error is a few u of the rise, not of the top (relative_sign below).
     """
     cdef double u = EPSILON
-    cdef double sx, sy, ab, bc, ca, kx, ky, dkx, dky, wx, wy, e_wx, e_wy
-    cdef double bdx, bdy, cdx, cdy, p1, p2, det, e_det
-    cdef double bb, cc, t1, t2, t3, t4, ux, uy, r, h, t, e_x, e_y, e_r, e_s, e_h, e_t, margin
-    cdef double s = 0.0
-    # the origin: the site opposite the longest side (a cyclic turn keeps the triple counter-clockwise);
-    # the centre's offsets from it are then computed without cancellation
-    ab = (bx - ax) * (bx - ax) + (by - ay) * (by - ay)
-    bc = (cx - bx) * (cx - bx) + (cy - by) * (cy - by)
-    ca = (ax - cx) * (ax - cx) + (ay - cy) * (ay - cy)
-    if ca > bc and ca >= ab:
-        sx = ax; sy = ay; ax = bx; ay = by; bx = cx; by = cy; cx = sx; cy = sy
-    elif ab > bc and ab > ca:
-        sx = cx; sy = cy; cx = bx; cy = by; bx = ax; by = ay; ax = sx; ay = sy
+    cdef double abx = bx - ax, aby = by - ay, bcx = cx - bx, bcy = cy - by, cax = ax - cx, cay = ay - cy
+    cdef double ab2 = abx * abx + aby * aby, bc2 = bcx * bcx + bcy * bcy, ca2 = cax * cax + cay * cay
+    cdef double ox, oy, kx, ky, bdx, bdy, cdx, cdy, bb, cc, dkx, dky, wx, wy, e_wx, e_wy
+    cdef double p1, p2, det, e_det, inv_det, t1, t2, t3, t4, ux, uy, r, h, t, e_x, e_y, e_r, e_s, e_h, e_t
+    cdef double s = 0.0, inv_s = 0.0
+    # the origin: the site opposite the longest side, so that the centre's offsets from it come without
+    # cancellation; B and C run from it to the other two, counter-clockwise (the differences are reused)
+    if ca2 > bc2 and ca2 >= ab2:
+        ox = bx; oy = by; bdx = bcx; bdy = bcy; cdx = -abx; cdy = -aby; bb = bc2; cc = ab2
+    elif ab2 > bc2 and ab2 > ca2:
+        ox = cx; oy = cy; bdx = cax; bdy = cay; cdx = -bcx; cdy = -bcy; bb = ca2; cc = bc2
+    else:
+        ox = ax; oy = ay; bdx = abx; bdy = aby; cdx = -cax; cdy = -cay; bb = ab2; cc = ca2
     # the highest site: the rise is measured from it
     kx = ax; ky = ay
     if by > ky:
@@ -159,26 +201,24 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
     if cy > ky:
         kx = cx; ky = cy
     base[0] = ky
-    bdx = bx - ax; bdy = by - ay; cdx = cx - ax; cdy = cy - ay
     p1 = bdx * cdy; p2 = bdy * cdx
     det = 2.0 * (p1 - p2)
     e_det = 2.0 * CCW_ERRBOUND_A * (fabs(p1) + fabs(p2))
-    # a nearly collinear triple gets its determinant to within 2 ulps (else the bound below is loose)
+    # a nearly collinear triple gets its determinant to within an ulp (else the bound below is loose)
     if not (e_det < EVENT_REFINE * det) and (
             usable_coordinate(ax) and usable_coordinate(ay) and usable_coordinate(bx)
             and usable_coordinate(by) and usable_coordinate(cx) and usable_coordinate(cy)):
         det = 2.0 * orient_rounded(ax, ay, bx, by, cx, cy)
         e_det = 2.001 * u * fabs(det)
-    # the centre, relative to a, and relative to the highest site
-    bb = bdx * bdx + bdy * bdy
-    cc = cdx * cdx + cdy * cdy
+    # the centre, relative to the origin, and relative to the highest site
+    inv_det = 1.0 / det
     t1 = cdy * bb; t2 = bdy * cc; t3 = bdx * cc; t4 = cdx * bb
-    ux = (t1 - t2) / det
-    uy = (t3 - t4) / det
+    ux = (t1 - t2) * inv_det
+    uy = (t3 - t4) * inv_det
     r = sqrt(ux * ux + uy * uy)
-    centre_x[0] = ax + ux
-    centre_y[0] = ay + uy
-    dkx = ax - kx; dky = ay - ky
+    centre_x[0] = ox + ux
+    centre_y[0] = oy + uy
+    dkx = ox - kx; dky = oy - ky
     wx = dkx + ux
     wy = dky + uy
     # the rise above the highest site: wy + r, or without cancellation when the centre lies below it
@@ -186,21 +226,24 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
         h = wy + r
     else:
         s = r - wy
-        h = wx * wx / s
+        inv_s = 1.0 / s
+        h = wx * wx * inv_s
     t = ky + h
     top[0] = t
     rise[0] = h
-    rise_err[0] = INFINITY
-    # the error bounds
-    margin = det - e_det
-    if not (margin > 0.0) or not (usable_difference(bdx) and usable_difference(bdy)
-                                  and usable_difference(cdx) and usable_difference(cdy)
-                                  and usable_difference(dkx) and usable_difference(dky)):
+    # the error bounds; a determinant or a denominator known to less than half its size gives up
+    if not (e_det <= 0.5 * det) or not (usable_difference(bdx) and usable_difference(bdy)
+                                        and usable_difference(cdx) and usable_difference(cdy)
+                                        and usable_difference(dkx) and usable_difference(dky)):
         lo[0] = -INFINITY
         hi[0] = INFINITY
+        rise_err[0] = INFINITY
         return
-    e_x = (u * fabs(ux) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t1) + fabs(t2)) + fabs(ux) * e_det) / margin
-    e_y = (u * fabs(uy) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t3) + fabs(t4)) + fabs(uy) * e_det) / margin
+    # (quotients through a rounded inverse: 2 u each; 1 / (det - e_det) <= 2 / det)
+    e_x = (2.0 * u * fabs(ux) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t1) + fabs(t2)) + fabs(ux) * e_det) \
+        * (2.0 * inv_det)
+    e_y = (2.0 * u * fabs(uy) * det * (1.0 + 2.0 * u) + 8.0 * u * (fabs(t3) + fabs(t4)) + fabs(uy) * e_det) \
+        * (2.0 * inv_det)
     e_r = 2.01 * u * r + e_x + e_y
     e_wx = e_x + u * fabs(dkx) * (1.0 + u) + u * fabs(wx)
     e_wy = e_y + u * fabs(dky) * (1.0 + u) + u * fabs(wy)
@@ -208,12 +251,13 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
         e_h = e_wy + e_r + u * h
     else:
         e_s = e_r + e_wy + u * s
-        if not (s > e_s):
+        if not (e_s <= 0.5 * s):
             lo[0] = -INFINITY
             hi[0] = INFINITY
+            rise_err[0] = INFINITY
             return
-        e_h = ((u * h * s * (1.0 + 2.0 * u) + e_wx * (2.0 * fabs(wx) + e_wx) + u * wx * wx + h * e_s)
-               / (s - e_s))
+        # (h = wx^2 * fl(1 / s): three roundings; 1 / (s - e_s) <= 2 / s)
+        e_h = (3.0 * u * h * s * (1.0 + 4.0 * u) + e_wx * (2.0 * fabs(wx) + e_wx) + h * e_s) * (2.0 * inv_s)
     # the slack: with every nonzero difference >= 2^-250 the radius is >= 2^-251, so at most the squares
     # of a centre offset below 2^-511 underflow, each by <= 2^-1074, and nothing divides them by less
     # than 2^-251 without the interval being (-inf, inf) already
@@ -221,6 +265,7 @@ cdef inline void circle_top(double ax, double ay, double bx, double by, double c
     if not (e_t < INFINITY) or not (fabs(t) < INFINITY):
         lo[0] = -INFINITY
         hi[0] = INFINITY
+        rise_err[0] = INFINITY
         return
     lo[0] = t - e_t
     hi[0] = t + e_t

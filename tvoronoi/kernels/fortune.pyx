@@ -1,4 +1,10 @@
-"""Fortune's sweepline: site and circle events, the beach line in an AVL tree, the result as a triangulation."""
+"""Fortune's sweepline: site and circle events, the beach line in an AVL tree, the result as a triangulation.
+
+Where each phase lives: the sweep's state in sweep_state.pxd, the beach line (AVL tree, locating a site) in
+beach_line.pxd, the event queue and its exact order in event_queue.pxd, the top of a circle event and its
+filters in circle_events.pxd, the exact integer fallback in event_order_exact.pxd; here the events
+themselves, closing the hull, the guard repair and the Python entries.
+"""
 
 import numpy as np
 
@@ -7,10 +13,15 @@ from libc.math cimport sqrt, INFINITY
 from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
-from tvoronoi.kernels.parabola cimport parabola_order
 from tvoronoi.kernels.mesh cimport nxt, prv
-from tvoronoi.kernels.circle_events cimport circle_top, relative_sign, circle_top_fine, fine_sign, quad
+from tvoronoi.kernels.circle_events cimport circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_sign, quad
 from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
+from tvoronoi.kernels.sweep_state cimport (
+    Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
+    OK, BROKEN, NO_MEMORY, NO_REPAIR,
+)
+from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_arc
+from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, site_first
 
 # The sweep line y = L moves upwards; sites are numbered in event order
 # (by y, then x). Each arc of the beach line is a node of an AVL tree (in
@@ -40,22 +51,6 @@ from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
 # should make impossible) stops the sweep with a status code that the Python
 # layer turns into a TvoronoiError.
 
-cdef enum:
-    NONE = -1
-    EVENT_SITE = 0
-    EVENT_CIRCLE = 1
-    EVENT_REPEAT = 2      # a site at the same place as an earlier one
-
-cdef enum:
-    FINE_UNKNOWN = 0
-    FINE_OK = 1
-    FINE_NONE = 2         # the quad filter cannot bound this event's top
-
-cdef enum:
-    OK = 0
-    BROKEN = 1            # an inconsistent state: a capacity exceeded, an arc without neighbours, ...
-    NO_MEMORY = 2         # the exact fallback could not allocate
-    NO_REPAIR = 3         # the exact repair did not converge within its bound
 
 STATUS_OK = OK
 STATUS_BROKEN = BROKEN
@@ -68,296 +63,36 @@ STATUS_MESSAGES = {
 }
 
 
-cdef struct Sweep:
-    const double* x
-    const double* y
-    int n
-    # arcs: site, list neighbours, tree links, pending event, record of the breakpoint to the right
-    int32_t* arc_site
-    int32_t* arc_prev
-    int32_t* arc_next
-    int32_t* left
-    int32_t* right
-    int32_t* parent
-    int8_t* height
-    int32_t* arc_event
-    int32_t* arc_edge
-    int root
-    int n_arcs
-    int first_arc
-    int32_t* free_arcs     # slots of removed arcs, reused so the live beach line stays in cache
-    int n_free
-    # circle events: position (top of the circle, rounded, and an interval that surely holds it),
-    # centre, arc; a binary heap of their ids
-    double* ev_y
-    double* ev_lo
-    double* ev_hi
-    double* ev_x
-    double* ev_cy
-    double* ev_base         # the top as base + rise: the y of the event's first site,
-    double* ev_rise         # the rise above it (rounded),
-    double* ev_rise_err     # and a bound on the rise's error
-    quad* ev_fine           # the top in quad precision and its bound (2 per event), for near ties
-    int8_t* ev_fine_state   # FINE_UNKNOWN, FINE_OK, FINE_NONE
-    int32_t* ev_arc
-    int32_t* heap
-    int32_t* ev_pos        # where each pending event sits in the heap
-    int n_heap
-    int n_events
-    int32_t* free_events
-    int n_free_ev
-    # edge records: the sites on each side, the Delaunay half-edges found so far, where it began
-    int32_t* rec_a
-    int32_t* rec_b
-    int32_t* rec_e0
-    int32_t* rec_e1
-    double* rec_x
-    double* rec_y
-    int n_recs
-    # the triangulation
-    int32_t* tv
-    int32_t* opp
-    int n_tri
-    int32_t* dup
-    # the first row of sites (equal y), before any other site
-    bint row_mode
-    int row_last
-    # the last event, for the step trace
-    int last_kind
-    int last_site
-    int last_tri
-    double sweep_y
-    # capacities of the arrays, what went wrong, and how often the exact fallback ran
-    int cap_arcs
-    int cap_ev
-    int cap_rec
-    int cap_tri
-    int status
-    long n_exact_site
-    long n_exact_circle
-    long n_fine_tops
-    long n_fine_tests
-
-
 # ---------------------------------------------------------------------------------------------------------
-# AVL tree of arcs (ordered left to right; positions are given, never searched by key, except in locate)
+# the event order at near ties (event_queue.pxd settles the rest): the rises above the highest sites, the
+# quad filter, then exact integers
 
-cdef inline int h_of(Sweep* s, int v) noexcept nogil:
-    return 0 if v == NONE else s.height[v]
-
-
-cdef inline void fix_height(Sweep* s, int v) noexcept nogil:
-    cdef int hl = h_of(s, s.left[v]), hr = h_of(s, s.right[v])
-    s.height[v] = <int8_t>(1 + (hl if hl > hr else hr))
-
-
-cdef inline void replace_child(Sweep* s, int p, int old, int new) noexcept nogil:
-    if p == NONE:
-        s.root = new
-    elif s.left[p] == old:
-        s.left[p] = new
-    else:
-        s.right[p] = new
-
-
-cdef int rotate_left(Sweep* s, int x) noexcept nogil:
-    cdef int y = s.right[x]
-    s.right[x] = s.left[y]
-    if s.left[y] != NONE:
-        s.parent[s.left[y]] = x
-    s.parent[y] = s.parent[x]
-    replace_child(s, s.parent[x], x, y)
-    s.left[y] = x
-    s.parent[x] = y
-    fix_height(s, x)
-    fix_height(s, y)
-    return y
-
-
-cdef int rotate_right(Sweep* s, int x) noexcept nogil:
-    cdef int y = s.left[x]
-    s.left[x] = s.right[y]
-    if s.right[y] != NONE:
-        s.parent[s.right[y]] = x
-    s.parent[y] = s.parent[x]
-    replace_child(s, s.parent[x], x, y)
-    s.right[y] = x
-    s.parent[x] = y
-    fix_height(s, x)
-    fix_height(s, y)
-    return y
-
-
-cdef void rebalance_up(Sweep* s, int v) noexcept nogil:
-    cdef int bal, before
-    while v != NONE:
-        before = s.height[v]
-        fix_height(s, v)
-        bal = h_of(s, s.left[v]) - h_of(s, s.right[v])
-        if -1 <= bal <= 1 and s.height[v] == before:
-            return          # this subtree's height did not change: nothing above it did
-
-        if bal > 1:
-            if h_of(s, s.left[s.left[v]]) < h_of(s, s.right[s.left[v]]):
-                rotate_left(s, s.left[v])
-            v = rotate_right(s, v)
-        elif bal < -1:
-            if h_of(s, s.right[s.right[v]]) < h_of(s, s.left[s.right[v]]):
-                rotate_right(s, s.right[v])
-            v = rotate_left(s, v)
-        v = s.parent[v]
-
-
-cdef int new_arc(Sweep* s, int site) noexcept nogil:
-    cdef int a
-    if s.n_free > 0:
-        s.n_free -= 1
-        a = s.free_arcs[s.n_free]
-    else:
-        a = s.n_arcs
-        s.n_arcs += 1
-    s.arc_site[a] = site
-    s.arc_prev[a] = NONE
-    s.arc_next[a] = NONE
-    s.left[a] = NONE
-    s.right[a] = NONE
-    s.parent[a] = NONE
-    s.height[a] = 1
-    s.arc_event[a] = NONE
-    s.arc_edge[a] = NONE
-    return a
-
-
-cdef void insert_after(Sweep* s, int x, int z) noexcept nogil:
-    """Put arc z right after arc x, in the list and in the tree."""
-    cdef int y
-    s.arc_prev[z] = x
-    s.arc_next[z] = s.arc_next[x]
-    if s.arc_next[x] != NONE:
-        s.arc_prev[s.arc_next[x]] = z
-    s.arc_next[x] = z
-    if s.right[x] == NONE:
-        s.right[x] = z
-        s.parent[z] = x
-    else:
-        y = s.right[x]
-        while s.left[y] != NONE:
-            y = s.left[y]
-        s.left[y] = z
-        s.parent[z] = y
-    rebalance_up(s, s.parent[z])
-
-
-cdef void remove_arc(Sweep* s, int z) noexcept nogil:
-    """Take arc z out of the list and the tree."""
-    cdef int y, zp, zl, zr, yp, yr, child, p
-    cdef int8_t zh
-    if s.arc_prev[z] != NONE:
-        s.arc_next[s.arc_prev[z]] = s.arc_next[z]
-    else:
-        s.first_arc = s.arc_next[z]
-    if s.arc_next[z] != NONE:
-        s.arc_prev[s.arc_next[z]] = s.arc_prev[z]
-    if s.left[z] != NONE and s.right[z] != NONE:
-        # swap z with its successor y in the tree (y has no left child)
-        y = s.right[z]
-        while s.left[y] != NONE:
-            y = s.left[y]
-        zp = s.parent[z]; zl = s.left[z]; zr = s.right[z]; zh = s.height[z]
-        yp = s.parent[y]; yr = s.right[y]
-        replace_child(s, zp, z, y)
-        s.parent[y] = zp
-        s.left[y] = zl
-        s.parent[zl] = y
-        if yp == z:
-            s.right[y] = z
-            s.parent[z] = y
-        else:
-            s.right[y] = zr
-            s.parent[zr] = y
-            s.left[yp] = z
-            s.parent[z] = yp
-        s.left[z] = NONE
-        s.right[z] = yr
-        if yr != NONE:
-            s.parent[yr] = z
-        s.height[z] = s.height[y]
-        s.height[y] = zh
-    child = s.left[z] if s.left[z] != NONE else s.right[z]
-    p = s.parent[z]
-    replace_child(s, p, z, child)
-    if child != NONE:
-        s.parent[child] = p
-    rebalance_up(s, p)
-    s.free_arcs[s.n_free] = z
-    s.n_free += 1
-
-
-# ---------------------------------------------------------------------------------------------------------
-# locating a new site on the beach line
-
-cdef int breakpoint_side(Sweep* s, int a, int b, double px, double py) noexcept nogil:
-    """-1 if p is left of the breakpoint between arcs of sites a (left) and b, +1 right, 0 on it."""
-    cdef double ax = s.x[a], ay = s.y[a], bx = s.x[b], by = s.y[b]
-    cdef int o
-    # of two parabolas, the narrower (its site nearer the sweep line) is above the
-    # other between their two crossings, and its apex lies between them: the
-    # breakpoint with a on the left is the right crossing if a is narrower
-    if ay > by:
-        if px <= ax:
-            return -1
-    elif by > ay:
-        if px >= bx:
-            return 1
-    elif ay == py:
-        return 1          # degenerate case: both on the sweep row; p comes after them
-    o = parabola_order(ax, ay, bx, by, px, py)
-    return -1 if o > 0 else (1 if o < 0 else 0)
-
-
-cdef int locate_arc(Sweep* s, double px, double py) noexcept nogil:
-    """The arc above p (at a breakpoint: the arc right of it)."""
-    cdef int v = s.root, a, c, step
-    while True:
-        a = s.arc_prev[v]
-        c = s.arc_next[v]
-        step = 0
-        if a != NONE and breakpoint_side(s, s.arc_site[a], s.arc_site[v], px, py) < 0:
-            step = -1
-        elif c != NONE and breakpoint_side(s, s.arc_site[v], s.arc_site[c], px, py) > 0:
-            step = 1
-        if step == -1 and s.left[v] != NONE:
-            v = s.left[v]
-        elif step == 1 and s.right[v] != NONE:
-            v = s.right[v]
-        else:
-            return v
-
-
-# ---------------------------------------------------------------------------------------------------------
-# circle events
-
-cdef inline void event_sites(Sweep* s, int ev, double* tri) noexcept nogil:
-    """The coordinates of the three sites of event ev (the arc and its two neighbours, counter-clockwise)."""
-    cdef int arc = s.ev_arc[ev]
-    cdef int a = s.arc_site[s.arc_prev[arc]], b = s.arc_site[arc], c = s.arc_site[s.arc_next[arc]]
-    tri[0] = s.x[a]; tri[1] = s.y[a]
-    tri[2] = s.x[b]; tri[3] = s.y[b]
-    tri[4] = s.x[c]; tri[5] = s.y[c]
+cdef void event_rise(Sweep* s, int ev, double* base, double* rise, double* rise_err) noexcept nogil:
+    """The top of event ev as base + rise (within rise_err): computed once, when a near tie needs it."""
+    cdef double tri[6]
+    cdef double top, lo, hi, centre_x, centre_y
+    if not (s.ev_fine_state[ev] & RISE_KNOWN):
+        event_sites(s, ev, tri)
+        circle_top(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5], &top, &lo, &hi,
+                   &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &centre_x, &centre_y)
+        s.ev_fine_state[ev] |= RISE_KNOWN
+    base[0] = s.ev_rise[3 * ev]
+    rise[0] = s.ev_rise[3 * ev + 1]
+    rise_err[0] = s.ev_rise[3 * ev + 2]
 
 
 cdef bint fine_top(Sweep* s, int ev) noexcept nogil:
     """The quad-precision top of event ev (computed once, when first needed); False if unavailable."""
     cdef double tri[6]
-    if s.ev_fine_state[ev] == FINE_UNKNOWN:
+    if (s.ev_fine_state[ev] & FINE_MASK) == FINE_UNKNOWN:
         s.n_fine_tops += 1
         event_sites(s, ev, tri)
         if circle_top_fine(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5],
                            &s.ev_fine[2 * ev], &s.ev_fine[2 * ev + 1]):
-            s.ev_fine_state[ev] = FINE_OK
+            s.ev_fine_state[ev] |= FINE_OK
         else:
-            s.ev_fine_state[ev] = FINE_NONE
-    return s.ev_fine_state[ev] == FINE_OK
+            s.ev_fine_state[ev] |= FINE_NONE
+    return (s.ev_fine_state[ev] & FINE_MASK) == FINE_OK
 
 
 cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
@@ -365,8 +100,12 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     cdef double ti[6]
     cdef double tj[6]
     cdef int c
+    cdef double base_i, rise_i, err_i, base_j, rise_j, err_j
     # near tie: the rises above the sites, the quad filter, then exact integers
-    c = relative_sign(s.ev_base[i], s.ev_rise[i], s.ev_rise_err[i], s.ev_base[j], s.ev_rise[j], s.ev_rise_err[j])
+    s.n_near += 1
+    event_rise(s, i, &base_i, &rise_i, &err_i)
+    event_rise(s, j, &base_j, &rise_j, &err_j)
+    c = relative_sign(base_i, rise_i, err_i, base_j, rise_j, err_j)
     if c != 0:
         return c
     s.n_fine_tests += 1
@@ -384,31 +123,25 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     return c
 
 
-cdef inline bint ev_less(Sweep* s, int i, int j) noexcept nogil:
-    """Event i comes before event j: by the top of its circle (exact), then by the centre's rounded x."""
-    cdef int c
-    if s.ev_hi[i] < s.ev_lo[j]:
-        return True
-    if s.ev_hi[j] < s.ev_lo[i]:
-        return False
-    c = top_order_exact(s, i, j)
+cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil:
+    """ev_less when the two events' intervals overlap: the exact sign, then the centre's rounded x."""
+    cdef int c = top_order_exact(s, i, j)
     if c != 0:
         return c < 0
     # equal tops: different centres share no arc (the events commute), one centre is a cocircular group
     return s.ev_x[i] < s.ev_x[j]
 
 
-cdef bint site_first(Sweep* s, int i, int ev) noexcept nogil:
-    """Site i comes before circle event ev: y_i <= top(ev), exactly (a site first at a tie)."""
+cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
+    """site_first when y_i lies in the event's interval."""
     cdef double yi = s.y[i]
     cdef double tri[6]
+    cdef double base, rise, err
     cdef int r
-    if yi <= s.ev_lo[ev]:
-        return True
-    if yi > s.ev_hi[ev]:
-        return False
     # near tie: the rise above the event's site, the quad filter, then exact integers
-    r = relative_sign(s.ev_base[ev], s.ev_rise[ev], s.ev_rise_err[ev], yi, 0.0, 0.0)
+    s.n_near += 1
+    event_rise(s, ev, &base, &rise, &err)
+    r = relative_sign(base, rise, err, yi, 0.0, 0.0)
     if r != 0:
         return r > 0
     s.n_fine_tests += 1
@@ -425,63 +158,8 @@ cdef bint site_first(Sweep* s, int i, int ev) noexcept nogil:
     return r == 1
 
 
-cdef inline void heap_set(Sweep* s, int k, int ev) noexcept nogil:
-    s.heap[k] = ev
-    s.ev_pos[ev] = k
-
-
-cdef void sift_up(Sweep* s, int k) noexcept nogil:
-    cdef int ev = s.heap[k], up
-    while k > 0:
-        up = (k - 1) // 2
-        if not ev_less(s, ev, s.heap[up]):
-            break
-        heap_set(s, k, s.heap[up])
-        k = up
-    heap_set(s, k, ev)
-
-
-cdef void sift_down(Sweep* s, int k) noexcept nogil:
-    cdef int ev = s.heap[k], c
-    while True:
-        c = 2 * k + 1
-        if c >= s.n_heap:
-            break
-        if c + 1 < s.n_heap and ev_less(s, s.heap[c + 1], s.heap[c]):
-            c += 1
-        if not ev_less(s, s.heap[c], ev):
-            break
-        heap_set(s, k, s.heap[c])
-        k = c
-    heap_set(s, k, ev)
-
-
-cdef void heap_push(Sweep* s, int ev) noexcept nogil:
-    s.heap[s.n_heap] = ev
-    s.ev_pos[ev] = s.n_heap
-    s.n_heap += 1
-    sift_up(s, s.n_heap - 1)
-
-
-cdef void heap_remove(Sweep* s, int ev) noexcept nogil:
-    """Take event ev out of the heap and free its slot."""
-    cdef int k = s.ev_pos[ev]
-    s.n_heap -= 1
-    if k < s.n_heap:
-        heap_set(s, k, s.heap[s.n_heap])
-        if k > 0 and ev_less(s, s.heap[k], s.heap[(k - 1) // 2]):
-            sift_up(s, k)
-        else:
-            sift_down(s, k)
-    s.free_events[s.n_free_ev] = ev
-    s.n_free_ev += 1
-
-
-cdef inline void cancel_event(Sweep* s, int arc) noexcept nogil:
-    if s.arc_event[arc] != NONE:
-        heap_remove(s, s.arc_event[arc])
-        s.arc_event[arc] = NONE
-
+# ---------------------------------------------------------------------------------------------------------
+# circle events: scheduling one
 
 cdef void check_circle(Sweep* s, int arc) noexcept nogil:
     """Schedule the circle event of arc if its two breakpoints converge."""
@@ -503,9 +181,15 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
         s.status = BROKEN
         return
     # the event is where the sweep line touches the circle's top: rounded, with an interval that holds it
-    circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev], &s.ev_lo[ev], &s.ev_hi[ev],
-               &s.ev_base[ev], &s.ev_rise[ev], &s.ev_rise_err[ev], &s.ev_x[ev], &s.ev_cy[ev])
-    s.ev_fine_state[ev] = FINE_UNKNOWN
+    if circle_top_fast(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev],
+                       &s.ev_span[2 * ev], &s.ev_span[2 * ev + 1], &s.ev_x[ev], &s.ev_cy[ev]):
+        s.ev_fine_state[ev] = FINE_UNKNOWN
+    else:
+        # a thin triangle (or tiny differences): the careful computation, its rise kept for near ties
+        circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev],
+                   &s.ev_span[2 * ev], &s.ev_span[2 * ev + 1],
+                   &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &s.ev_x[ev], &s.ev_cy[ev])
+        s.ev_fine_state[ev] = FINE_UNKNOWN | RISE_KNOWN
     s.ev_arc[ev] = arc
     s.arc_event[arc] = ev
     heap_push(s, ev)
@@ -527,13 +211,20 @@ cdef int new_record(Sweep* s, int a, int b, double x, double y) noexcept nogil:
 
 
 cdef inline void attach(Sweep* s, int r, int e) noexcept nogil:
-    """Half-edge e of a new triangle lies on the edge of record r: pair it with the other side."""
-    if s.rec_e0[r] == NONE:
+    """Half-edge e of a new triangle lies on the edge of record r: pair it with the other side.
+
+    Each twin link is written once, both ways, between half-edges with the same two ends; anything
+    else is an inconsistent state (BROKEN), so the finished links need no second look.
+    """
+    cdef int o = s.rec_e0[r]
+    if o == NONE:
         s.rec_e0[r] = e
+    elif s.rec_e1[r] != NONE or s.tv[o] != s.tv[nxt(e)] or s.tv[nxt(o)] != s.tv[e]:
+        s.status = BROKEN           # a third triangle on one edge, or a twin with other ends
     else:
         s.rec_e1[r] = e
-        s.opp[e] = s.rec_e0[r]
-        s.opp[s.rec_e0[r]] = e
+        s.opp[e] = o
+        s.opp[o] = e
 
 
 cdef void site_event(Sweep* s, int i) noexcept nogil:
@@ -588,7 +279,8 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
 cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     cdef int arc = s.ev_arc[ev], l = s.arc_prev[arc], r = s.arc_next[arc]
     cdef int a, b, c, t, rec
-    if l == NONE or r == NONE or s.n_tri >= s.cap_tri or s.n_recs >= s.cap_rec:
+    if (l == NONE or r == NONE or s.arc_edge[l] == NONE or s.arc_edge[arc] == NONE
+            or s.n_tri >= s.cap_tri or s.n_recs >= s.cap_rec):
         s.status = BROKEN           # an event of an arc at the end of the beach line, or too many
         return
     a = s.arc_site[l]
@@ -649,10 +341,11 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
 cdef int close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
     """An infinite triangle beyond each edge that has a triangle on one side only; OK or BROKEN.
 
-    vmap (n + 1 entries) is scratch. Every twin link is checked afterwards, so
-    the repair and the Python layer never follow a link that was not written.
+    vmap (n + 1 entries) is scratch. Every twin link is written once, both
+    ways, and checked (here and in attach), so the repair and the Python layer
+    never follow a link that was not written.
     """
-    cdef int r, e, u, w, t, k, o, first = s.n_tri
+    cdef int r, e, u, w, t, k, first = s.n_tri
     for k in range(s.n + 1):
         vmap[k] = NONE
     # an infinite triangle (w, u, inf) beyond each finite half-edge u->w without a twin
@@ -678,14 +371,14 @@ cdef int close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
     # the infinite triangle that starts at u
     for t in range(first, s.n_tri):
         u = s.tv[3 * t + 1]
-        if vmap[u] == NONE:
-            return BROKEN           # the hull is not a closed cycle
+        if vmap[u] == NONE or s.opp[3 * vmap[u] + 2] != NONE:
+            return BROKEN           # the hull is not one closed cycle
         s.opp[3 * t + 1] = 3 * vmap[u] + 2
         s.opp[3 * vmap[u] + 2] = 3 * t + 1
-    # every half-edge has a twin that points back at it, with the same two ends
+    # every link was written once, both ways, between matching ends: what is left is a half-edge
+    # without a twin
     for e in range(3 * s.n_tri):
-        o = s.opp[e]
-        if o < 0 or o >= 3 * s.n_tri or s.opp[o] != e or s.tv[o] != s.tv[nxt(e)] or s.tv[nxt(o)] != s.tv[e]:
+        if s.opp[e] == NONE:
             return BROKEN
     return OK
 
@@ -757,7 +450,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     (vertex n at infinity; only when the sweep finished without trouble and
     some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
     ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
-    left to the quad one, events whose quad top was computed), ``exact_tests``
+    left to the rises, those left to the quad filter, events whose quad top
+    was computed), ``exact_tests``
     (site and circle comparisons left to exact integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
@@ -773,9 +467,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
         "arc_edge": np.empty(cap_arcs, np.int32),
         "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
-        "ev_lo": np.empty(cap_ev, np.float64), "ev_hi": np.empty(cap_ev, np.float64),
-        "ev_fine_state": np.empty(cap_ev, np.int8), "ev_base": np.empty(cap_ev, np.float64),
-        "ev_rise": np.empty(cap_ev, np.float64), "ev_rise_err": np.empty(cap_ev, np.float64),
+        "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
+        "ev_fine_state": np.empty(cap_ev, np.int8),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
@@ -792,9 +485,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] free_arcs = arrays["free_arcs"]
     cdef int32_t[::1] arc_event = arrays["arc_event"], arc_edge = arrays["arc_edge"]
     cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
-    cdef double[::1] ev_lo = arrays["ev_lo"], ev_hi = arrays["ev_hi"]
+    cdef double[::1] ev_span = arrays["ev_span"], ev_rise = arrays["ev_rise"]
     cdef int8_t[::1] ev_fine_state = arrays["ev_fine_state"]
-    cdef double[::1] ev_base = arrays["ev_base"], ev_rise = arrays["ev_rise"], ev_rise_err = arrays["ev_rise_err"]
     cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
@@ -809,9 +501,9 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
-    s.ev_lo = &ev_lo[0]; s.ev_hi = &ev_hi[0]
+    s.ev_span = &ev_span[0]
+    s.ev_rise = &ev_rise[0]
     s.ev_fine_state = &ev_fine_state[0]
-    s.ev_base = &ev_base[0]; s.ev_rise = &ev_rise[0]; s.ev_rise_err = &ev_rise_err[0]
     s.ev_fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
     if s.ev_fine == NULL:
         raise MemoryError("Fortune's sweep: event buffers")
@@ -825,7 +517,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
     s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
     # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
@@ -840,7 +532,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         s.ev_fine = NULL
     out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
            "last": (s.last_kind, s.last_site, s.last_tri),
-           "near_ties": (s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle)}
+           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle)}
     if s.status != OK:
         return out
     cdef bint finished = next_site == n and s.n_heap == 0
@@ -939,7 +631,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
     cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
-    cdef int n_f64 = 8 * cap_ev + 2 * cap_rec
+    cdef int n_f64 = 9 * cap_ev + 2 * cap_rec
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
     cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
@@ -982,11 +674,8 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.ev_y = q; q += cap_ev
     s.ev_x = q; q += cap_ev
     s.ev_cy = q; q += cap_ev
-    s.ev_lo = q; q += cap_ev
-    s.ev_hi = q; q += cap_ev
-    s.ev_base = q; q += cap_ev
-    s.ev_rise = q; q += cap_ev
-    s.ev_rise_err = q; q += cap_ev
+    s.ev_span = q; q += 2 * cap_ev
+    s.ev_rise = q; q += 3 * cap_ev
     s.rec_x = q; q += cap_rec
     s.rec_y = q
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
@@ -994,7 +683,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
     s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):
