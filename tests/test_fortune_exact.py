@@ -500,3 +500,22 @@ def test_hard_families_finish(kind, tmp_path):
     exact = [(Fraction(float(x)), Fraction(float(y))) for x, y in pts]
     assert len(set(exact)) == len(pts)
     assert n_finite == 2 * len(pts) - 2 - exact_hull_count(exact)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the stages of the event order are all exercised, and trouble is an error, not a crash
+
+def test_every_stage_of_the_event_order_runs():
+    """An exact lattice has exactly equal tops (integers decide), sites within 1e-16 of two lines have
+    near ties that the rises settle; both sweeps stay exact."""
+    _, _, out, _ = check_sweep(lattice(8, "square", 0.0, 0.0, SEED))
+    assert out["exact_tests"][1] > 0
+    _, _, out, _ = check_sweep(parallel_lines(300, 1.0, 1e-16, SEED))
+    assert out["near_ties"][0] > 0
+
+
+def test_an_inconsistent_sweep_is_a_tvoronoi_error(monkeypatch):
+    real = fortune.sweep
+    monkeypatch.setattr(fortune, "sweep", lambda xs, ys: {**real(xs, ys), "status": fortune.STATUS_BROKEN})
+    with pytest.raises(tvoronoi.TvoronoiError, match="inconsistent state"):
+        tvoronoi.voronoi(np.random.default_rng(SEED).random((20, 2)), engine="fortune")

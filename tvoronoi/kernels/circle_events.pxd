@@ -1,32 +1,41 @@
 # Circle events of Fortune's sweep: where an event happens (the top of the circle through three sites) as a
-# rounded value with a proven error bound, so that the event order is decided exactly: by the bound when
-# it separates two positions, by exact integer arithmetic (event_order_exact.pxd) when it does not.
+# rounded value with a proven error bound, so that the event order is decided exactly. Four stages, each
+# only for what the one before could not separate:
+#   1. circle_top_fast / circle_top: the top and an interval [lo, hi] that holds it (two doubles compared);
+#   2. the top as base + rise, base the highest site's y, rise with its own bound (relative_sign): near
+#      ties much closer than an ulp of the top (sites within 1e-16 of a line) are far apart in the rises;
+#   3. circle_top_fine: the same computation in binary128 with its bound;
+#   4. exact integer arithmetic (event_order_exact.pxd).
 #
-# For sites a, b, c counter-clockwise, relative to a (B = b - a, C = c - a):
-#     D = Bx Cy - By Cx > 0,   centre - a = (Ux, Uy) = (Cy |B|^2 - By |C|^2,  Bx |C|^2 - Cx |B|^2) / (2 D),
-#     radius R = |(Ux, Uy)|,   top T = ay + Uy + R.
-# Uy + R cancels when the centre lies far below the sites (a huge circle through nearly collinear sites:
-# a few ulps of a 1e17 radius would move the top of a circle whose sites lie within 1e-18 of a line by
-# more than the spread of the sites); there the top is computed as ay + Ux^2 / (R - Uy), which is the same
-# number (R^2 - Uy^2 = Ux^2) without the cancellation.
+# For sites a, b, c counter-clockwise, relative to an origin o among them (B, C: from o to the other two,
+# counter-clockwise):
+#     D = Bx Cy - By Cx > 0,   centre - o = (Ux, Uy) = (Cy |B|^2 - By |C|^2,  Bx |C|^2 - Cx |B|^2) / (2 D),
+#     radius R = |(Ux, Uy)|,   top T = oy + Uy + R.
+# circle_top takes o opposite the longest side (the offsets then come without cancellation) and measures
+# the rise from the highest site k, W = centre - k: rise = Wy + R, and when the centre lies below k,
+# Wx^2 / (R - Wy), the same number (R^2 - Wy^2 = Wx^2) without the cancellation of Wy + R (a few ulps of a
+# 1e17 radius would otherwise move the top of a circle through sites within 1e-18 of a line by more than
+# the spread of the sites).
 #
 # The error bound, u = 2^-53 (each rounded operation has relative error at most u):
 #   - differences, squares and products: |bb - |B|^2| <= 4.0001 u |B|^2, each product of three
 #     differences within 6.0001 u; so |numx - 2 D Ux| <= 8 u (|t1| + |t2|), the same for numy;
-#   - |det - 2 D| <= e_det = 2 CCW_ERRBOUND_A (|p1| + |p2|) (Shewchuk's orient2d bound, same determinant);
-#   - a quotient q = fl(num / det) of values with errors e_num, e_det, det > e_det, is within
-#     E = (u |q| det / (1 - u) + e_num + |q| e_det) / (det - e_det) of the exact quotient;
+#   - |det - 2 D| <= e_det = 2 CCW_ERRBOUND_A (|p1| + |p2|) (Shewchuk's orient2d bound, same determinant),
+#     or 2.001 u |det| when det is recomputed from its exact expansion (orient_rounded);
+#   - a quotient q = num * fl(1 / det) of values with errors e_num, e_det, e_det <= det / 2, is within
+#     E = (2 u |q| det (1 + 2u) + e_num + |q| e_det) * 2 / det of the exact quotient;
 #   - |r - R| <= 2.01 u r + Ex + Ey (the norm is 1-Lipschitz; the rounded sqrt of rounded squares);
-#   - uy >= 0: h = uy + r within Ey + Er + u h;  uy < 0: s = r - uy within Es = Er + Ey + u s, s > Es,
-#     h = ux^2 / s within (u h s / (1 - u) + Ex (2 |ux| + Ex) + u ux^2 + h Es) / (s - Es);
-#   - T = ay + h within Eh + u |T|.
+#   - W = (o - k) + U: Ewx = Ex + u |ox - kx| (1 + u) + u |wx|, the same for y;
+#   - wy >= 0: h = wy + r within Ewy + Er + u h;  wy < 0: s = r - wy within Es = Er + Ewy + u s,
+#     Es <= s / 2, h = wx^2 fl(1 / s) within (3 u h s (1 + 4u) + Ewx (2 |wx| + Ewx) + h Es) * 2 / s;
+#   - T = ky + h within Eh + u |T|.
 # The bound itself is computed with rounding: it is a sum of products and quotients of nonnegative terms
 # (about 30 operations), so a factor 1 + 1e-6 covers its own rounding, and 2 u |T| more the rounding of
 # T -/+ bound. Underflow: the filter requires every nonzero coordinate difference to be at least
 # 2^-250, so that no product of up to three differences underflows; what may still underflow (the squares
 # of a tiny centre offset) is absorbed by an absolute slack of 2^-800 (the circle's radius is at least
 # 2^-251 then, see the comment at the slack). Anything not finite (overflow of a far-away centre) or a
-# determinant within its own error gives the interval (-inf, +inf): every comparison goes exact.
+# determinant known to less than half its size gives the interval (-inf, +inf): the later stages decide.
 
 from libc.math cimport fabs, sqrt, INFINITY
 

@@ -38,7 +38,8 @@ from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, 
 # Every decision is exact: which arc a site falls on (parabola_order and
 # coordinate comparisons), whether three arcs converge (orient2d), and the
 # order of events (circle_events.pxd: a rounded top of each circle with a
-# proven error bound, exact integer arithmetic when two bounds overlap). At an
+# proven error bound; near ties by the rise above the highest site, then in
+# quad precision, then in exact integers, event_order_exact.pxd). At an
 # exact tie a site comes before a circle event, and circle events with equal
 # tops go by their rounded centre x: events at one height with different
 # centres share no arc and commute, events at one centre are cocircular sites,
