@@ -452,8 +452,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
     ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
     left to the rises, those left to the quad filter, events whose quad top
-    was computed), ``exact_tests``
-    (site and circle comparisons left to exact integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    was computed), ``exact_tests`` (site and circle comparisons left to exact
+    integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
