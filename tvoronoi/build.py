@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.diagram import Diagram
+from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import clip, dcel, delaunay, fortune, order
 
 
@@ -30,8 +31,6 @@ BOX_SCALED_MAX = 2.0 ** 1000
 
 def check_box_scale(box, e: int) -> None:
     """Refuse a box whose sides the exact tests could not handle in the sites' scaled unit."""
-    from tvoronoi.errors import TvoronoiError
-
     for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
         try:
             s = abs(math.ldexp(v, -e))
@@ -107,12 +106,23 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return perm.astype(np.int32)
 
 
+def sweep_checked(xs: np.ndarray, ys: np.ndarray) -> dict:
+    """fortune.sweep on sites in sweep order; a state the sweep could not complete is an error, never a result."""
+    result = fortune.sweep(xs, ys)
+    if result["status"] != fortune.STATUS_OK:
+        raise TvoronoiError(
+            f"{fortune.STATUS_MESSAGES[result['status']]} on {len(xs)} points; "
+            "build with engine='incremental' instead, and please report the input"
+        )
+    return result
+
+
 def fortune_dcel(xs: np.ndarray, ys: np.ndarray, exponent: int = 0):
     """Run Fortune's sweep on sites in input order; returns (perm, xs, ys, out) as incremental_dcel."""
     perm = sweep_order(xs, ys)
     xs = np.ascontiguousarray(xs[perm])
     ys = np.ascontiguousarray(ys[perm])
-    result = fortune.sweep(xs, ys)
+    result = sweep_checked(xs, ys)
     if "tv" not in result:
         return perm, xs, ys, collinear_dcel(xs, ys)
     out = dcel.voronoi_from_delaunay(xs, ys, result["tv"], result["opp"], exponent)

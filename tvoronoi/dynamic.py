@@ -7,10 +7,10 @@ import math
 import numpy as np
 
 from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox, scale_exponent
-from tvoronoi.build import assemble, collinear_dcel, sweep_order
+from tvoronoi.build import assemble, collinear_dcel, sweep_checked, sweep_order
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
-from tvoronoi.kernels import dcel, delaunay, dynamic, fortune, order
+from tvoronoi.kernels import dcel, delaunay, dynamic, order
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
     """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
@@ -119,7 +119,7 @@ class DynamicVoronoi:
         if self.engine == "fortune":
             perm = sweep_order(xs, ys)
             sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
-            res = fortune.sweep(sx, sy)
+            res = sweep_checked(sx, sy)
             ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
         else:
             # a biased randomized insertion order, as in the batch engine

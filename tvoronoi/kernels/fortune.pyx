@@ -1,4 +1,10 @@
-"""Fortune's sweepline: site and circle events, the beach line in an AVL tree, the result as a triangulation."""
+"""Fortune's sweepline: site and circle events, the beach line in an AVL tree, the result as a triangulation.
+
+Where each phase lives: the sweep's state in sweep_state.pxd, the beach line (AVL tree, locating a site) in
+beach_line.pxd, the event queue and its exact order in event_queue.pxd, the top of a circle event and its
+filters in circle_events.pxd, the exact integer fallback in event_order_exact.pxd; here the events
+themselves, closing the hull, the guard repair and the Python entries.
+"""
 
 import numpy as np
 
@@ -7,8 +13,15 @@ from libc.math cimport sqrt, INFINITY
 from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
-from tvoronoi.kernels.parabola cimport parabola_order
 from tvoronoi.kernels.mesh cimport nxt, prv
+from tvoronoi.kernels.circle_events cimport circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_sign, quad
+from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
+from tvoronoi.kernels.sweep_state cimport (
+    Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
+    OK, BROKEN, NO_MEMORY, NO_REPAIR,
+)
+from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_arc
+from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, site_first
 
 # The sweep line y = L moves upwards; sites are numbered in event order
 # (by y, then x). Each arc of the beach line is a node of an AVL tree (in
@@ -23,336 +36,135 @@ from tvoronoi.kernels.mesh cimport nxt, prv
 # hull). dcel.voronoi_from_delaunay turns it into the Voronoi DCEL.
 #
 # Every decision is exact: which arc a site falls on (parabola_order and
-# coordinate comparisons), whether three arcs converge (orient2d). Event
-# positions are rounded doubles; where rounding could order two events that
-# are equal up to an ulp the wrong way (cocircular and nearly cocircular
-# sites), a final pass of exact Lawson flips restores the Delaunay property,
-# so the diagram is exact on every input.
+# coordinate comparisons), whether three arcs converge (orient2d), and the
+# order of events (circle_events.pxd: a rounded top of each circle with a
+# proven error bound; near ties by the rise above the highest site, then in
+# quad precision, then in exact integers, event_order_exact.pxd). At an
+# exact tie a site comes before a circle event, and circle events with equal
+# tops go by their rounded centre x: events at one height with different
+# centres share no arc and commute, events at one centre are cocircular sites,
+# any order of which gives a triangulation of their group (the dual merges
+# it). A final pass of exact Lawson flips stays as a guard; it finds nothing
+# to flip when the order is exact.
+#
+# The kernel never trusts its own state blindly: every array has its bound
+# checked before a write, and an inconsistent state (which exact decisions
+# should make impossible) stops the sweep with a status code that the Python
+# layer turns into a TvoronoiError.
 
-cdef enum:
-    NONE = -1
-    EVENT_SITE = 0
-    EVENT_CIRCLE = 1
-    EVENT_REPEAT = 2      # a site at the same place as an earlier one
 
-
-cdef struct Sweep:
-    const double* x
-    const double* y
-    int n
-    # arcs: site, list neighbours, tree links, pending event, record of the breakpoint to the right
-    int32_t* arc_site
-    int32_t* arc_prev
-    int32_t* arc_next
-    int32_t* left
-    int32_t* right
-    int32_t* parent
-    int8_t* height
-    int32_t* arc_event
-    int32_t* arc_edge
-    int root
-    int n_arcs
-    int first_arc
-    int32_t* free_arcs     # slots of removed arcs, reused so the live beach line stays in cache
-    int n_free
-    # circle events: position (top of the circle), centre, arc; a binary heap of their ids
-    double* ev_y
-    double* ev_x
-    double* ev_cy
-    int32_t* ev_arc
-    int32_t* heap
-    int32_t* ev_pos        # where each pending event sits in the heap
-    int n_heap
-    int n_events
-    int32_t* free_events
-    int n_free_ev
-    # edge records: the sites on each side, the Delaunay half-edges found so far, where it began
-    int32_t* rec_a
-    int32_t* rec_b
-    int32_t* rec_e0
-    int32_t* rec_e1
-    double* rec_x
-    double* rec_y
-    int n_recs
-    # the triangulation
-    int32_t* tv
-    int32_t* opp
-    int n_tri
-    int32_t* dup
-    # the first row of sites (equal y), before any other site
-    bint row_mode
-    int row_last
-    # the last event, for the step trace
-    int last_kind
-    int last_site
-    int last_tri
-    double sweep_y
+STATUS_OK = OK
+STATUS_BROKEN = BROKEN
+STATUS_NO_MEMORY = NO_MEMORY
+STATUS_NO_REPAIR = NO_REPAIR
+STATUS_MESSAGES = {
+    BROKEN: "Fortune's sweep reached an inconsistent state",
+    NO_MEMORY: "Fortune's sweep ran out of memory in its exact arithmetic",
+    NO_REPAIR: "Fortune's sweep: the exact repair did not converge",
+}
 
 
 # ---------------------------------------------------------------------------------------------------------
-# AVL tree of arcs (ordered left to right; positions are given, never searched by key, except in locate)
+# the event order at near ties (event_queue.pxd settles the rest): the rises above the highest sites, the
+# quad filter, then exact integers
 
-cdef inline int h_of(Sweep* s, int v) noexcept nogil:
-    return 0 if v == NONE else s.height[v]
-
-
-cdef inline void fix_height(Sweep* s, int v) noexcept nogil:
-    cdef int hl = h_of(s, s.left[v]), hr = h_of(s, s.right[v])
-    s.height[v] = <int8_t>(1 + (hl if hl > hr else hr))
-
-
-cdef inline void replace_child(Sweep* s, int p, int old, int new) noexcept nogil:
-    if p == NONE:
-        s.root = new
-    elif s.left[p] == old:
-        s.left[p] = new
-    else:
-        s.right[p] = new
+cdef void event_rise(Sweep* s, int ev, double* base, double* rise, double* rise_err) noexcept nogil:
+    """The top of event ev as base + rise (within rise_err): computed once, when a near tie needs it."""
+    cdef double tri[6]
+    cdef double top, lo, hi, centre_x, centre_y
+    if not (s.ev_fine_state[ev] & RISE_KNOWN):
+        event_sites(s, ev, tri)
+        circle_top(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5], &top, &lo, &hi,
+                   &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &centre_x, &centre_y)
+        s.ev_fine_state[ev] |= RISE_KNOWN
+    base[0] = s.ev_rise[3 * ev]
+    rise[0] = s.ev_rise[3 * ev + 1]
+    rise_err[0] = s.ev_rise[3 * ev + 2]
 
 
-cdef int rotate_left(Sweep* s, int x) noexcept nogil:
-    cdef int y = s.right[x]
-    s.right[x] = s.left[y]
-    if s.left[y] != NONE:
-        s.parent[s.left[y]] = x
-    s.parent[y] = s.parent[x]
-    replace_child(s, s.parent[x], x, y)
-    s.left[y] = x
-    s.parent[x] = y
-    fix_height(s, x)
-    fix_height(s, y)
-    return y
-
-
-cdef int rotate_right(Sweep* s, int x) noexcept nogil:
-    cdef int y = s.left[x]
-    s.left[x] = s.right[y]
-    if s.right[y] != NONE:
-        s.parent[s.right[y]] = x
-    s.parent[y] = s.parent[x]
-    replace_child(s, s.parent[x], x, y)
-    s.right[y] = x
-    s.parent[x] = y
-    fix_height(s, x)
-    fix_height(s, y)
-    return y
-
-
-cdef void rebalance_up(Sweep* s, int v) noexcept nogil:
-    cdef int bal, before
-    while v != NONE:
-        before = s.height[v]
-        fix_height(s, v)
-        bal = h_of(s, s.left[v]) - h_of(s, s.right[v])
-        if -1 <= bal <= 1 and s.height[v] == before:
-            return          # this subtree's height did not change: nothing above it did
-
-        if bal > 1:
-            if h_of(s, s.left[s.left[v]]) < h_of(s, s.right[s.left[v]]):
-                rotate_left(s, s.left[v])
-            v = rotate_right(s, v)
-        elif bal < -1:
-            if h_of(s, s.right[s.right[v]]) < h_of(s, s.left[s.right[v]]):
-                rotate_right(s, s.right[v])
-            v = rotate_left(s, v)
-        v = s.parent[v]
-
-
-cdef int new_arc(Sweep* s, int site) noexcept nogil:
-    cdef int a
-    if s.n_free > 0:
-        s.n_free -= 1
-        a = s.free_arcs[s.n_free]
-    else:
-        a = s.n_arcs
-        s.n_arcs += 1
-    s.arc_site[a] = site
-    s.arc_prev[a] = NONE
-    s.arc_next[a] = NONE
-    s.left[a] = NONE
-    s.right[a] = NONE
-    s.parent[a] = NONE
-    s.height[a] = 1
-    s.arc_event[a] = NONE
-    s.arc_edge[a] = NONE
-    return a
-
-
-cdef void insert_after(Sweep* s, int x, int z) noexcept nogil:
-    """Put arc z right after arc x, in the list and in the tree."""
-    cdef int y
-    s.arc_prev[z] = x
-    s.arc_next[z] = s.arc_next[x]
-    if s.arc_next[x] != NONE:
-        s.arc_prev[s.arc_next[x]] = z
-    s.arc_next[x] = z
-    if s.right[x] == NONE:
-        s.right[x] = z
-        s.parent[z] = x
-    else:
-        y = s.right[x]
-        while s.left[y] != NONE:
-            y = s.left[y]
-        s.left[y] = z
-        s.parent[z] = y
-    rebalance_up(s, s.parent[z])
-
-
-cdef void remove_arc(Sweep* s, int z) noexcept nogil:
-    """Take arc z out of the list and the tree."""
-    cdef int y, zp, zl, zr, yp, yr, child, p
-    cdef int8_t zh
-    if s.arc_prev[z] != NONE:
-        s.arc_next[s.arc_prev[z]] = s.arc_next[z]
-    else:
-        s.first_arc = s.arc_next[z]
-    if s.arc_next[z] != NONE:
-        s.arc_prev[s.arc_next[z]] = s.arc_prev[z]
-    if s.left[z] != NONE and s.right[z] != NONE:
-        # swap z with its successor y in the tree (y has no left child)
-        y = s.right[z]
-        while s.left[y] != NONE:
-            y = s.left[y]
-        zp = s.parent[z]; zl = s.left[z]; zr = s.right[z]; zh = s.height[z]
-        yp = s.parent[y]; yr = s.right[y]
-        replace_child(s, zp, z, y)
-        s.parent[y] = zp
-        s.left[y] = zl
-        s.parent[zl] = y
-        if yp == z:
-            s.right[y] = z
-            s.parent[z] = y
+cdef bint fine_top(Sweep* s, int ev) noexcept nogil:
+    """The quad-precision top of event ev (computed once, when first needed); False if unavailable."""
+    cdef double tri[6]
+    if (s.ev_fine_state[ev] & FINE_MASK) == FINE_UNKNOWN:
+        s.n_fine_tops += 1
+        event_sites(s, ev, tri)
+        if circle_top_fine(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5],
+                           &s.ev_fine[2 * ev], &s.ev_fine[2 * ev + 1]):
+            s.ev_fine_state[ev] |= FINE_OK
         else:
-            s.right[y] = zr
-            s.parent[zr] = y
-            s.left[yp] = z
-            s.parent[z] = yp
-        s.left[z] = NONE
-        s.right[z] = yr
-        if yr != NONE:
-            s.parent[yr] = z
-        s.height[z] = s.height[y]
-        s.height[y] = zh
-    child = s.left[z] if s.left[z] != NONE else s.right[z]
-    p = s.parent[z]
-    replace_child(s, p, z, child)
-    if child != NONE:
-        s.parent[child] = p
-    rebalance_up(s, p)
-    s.free_arcs[s.n_free] = z
-    s.n_free += 1
+            s.ev_fine_state[ev] |= FINE_NONE
+    return (s.ev_fine_state[ev] & FINE_MASK) == FINE_OK
+
+
+cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
+    """Sign of top(i) - top(j), exactly (the intervals of the two events overlap)."""
+    cdef double ti[6]
+    cdef double tj[6]
+    cdef int c
+    cdef double base_i, rise_i, err_i, base_j, rise_j, err_j
+    # near tie: the rises above the sites, the quad filter, then exact integers
+    s.n_near += 1
+    event_rise(s, i, &base_i, &rise_i, &err_i)
+    event_rise(s, j, &base_j, &rise_j, &err_j)
+    c = relative_sign(base_i, rise_i, err_i, base_j, rise_j, err_j)
+    if c != 0:
+        return c
+    s.n_fine_tests += 1
+    if fine_top(s, i) and fine_top(s, j):
+        c = fine_sign(s.ev_fine[2 * i] - s.ev_fine[2 * j], s.ev_fine[2 * i + 1] + s.ev_fine[2 * j + 1])
+        if c != 0:
+            return c
+    event_sites(s, i, ti)
+    event_sites(s, j, tj)
+    s.n_exact_circle += 1
+    c = tvb_top_order(ti, tj)
+    if c == 2:
+        s.status = NO_MEMORY
+        return 0
+    return c
+
+
+cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil:
+    """ev_less when the two events' intervals overlap: the exact sign, then the centre's rounded x."""
+    cdef int c = top_order_exact(s, i, j)
+    if c != 0:
+        return c < 0
+    # equal tops: different centres share no arc (the events commute), one centre is a cocircular group
+    return s.ev_x[i] < s.ev_x[j]
+
+
+cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
+    """site_first when y_i lies in the event's interval."""
+    cdef double yi = s.y[i]
+    cdef double tri[6]
+    cdef double base, rise, err
+    cdef int r
+    # near tie: the rise above the event's site, the quad filter, then exact integers
+    s.n_near += 1
+    event_rise(s, ev, &base, &rise, &err)
+    r = relative_sign(base, rise, err, yi, 0.0, 0.0)
+    if r != 0:
+        return r > 0
+    s.n_fine_tests += 1
+    if fine_top(s, ev):
+        r = fine_sign(s.ev_fine[2 * ev] - <quad>yi, s.ev_fine[2 * ev + 1])
+        if r != 0:
+            return r > 0
+    event_sites(s, ev, tri)
+    s.n_exact_site += 1
+    r = tvb_site_first(yi, tri)
+    if r < 0:
+        s.status = NO_MEMORY
+        return True
+    return r == 1
 
 
 # ---------------------------------------------------------------------------------------------------------
-# locating a new site on the beach line
-
-cdef int breakpoint_side(Sweep* s, int a, int b, double px, double py) noexcept nogil:
-    """-1 if p is left of the breakpoint between arcs of sites a (left) and b, +1 right, 0 on it."""
-    cdef double ax = s.x[a], ay = s.y[a], bx = s.x[b], by = s.y[b]
-    cdef int o
-    # of two parabolas, the narrower (its site nearer the sweep line) is above the
-    # other between their two crossings, and its apex lies between them: the
-    # breakpoint with a on the left is the right crossing if a is narrower
-    if ay > by:
-        if px <= ax:
-            return -1
-    elif by > ay:
-        if px >= bx:
-            return 1
-    elif ay == py:
-        return 1          # degenerate case: both on the sweep row; p comes after them
-    o = parabola_order(ax, ay, bx, by, px, py)
-    return -1 if o > 0 else (1 if o < 0 else 0)
-
-
-cdef int locate_arc(Sweep* s, double px, double py) noexcept nogil:
-    """The arc above p (at a breakpoint: the arc right of it)."""
-    cdef int v = s.root, a, c, step
-    while True:
-        a = s.arc_prev[v]
-        c = s.arc_next[v]
-        step = 0
-        if a != NONE and breakpoint_side(s, s.arc_site[a], s.arc_site[v], px, py) < 0:
-            step = -1
-        elif c != NONE and breakpoint_side(s, s.arc_site[v], s.arc_site[c], px, py) > 0:
-            step = 1
-        if step == -1 and s.left[v] != NONE:
-            v = s.left[v]
-        elif step == 1 and s.right[v] != NONE:
-            v = s.right[v]
-        else:
-            return v
-
-
-# ---------------------------------------------------------------------------------------------------------
-# circle events
-
-cdef inline bint ev_less(Sweep* s, int i, int j) noexcept nogil:
-    return s.ev_y[i] < s.ev_y[j] or (s.ev_y[i] == s.ev_y[j] and s.ev_x[i] < s.ev_x[j])
-
-
-cdef inline void heap_set(Sweep* s, int k, int ev) noexcept nogil:
-    s.heap[k] = ev
-    s.ev_pos[ev] = k
-
-
-cdef void sift_up(Sweep* s, int k) noexcept nogil:
-    cdef int ev = s.heap[k], up
-    while k > 0:
-        up = (k - 1) // 2
-        if not ev_less(s, ev, s.heap[up]):
-            break
-        heap_set(s, k, s.heap[up])
-        k = up
-    heap_set(s, k, ev)
-
-
-cdef void sift_down(Sweep* s, int k) noexcept nogil:
-    cdef int ev = s.heap[k], c
-    while True:
-        c = 2 * k + 1
-        if c >= s.n_heap:
-            break
-        if c + 1 < s.n_heap and ev_less(s, s.heap[c + 1], s.heap[c]):
-            c += 1
-        if not ev_less(s, s.heap[c], ev):
-            break
-        heap_set(s, k, s.heap[c])
-        k = c
-    heap_set(s, k, ev)
-
-
-cdef void heap_push(Sweep* s, int ev) noexcept nogil:
-    s.heap[s.n_heap] = ev
-    s.ev_pos[ev] = s.n_heap
-    s.n_heap += 1
-    sift_up(s, s.n_heap - 1)
-
-
-cdef void heap_remove(Sweep* s, int ev) noexcept nogil:
-    """Take event ev out of the heap and free its slot."""
-    cdef int k = s.ev_pos[ev]
-    s.n_heap -= 1
-    if k < s.n_heap:
-        heap_set(s, k, s.heap[s.n_heap])
-        if k > 0 and ev_less(s, s.heap[k], s.heap[(k - 1) // 2]):
-            sift_up(s, k)
-        else:
-            sift_down(s, k)
-    s.free_events[s.n_free_ev] = ev
-    s.n_free_ev += 1
-
-
-cdef inline void cancel_event(Sweep* s, int arc) noexcept nogil:
-    if s.arc_event[arc] != NONE:
-        heap_remove(s, s.arc_event[arc])
-        s.arc_event[arc] = NONE
-
+# circle events: scheduling one
 
 cdef void check_circle(Sweep* s, int arc) noexcept nogil:
     """Schedule the circle event of arc if its two breakpoints converge."""
     cdef int l = s.arc_prev[arc], r = s.arc_next[arc], a, b, c, ev
-    cdef double bx, by, cx, cy, det, bb, cc, ux, uy
     if l == NONE or r == NONE:
         return
     a = s.arc_site[l]
@@ -360,23 +172,25 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
     c = s.arc_site[r]
     if a == c or orient2d(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c]) <= 0:
         return
-    # the circumcentre, relative to a; the event is where the sweep line touches the circle's top
-    bx = s.x[b] - s.x[a]; by = s.y[b] - s.y[a]
-    cx = s.x[c] - s.x[a]; cy = s.y[c] - s.y[a]
-    det = 2.0 * (bx * cy - by * cx)
-    bb = bx * bx + by * by
-    cc = cx * cx + cy * cy
-    ux = (cy * bb - by * cc) / det
-    uy = (bx * cc - cx * bb) / det
     if s.n_free_ev > 0:
         s.n_free_ev -= 1
         ev = s.free_events[s.n_free_ev]
-    else:
+    elif s.n_events < s.cap_ev:
         ev = s.n_events
         s.n_events += 1
-    s.ev_x[ev] = s.x[a] + ux
-    s.ev_cy[ev] = s.y[a] + uy
-    s.ev_y[ev] = s.ev_cy[ev] + sqrt(ux * ux + uy * uy)
+    else:
+        s.status = BROKEN
+        return
+    # the event is where the sweep line touches the circle's top: rounded, with an interval that holds it
+    if circle_top_fast(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev],
+                       &s.ev_span[2 * ev], &s.ev_span[2 * ev + 1], &s.ev_x[ev], &s.ev_cy[ev]):
+        s.ev_fine_state[ev] = FINE_UNKNOWN
+    else:
+        # a thin triangle (or tiny differences): the careful computation, its rise kept for near ties
+        circle_top(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], &s.ev_y[ev],
+                   &s.ev_span[2 * ev], &s.ev_span[2 * ev + 1],
+                   &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &s.ev_x[ev], &s.ev_cy[ev])
+        s.ev_fine_state[ev] = FINE_UNKNOWN | RISE_KNOWN
     s.ev_arc[ev] = arc
     s.arc_event[arc] = ev
     heap_push(s, ev)
@@ -398,13 +212,20 @@ cdef int new_record(Sweep* s, int a, int b, double x, double y) noexcept nogil:
 
 
 cdef inline void attach(Sweep* s, int r, int e) noexcept nogil:
-    """Half-edge e of a new triangle lies on the edge of record r: pair it with the other side."""
-    if s.rec_e0[r] == NONE:
+    """Half-edge e of a new triangle lies on the edge of record r: pair it with the other side.
+
+    Each twin link is written once, both ways, between half-edges with the same two ends; anything
+    else is an inconsistent state (BROKEN), so the finished links need no second look.
+    """
+    cdef int o = s.rec_e0[r]
+    if o == NONE:
         s.rec_e0[r] = e
+    elif s.rec_e1[r] != NONE or s.tv[o] != s.tv[nxt(e)] or s.tv[nxt(o)] != s.tv[e]:
+        s.status = BROKEN           # a third triangle on one edge, or a twin with other ends
     else:
         s.rec_e1[r] = e
-        s.opp[e] = s.rec_e0[r]
-        s.opp[s.rec_e0[r]] = e
+        s.opp[e] = o
+        s.opp[o] = e
 
 
 cdef void site_event(Sweep* s, int i) noexcept nogil:
@@ -425,12 +246,19 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
         # degenerate case: the first row of sites (equal y); their breakpoints are
         # vertical lines coming up from infinity, in order of x
         b = s.row_last
+        if s.n_free + (s.cap_arcs - s.n_arcs) < 1 or s.n_recs >= s.cap_rec:
+            s.status = BROKEN
+            return
         p = new_arc(s, i)
         insert_after(s, b, p)
         s.arc_edge[b] = new_record(s, s.arc_site[b], i, 0.5 * (s.x[s.arc_site[b]] + px), -INFINITY)
         s.row_last = p
         return
     s.row_mode = False
+    if s.n_free + (s.cap_arcs - s.n_arcs) < 2 or s.n_recs >= s.cap_rec:
+        s.status = BROKEN           # more arcs or edges than n sites can make
+        return
+    # find the arc above the site and split it in two around a new arc
     b = locate_arc(s, px, py)
     site_b = s.arc_site[b]
     cancel_event(s, b)
@@ -451,7 +279,14 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
 
 cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     cdef int arc = s.ev_arc[ev], l = s.arc_prev[arc], r = s.arc_next[arc]
-    cdef int a = s.arc_site[l], b = s.arc_site[arc], c = s.arc_site[r], t, rec
+    cdef int a, b, c, t, rec
+    if (l == NONE or r == NONE or s.arc_edge[l] == NONE or s.arc_edge[arc] == NONE
+            or s.n_tri >= s.cap_tri or s.n_recs >= s.cap_rec):
+        s.status = BROKEN           # an event of an arc at the end of the beach line, or too many
+        return
+    a = s.arc_site[l]
+    b = s.arc_site[arc]
+    c = s.arc_site[r]
     s.sweep_y = s.ev_y[ev]
     # the Voronoi vertex: triangle (a, b, c), counter-clockwise
     t = s.n_tri
@@ -482,7 +317,9 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
     """Process the next event; 0 when there is none left."""
     cdef int i, ev
     i = next_site[0]
-    if i < s.n and (s.n_heap == 0 or s.y[i] <= s.ev_y[s.heap[0]]):
+    if s.status != OK:
+        return 0
+    if i < s.n and (s.n_heap == 0 or site_first(s, i, s.heap[0])):
         # sites come before circle events at the same position
         next_site[0] = i + 1
         if i > 0 and s.x[i] == s.x[i - 1] and s.y[i] == s.y[i - 1]:
@@ -502,16 +339,25 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # closing the hull, and the exact repair
 
-cdef void close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
-    """An infinite triangle beyond each edge that has a triangle on one side only."""
-    cdef int r, e, u, w, t, first = s.n_tri
+cdef int close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
+    """An infinite triangle beyond each edge that has a triangle on one side only; OK or BROKEN.
+
+    vmap (n + 1 entries) is scratch. Every twin link is written once, both
+    ways, and checked (here and in attach), so the repair and the Python layer
+    never follow a link that was not written.
+    """
+    cdef int r, e, u, w, t, k, first = s.n_tri
+    for k in range(s.n + 1):
+        vmap[k] = NONE
+    # an infinite triangle (w, u, inf) beyond each finite half-edge u->w without a twin
     for r in range(s.n_recs):
         e = s.rec_e0[r]
         if e == NONE or s.rec_e1[r] != NONE:
             continue
-        # the finite side has half-edge u->w; beyond it lies (w, u, inf)
         u = s.tv[e]
         w = s.tv[nxt(e)]
+        if s.n_tri >= s.cap_tri or vmap[w] != NONE:
+            return BROKEN           # more hull edges than sites, or two hull edges leaving w
         t = s.n_tri
         s.n_tri += 1
         s.tv[3 * t] = w
@@ -519,20 +365,36 @@ cdef void close_hull(Sweep* s, int32_t* vmap) noexcept nogil:
         s.tv[3 * t + 2] = s.n
         s.opp[3 * t] = e
         s.opp[e] = 3 * t
+        s.opp[3 * t + 1] = NONE
+        s.opp[3 * t + 2] = NONE
         vmap[w] = t
+    # link the infinite triangles around the hull: (w, u, inf) has edge u->inf, the twin of inf->u in
+    # the infinite triangle that starts at u
     for t in range(first, s.n_tri):
-        # (w, u, inf): its edge u->inf is the twin of inf->u in the triangle that starts at u
         u = s.tv[3 * t + 1]
+        if vmap[u] == NONE or s.opp[3 * vmap[u] + 2] != NONE:
+            return BROKEN           # the hull is not one closed cycle
         s.opp[3 * t + 1] = 3 * vmap[u] + 2
         s.opp[3 * vmap[u] + 2] = 3 * t + 1
+    # every link was written once, both ways, between matching ends: what is left is a half-edge
+    # without a twin
+    for e in range(3 * s.n_tri):
+        if s.opp[e] == NONE:
+            return BROKEN
+    return OK
 
 
 cdef bint is_infinite(Sweep* s, int t) noexcept nogil:
     return s.tv[3 * t] == s.n or s.tv[3 * t + 1] == s.n or s.tv[3 * t + 2] == s.n
 
 
-cdef int repair(Sweep* s, int32_t* stack, int8_t* queued) noexcept nogil:
-    """Lawson flips until every edge is locally Delaunay (exact incircle). Returns the flip count."""
+cdef int repair(Sweep* s, int32_t* stack, int8_t* queued, int max_flips) noexcept nogil:
+    """Lawson flips until every edge is locally Delaunay (exact incircle).
+
+    Returns the flip count, or -1 when more than max_flips were needed (an
+    input that was not a triangulation; each flip is exact, so on a valid
+    triangulation the flips end).
+    """
     cdef int n_he = 3 * s.n_tri, top = 0, e, o, e1, e2, o1, o2, a, b, c, d, A, B, flips = 0, k
     cdef int quad[4]
     for e in range(n_he):
@@ -551,6 +413,8 @@ cdef int repair(Sweep* s, int32_t* stack, int8_t* queued) noexcept nogil:
         a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
         if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
             continue
+        if flips >= max_flips:
+            return -1
         # flip a-b to c-d: (a, b, c) + (b, a, d) become (d, b, c) + (c, a, d)
         A = s.opp[e2]
         B = s.opp[o2]
@@ -582,10 +446,14 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
 
     Returns
     -------
-    dict: ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation (vertex n
-    at infinity; only when the sweep finished and some triangle exists),
-    ``dup`` (n,) int32, ``steps`` (events processed), ``flips`` (exact
-    repairs), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    dict: ``status`` (STATUS_OK, or the code of an inconsistent state, with
+    STATUS_MESSAGES), ``tv``, ``opp`` (3 * n_tri,) int32 -- the triangulation
+    (vertex n at infinity; only when the sweep finished without trouble and
+    some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
+    ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
+    left to the rises, those left to the quad filter, events whose quad top
+    was computed), ``exact_tests`` (site and circle comparisons left to exact
+    integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
@@ -600,6 +468,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
         "arc_edge": np.empty(cap_arcs, np.int32),
         "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
+        "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
+        "ev_fine_state": np.empty(cap_ev, np.int8),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
@@ -616,6 +486,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] free_arcs = arrays["free_arcs"]
     cdef int32_t[::1] arc_event = arrays["arc_event"], arc_edge = arrays["arc_edge"]
     cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
+    cdef double[::1] ev_span = arrays["ev_span"], ev_rise = arrays["ev_rise"]
+    cdef int8_t[::1] ev_fine_state = arrays["ev_fine_state"]
     cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
@@ -630,6 +502,12 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
+    s.ev_span = &ev_span[0]
+    s.ev_rise = &ev_rise[0]
+    s.ev_fine_state = &ev_fine_state[0]
+    s.ev_fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
+    if s.ev_fine == NULL:
+        raise MemoryError("Fortune's sweep: event buffers")
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
     s.free_events = &free_events[0]; s.n_free_ev = 0
     s.free_arcs = &free_arcs[0]; s.n_free = 0
@@ -639,15 +517,25 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.dup = &dup[0] if n else NULL
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
+    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
-    with nogil:
-        while stop_after < 0 or steps < stop_after:
-            if not step(&s, &next_site):
-                break
-            steps += 1
-    out = {"dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
-           "last": (s.last_kind, s.last_site, s.last_tri)}
+    # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
+    try:
+        with nogil:
+            while stop_after < 0 or steps < stop_after:
+                if not step(&s, &next_site):
+                    break
+                steps += 1
+    finally:
+        free(s.ev_fine)
+        s.ev_fine = NULL
+    out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
+           "last": (s.last_kind, s.last_site, s.last_tri),
+           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle)}
+    if s.status != OK:
+        return out
     cdef bint finished = next_site == n and s.n_heap == 0
     if not finished or stop_after >= 0:
         out.update(_state(&s, arrays))
@@ -657,17 +545,29 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef int32_t[::1] stack
     cdef int8_t[::1] queued
     if s.n_tri > 0:
+        # close the hull with triangles at infinity, then the exact repair (a guard: no flips expected)
         vmap = np.empty(n + 1, np.int32)
         with nogil:
-            close_hull(&s, &vmap[0])
+            s.status = close_hull(&s, &vmap[0])
+        if s.status != OK:
+            out["status"] = s.status
+            return out
         stack = np.empty(3 * s.n_tri, np.int32)
         queued = np.zeros(3 * s.n_tri, np.int8)
         with nogil:
-            flips = repair(&s, &stack[0], &queued[0])
+            flips = repair(&s, &stack[0], &queued[0], max_repair_flips(s.n_tri))
+        if flips < 0:
+            out["status"] = NO_REPAIR
+            return out
         out["tv"] = arrays["tv"][:3 * s.n_tri]
         out["opp"] = arrays["opp"][:3 * s.n_tri]
     out["flips"] = flips
     return out
+
+
+cdef inline int max_repair_flips(int n_tri) noexcept nogil:
+    """A bound on the flips of the guard repair: none are expected; a wrong sweep is reported, not looped on."""
+    return 3 * n_tri + 1024
 
 
 cdef dict _state(Sweep* s, dict arrays):
@@ -717,7 +617,7 @@ def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_
     s.opp = &opp[0]
     s.n_tri = n_he // 3
     with nogil:
-        flips = repair(&s, &stack[0], &queued[0])
+        flips = repair(&s, &stack[0], &queued[0], 2_000_000_000)
     return flips
 
 
@@ -726,21 +626,23 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
 
     Writes the Delaunay triangles, vertex n at infinity, into tv_out (room for
     cap triangles) and returns their number; -1 when no triangle exists (the
-    sites are collinear) or cap is too small. No Python objects: scratch
+    sites are collinear), cap is too small, memory ran out or the sweep met an
+    inconsistent state. No Python objects: scratch
     memory comes from malloc.
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
     cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
-    cdef int n_f64 = 3 * cap_ev + 2 * cap_rec
+    cdef int n_f64 = 9 * cap_ev + 2 * cap_rec
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
-    cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri) * sizeof(int8_t))
+    cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
+    cdef quad* fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
     cdef int32_t* p = ib
     cdef double* q = fb
     cdef Sweep s
     cdef int next_site = 0, k, result = -1
-    if ib == NULL or fb == NULL or bb == NULL:
-        free(ib); free(fb); free(bb)
+    if ib == NULL or fb == NULL or bb == NULL or fine == NULL:
+        free(ib); free(fb); free(bb); free(fine)
         return -1
     s.x = x; s.y = y; s.n = n
     s.arc_site = p; p += cap_arcs
@@ -768,29 +670,85 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     cdef int32_t* stack = p
     s.height = bb
     cdef int8_t* queued = bb + cap_arcs
+    s.ev_fine_state = bb + cap_arcs + 3 * cap_tri
+    s.ev_fine = fine
     s.ev_y = q; q += cap_ev
     s.ev_x = q; q += cap_ev
     s.ev_cy = q; q += cap_ev
+    s.ev_span = q; q += 2 * cap_ev
+    s.ev_rise = q; q += 3 * cap_ev
     s.rec_x = q; q += cap_rec
     s.rec_y = q
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0; s.n_free = 0; s.n_recs = 0; s.n_tri = 0
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
     s.row_mode = False; s.row_last = NONE
+    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):
         pass
-    if s.n_tri > 0:
-        close_hull(&s, vmap)
+    if s.n_tri > 0 and s.status == OK:
+        s.status = close_hull(&s, vmap)
+    if s.n_tri > 0 and s.status == OK:
         for k in range(3 * s.n_tri):
             queued[k] = 0
-        repair(&s, stack, queued)
-        if s.n_tri <= cap:
+        if repair(&s, stack, queued, max_repair_flips(s.n_tri)) >= 0 and s.n_tri <= cap:
             for k in range(3 * s.n_tri):
                 tv_out[k] = s.tv[k]
             result = s.n_tri
     free(ib)
     free(fb)
     free(bb)
+    free(fine)
     return result
+
+
+def circle_event_top(double ax, double ay, double bx, double by, double cx, double cy):
+    """The circle event of sites a, b, c (counter-clockwise), for tests.
+
+    Returns (top, lo, hi, base, rise, rise_err, centre x, centre y): ``top``
+    is rounded; the exact top lies in [lo, hi] and within rise_err of
+    base + rise.
+    """
+    cdef double top, lo, hi, base, rise, rise_err, centre_x, centre_y
+    circle_top(ax, ay, bx, by, cx, cy, &top, &lo, &hi, &base, &rise, &rise_err, &centre_x, &centre_y)
+    return top, lo, hi, base, rise, rise_err, centre_x, centre_y
+
+
+def circle_event_top_fine(double ax, double ay, double bx, double by, double cx, double cy):
+    """The quad-precision filter's top of the circle through a, b, c, for tests: None when it gives up,
+    else (head, tail, err): the exact top lies within err of head + tail (err rounded up to a double)."""
+    cdef quad top, err
+    cdef double head, tail
+    if not circle_top_fine(ax, ay, bx, by, cx, cy, &top, &err):
+        return None
+    head = <double>top
+    tail = <double>(top - <quad>head)
+    # (head + tail holds 106 of the 113 bits: the tail's rounding joins the bound)
+    return head, tail, (np.nextafter(<double>err, np.inf) + abs(tail) * 2.0 ** -52) * (1 + 2.0 ** -50)
+
+
+def site_before_event(double y, double ax, double ay, double bx, double by, double cx, double cy):
+    """Exact: a site at height y comes before the circle event of a, b, c (y <= top), for tests."""
+    cdef double tri[6]
+    tri[0] = ax; tri[1] = ay; tri[2] = bx; tri[3] = by; tri[4] = cx; tri[5] = cy
+    cdef int r = tvb_site_first(y, tri)
+    if r < 0:
+        raise MemoryError("exact event order")
+    return r == 1
+
+
+def event_top_order(t1, t2):
+    """Exact sign of top(t1) - top(t2) for two counter-clockwise triples (ax, ay, bx, by, cx, cy), for tests."""
+    cdef double a[6]
+    cdef double b[6]
+    cdef int k, r
+    for k in range(6):
+        a[k] = t1[k]
+        b[k] = t2[k]
+    r = tvb_top_order(a, b)
+    if r == 2:
+        raise MemoryError("exact event order")
+    return r
