@@ -1,0 +1,87 @@
+"""Run every adversarial family (and every fixture) with both engines in a child process; print a table.
+
+Usage: python tests/run_hunt.py [--timeout S] [--kernels DIR] [--only SUBSTRING] [--json FILE] [--fixtures]
+
+Each row is family x engine; each column a check: ``ok``, ``FAIL: <first message>``, ``CRASH``, ``TIMEOUT``.
+The ``agree`` column compares the two engines' cells bit for bit.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import adversarial  # noqa: E402
+import exact_checks  # noqa: E402
+from fixtures_io import FIXTURES, load_fixture  # noqa: E402
+from hunt_worker import CHECK_NAMES, Worker, load_cells  # noqa: E402
+
+ENGINES = ("fortune", "incremental")
+
+
+def short(result: str, width: int = 90) -> str:
+    if result == "ok":
+        return "ok"
+    tag = "CRASH" if result.startswith("crash") else "TIMEOUT" if result.startswith("timeout") else "FAIL"
+    text = f"{tag}: {result}"
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def agree(worker: Worker, answers: dict) -> str:
+    try:
+        cells = [load_cells(answers[e]["saved"]) for e in ENGINES]
+    except KeyError:
+        return "not run (an engine gave no diagram)"
+    try:
+        exact_checks.check_same_cells(*cells, names=ENGINES)
+        return "ok"
+    except AssertionError as exc:
+        return str(exc)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--kernels")
+    ap.add_argument("--only", default="")
+    ap.add_argument("--json")
+    ap.add_argument("--fixtures", action="store_true", help="run the fixtures instead of the families")
+    args = ap.parse_args(argv)
+
+    worker = Worker(kernels=args.kernels)
+    rows = []
+    names = sorted(FIXTURES) if args.fixtures else list(adversarial.FAMILIES)
+    try:
+        for name in names:
+            if args.only not in name:
+                continue
+            answers = {}
+            for engine in ENGINES:
+                key = f"{name}-{engine}"
+                if args.fixtures:
+                    case = load_fixture(name)
+                    req = {"points": case.points.tolist(), "bbox": case.bbox}
+                else:
+                    req = {"family": name}
+                req |= {"engine": engine, "save": worker.cells_path(key)}
+                answers[engine] = worker.run(req, timeout=args.timeout)
+            a = agree(worker, answers)
+            for engine in ENGINES:
+                row = {"family": name, "engine": engine, **{c: answers[engine][c] for c in CHECK_NAMES},
+                       "agree": a, "seconds": answers[engine]["seconds"]}
+                rows.append(row)
+                cols = " | ".join(short(row[c]) for c in (*CHECK_NAMES, "agree"))
+                print(f"| {name} | {engine} | {cols} | {row['seconds']} |", flush=True)
+    finally:
+        worker.close()
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
