@@ -339,6 +339,7 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "collinear_plus_one_ulp": partial(collinear_plus_one, 100),
     # lattices
     "grid70_noise1e-17": partial(square_grid, 70, noise=1e-17),
+    "grid10_noise1e-17": partial(square_grid, 10, noise=1e-17),
     "grid30_noise1e-12": partial(square_grid, 30, noise=1e-12),
     "grid30_noise1e-6": partial(square_grid, 30, noise=1e-6),
     "triangular40": partial(triangular_lattice, 40),

@@ -1,16 +1,21 @@
 """Run cases in a child process with a time limit, so that an engine's crash or hang fails one case only.
 
-The child (``python tests/hunt_worker.py``) reads one JSON request a line on stdin, builds the diagram,
-runs the checks of ``exact_checks`` and answers one JSON line: ``{"build": "ok" | message, "box": ...,
-"delaunay": ..., "cells": ..., "tiling": ...}``, and saves the cells (for comparing engines) when asked.
-``Worker`` is the parent's side: it restarts the child after a crash or a timeout and reports
-``crash: <signal or sanitizer line>`` or ``timeout after N s`` for that case.
+The child (``python tests/hunt_worker.py --serve``) reads one JSON request a line on stdin (a family name,
+or points and a box; the engine), builds the diagram, runs the checks of ``exact_checks`` and answers one
+JSON line: ``{"build": "ok" | message, "box": ..., "delaunay": ..., "cells": ..., "distinct": ...,
+"tiling": ..., "digest": ...}``, saving the cells (to compare engines) when asked. A request may also set
+``"poison": BYTE`` (``np.empty`` fills new arrays with that byte during the build, see ``poisoned_empty``)
+and ``"checks": false`` (build and digest only).
 
-``--kernels DIR`` loads the compiled kernels from DIR (the bounds-checked build) instead of the package's.
+``Worker`` is the parent's side: it restarts the child after a crash or a timeout and reports ``crash
+(signal ...): <fatal error or sanitizer line>`` or ``timeout after N s`` as every check's result.
+``--kernels DIR`` makes the child load the compiled kernels from DIR (the checked build).
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import json
 import os
 import selectors
@@ -25,7 +30,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-CHECK_NAMES = ("build", "box", "delaunay", "cells", "tiling")
+CHECK_NAMES = ("build", "box", "delaunay", "cells", "distinct", "tiling")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -44,6 +49,39 @@ def _use_kernels(directory: str) -> None:
 
     for mod in (clip, dcel, delaunay, fortune):
         assert mod.__file__.startswith(kdir), f"{mod.__name__} loaded from {mod.__file__}, not {kdir}"
+
+
+@contextlib.contextmanager
+def poisoned_empty(byte: int | None):
+    """While active, ``numpy.empty`` fills every new array with this byte (None: leave it alone).
+
+    The kernels allocate their work arrays with ``np.empty``; an engine whose result changes with the byte
+    reads memory it never wrote.
+    """
+    if byte is None:
+        yield
+        return
+    real = np.empty
+
+    def empty(*args, **kwargs):
+        a = real(*args, **kwargs)
+        if a.size and a.flags.c_contiguous:
+            a.reshape(-1).view(np.uint8)[:] = byte
+        return a
+
+    np.empty = empty
+    try:
+        yield
+    finally:
+        np.empty = real
+
+
+def digest(d) -> str:
+    """A hash of a diagram's triangles and clipped cells (equal hashes: the same output bit for bit)."""
+    h = hashlib.sha1()
+    for a in (d.triangles, d.site_of, d.cell_points, d.cell_offsets, d.cell_vertices):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
 
 
 def _serve(kernels: str | None) -> None:
@@ -69,6 +107,14 @@ def _serve(kernels: str | None) -> None:
     proto.flush()
     for line in sys.stdin:
         req = json.loads(line)
+        if req.get("selftest") == "asan":          # overflow a numpy buffer: ASan must stop the child here
+            import ctypes
+
+            src, dst = np.zeros(64), np.zeros(128)
+            ctypes.memmove(dst.ctypes.data, src.ctypes.data, 8 * 65)
+            proto.write(json.dumps({"build": "not caught"}) + "\n")
+            proto.flush()
+            continue
         if "family" in req:
             case = adversarial.make(req["family"], req.get("seed", adversarial.SEED))
             pts, bbox = case.points, case.bbox
@@ -78,16 +124,19 @@ def _serve(kernels: str | None) -> None:
         out: dict = {}
         unraisable.clear()
         try:
-            d = tvoronoi.voronoi(pts, engine=req["engine"], bbox=bbox)
+            with poisoned_empty(req.get("poison")):
+                d = tvoronoi.voronoi(pts, engine=req["engine"], bbox=bbox)
             out["build"] = "ok"
         except Exception as exc:  # noqa: BLE001 -- reported, not hidden
             out["build"] = f"{type(exc).__name__}: {exc}"
             d = None
         if unraisable:
             out["build"] = "error ignored inside a kernel: " + unraisable[0]
+        if d is not None:
+            out["digest"] = digest(d)
         for name in CHECK_NAMES[1:]:
-            if d is None:
-                out[name] = "not run (no diagram)"
+            if d is None or not req.get("checks", True):
+                out[name] = "not run" + (" (no diagram)" if d is None else "")
                 continue
             try:
                 exact_checks.CHECKS[name](d)
@@ -202,6 +251,44 @@ class Worker:
             msg = f"crash ({sig}): {self._stderr_tail()}"
             self.proc = None
         return {name: msg for name in CHECK_NAMES} | {"seconds": round(time.monotonic() - t0, 3)}
+
+
+def sanitizer_env(kernels: str) -> dict:
+    """The environment a child needs for kernels built with AddressSanitizer (empty if they were not).
+
+    Python itself is not instrumented, so the ASan runtime must be loaded first (LD_PRELOAD); leak
+    detection is off (the interpreter keeps memory to the end by design).
+    """
+    sos = sorted(Path(kernels, "tvoronoi", "kernels").glob("*.so"))
+    if not sos:
+        return {}
+    out = subprocess.run(["ldd", str(sos[0])], capture_output=True, text=True, check=False).stdout
+    libs = [ln.split("=>")[1].split("(")[0].strip() for ln in out.splitlines() if "libasan" in ln and "=>" in ln]
+    if not libs:
+        return {}
+    return {"LD_PRELOAD": libs[0], "ASAN_OPTIONS": "detect_leaks=0:abort_on_error=0:halt_on_error=1"}
+
+
+# Bytes that np.empty's arrays are filled with: zeros, all ones (int32 -1, NaN), and 0x01 (int32 16843009:
+# an index far out of any array).
+POISONS = (0x00, 0xFF, 0x01)
+
+
+def uninit_result(worker: Worker, request: dict, reference: dict, *, timeout: float) -> str:
+    """"ok" if the build gives the same output (digest or error) whatever np.empty's arrays held."""
+    if "digest" not in reference and not reference["build"].startswith(("crash", "timeout")):
+        want = reference["build"]                 # an error the engine reports: must stay the same
+    elif "digest" in reference:
+        want = reference["digest"]
+    else:
+        return f"not run: the engine fails without poison ({reference['build'][:60]})"
+    for byte in POISONS:
+        ans = worker.run(dict(request, poison=byte, checks=False, save=None), timeout=timeout)
+        got = ans.get("digest", ans["build"])
+        if got != want:
+            what = ans["build"] if "digest" not in ans else "another diagram"
+            return f"with np.empty filled with 0x{byte:02x}: {what} (reads memory it did not write)"
+    return "ok"
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 Usage: python tests/run_hunt.py [--timeout S] [--kernels DIR] [--only SUBSTRING] [--json FILE] [--fixtures]
 
 Each row is family x engine; each column a check: ``ok``, ``FAIL: <first message>``, ``CRASH``, ``TIMEOUT``.
-The ``agree`` column compares the two engines' cells bit for bit.
+The ``agree`` column compares the two engines' cells bit for bit; ``uninit`` rebuilds with np.empty's arrays
+filled with a few bytes and wants the same output (``hunt_worker.uninit_result``).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import adversarial  # noqa: E402
 import exact_checks  # noqa: E402
 from fixtures_io import FIXTURES, load_fixture  # noqa: E402
-from hunt_worker import CHECK_NAMES, Worker, load_cells  # noqa: E402
+from hunt_worker import CHECK_NAMES, Worker, load_cells, uninit_result  # noqa: E402
 
 ENGINES = ("fortune", "incremental")
 
@@ -54,6 +55,8 @@ def main(argv=None) -> int:
 
     worker = Worker(kernels=args.kernels)
     rows = []
+    print("| family | engine | " + " | ".join((*CHECK_NAMES, "agree", "uninit")) + " | s |")
+    print("|---" * (len(CHECK_NAMES) + 5) + "|")
     names = sorted(FIXTURES) if args.fixtures else list(adversarial.FAMILIES)
     try:
         for name in names:
@@ -71,10 +74,12 @@ def main(argv=None) -> int:
                 answers[engine] = worker.run(req, timeout=args.timeout)
             a = agree(worker, answers)
             for engine in ENGINES:
+                base = {k: v for k, v in req.items() if k not in ("engine", "save")} | {"engine": engine}
+                u = uninit_result(worker, base, answers[engine], timeout=min(args.timeout, 20.0))
                 row = {"family": name, "engine": engine, **{c: answers[engine][c] for c in CHECK_NAMES},
-                       "agree": a, "seconds": answers[engine]["seconds"]}
+                       "agree": a, "uninit": u, "seconds": answers[engine]["seconds"]}
                 rows.append(row)
-                cols = " | ".join(short(row[c]) for c in (*CHECK_NAMES, "agree"))
+                cols = " | ".join(short(row[c]) for c in (*CHECK_NAMES, "agree", "uninit"))
                 print(f"| {name} | {engine} | {cols} | {row['seconds']} |", flush=True)
     finally:
         worker.close()
