@@ -24,6 +24,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import traceback
 from pathlib import Path
 
 import numpy as np
@@ -128,7 +129,8 @@ def _serve(kernels: str | None) -> None:
                 d = tvoronoi.voronoi(pts, engine=req["engine"], bbox=bbox)
             out["build"] = "ok"
         except Exception as exc:  # noqa: BLE001 -- reported, not hidden
-            out["build"] = f"{type(exc).__name__}: {exc}"
+            tb = traceback.extract_tb(exc.__traceback__)[-1]
+            out["build"] = f"{type(exc).__name__}: {exc} (at {Path(tb.filename).name}:{tb.lineno})"
             d = None
         if unraisable:
             out["build"] = "error ignored inside a kernel: " + unraisable[0]
@@ -266,7 +268,10 @@ def sanitizer_env(kernels: str) -> dict:
     libs = [ln.split("=>")[1].split("(")[0].strip() for ln in out.splitlines() if "libasan" in ln and "=>" in ln]
     if not libs:
         return {}
-    return {"LD_PRELOAD": libs[0], "ASAN_OPTIONS": "detect_leaks=0:abort_on_error=0:halt_on_error=1"}
+    # every new heap block filled with 0xbe (by default only its first 4 KiB): a read of memory never written
+    # then gives the same garbage each run (int32 -1094795586, a negative index) instead of whatever was there
+    opts = "detect_leaks=0:halt_on_error=1:malloc_fill_byte=190:max_malloc_fill_size=1073741824"
+    return {"LD_PRELOAD": libs[0], "ASAN_OPTIONS": opts}
 
 
 # Bytes that np.empty's arrays are filled with: zeros, all ones (int32 -1, NaN), and 0x01 (int32 16843009:

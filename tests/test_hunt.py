@@ -3,7 +3,8 @@
 Each case runs in a child process with a time limit (``hunt_worker``): a crash or a hang of an engine fails
 that case's tests and the next case gets a fresh child. Checks (``exact_checks``): ``build`` (no error),
 ``box`` (positive size), ``delaunay`` (exact), ``cells`` (valid, CCW, holding their sites), ``distinct``
-(no point twice in a cell), ``tiling`` (coverage, exact areas), and ``agree`` (the engines bit for bit).
+(no point twice in a cell), ``tiling`` (coverage, exact areas), and ``agree`` (the engines bit for bit);
+the same output whatever np.empty's arrays held; Fortune on the checked build (``checked_build``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from hypothesis import HealthCheck, Phase, given, settings, strategies as st
 
 import adversarial
 import exact_checks
+from checked_build import build_only, checked_worker
 from fixtures_io import FIXTURES, load_fixture
 from hunt_worker import CHECK_NAMES, Worker, load_cells, uninit_result
 
@@ -127,6 +129,28 @@ def test_fixture_engines_agree(worker, fixture):
 @pytest.mark.parametrize("fixture", sorted(FIXTURES))
 def test_fixture_reads_only_written_memory(worker, fixture, engine):
     assert_reads_only_written_memory(worker, "fixture", fixture, engine)
+
+
+# ---------------------------------------------------------------------------------------------
+# Fortune against the checked build (bounds checks, ASan; the incremental engine's are in test_checked_build)
+
+
+@pytest.fixture(scope="module")
+def checked():
+    with checked_worker() as w:
+        yield w
+
+
+@pytest.mark.parametrize("family", list(adversarial.FAMILIES))
+def test_checked_fortune_family(checked, family):
+    assert_ok(build_only(checked, {"family": family, "engine": "fortune"}), f"{family}, checked build")
+
+
+@pytest.mark.parametrize("fixture", sorted(FIXTURES))
+def test_checked_fortune_fixture(checked, fixture):
+    case = load_fixture(fixture)
+    req = {"points": case.points.tolist(), "bbox": case.bbox, "engine": "fortune"}
+    assert_ok(build_only(checked, req), f"{fixture}, checked build")
 
 
 # ---------------------------------------------------------------------------------------------
