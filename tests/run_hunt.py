@@ -1,15 +1,18 @@
 """Run every adversarial family (and every fixture) with both engines in a child process; print a table.
 
 Usage: python tests/run_hunt.py [--timeout S] [--kernels DIR] [--only SUBSTRING] [--json FILE] [--fixtures]
+                                [--checked]
 
 Each row is family x engine; each column a check: ``ok``, ``FAIL: <first message>``, ``CRASH``, ``TIMEOUT``.
 The ``agree`` column compares the two engines' cells bit for bit; ``uninit`` rebuilds with np.empty's arrays
-filled with a few bytes and wants the same output (``hunt_worker.uninit_result``).
+filled with a few bytes and wants the same output (``hunt_worker.uninit_result``); ``checked`` (with
+--checked) is the build alone on the bounds-checked ASan kernels (``checked_build``).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from pathlib import Path
@@ -17,6 +20,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import adversarial  # noqa: E402
+from checked_build import build_only, checked_worker  # noqa: E402
 import exact_checks  # noqa: E402
 from fixtures_io import FIXTURES, load_fixture  # noqa: E402
 from hunt_worker import CHECK_NAMES, Worker, load_cells, uninit_result  # noqa: E402
@@ -51,12 +55,16 @@ def main(argv=None) -> int:
     ap.add_argument("--only", default="")
     ap.add_argument("--json")
     ap.add_argument("--fixtures", action="store_true", help="run the fixtures instead of the families")
+    ap.add_argument("--checked", action="store_true", help="add a column: the build on build/checked (ASan)")
     args = ap.parse_args(argv)
 
     worker = Worker(kernels=args.kernels)
+    checked = contextlib.ExitStack()
+    cw = checked.enter_context(checked_worker()) if args.checked else None
+    cols = (*CHECK_NAMES, "agree", "uninit") + (("checked",) if cw else ())
     rows = []
-    print("| family | engine | " + " | ".join((*CHECK_NAMES, "agree", "uninit")) + " | s |")
-    print("|---" * (len(CHECK_NAMES) + 5) + "|")
+    print("| family | engine | " + " | ".join(cols) + " | s |")
+    print("|---" * (len(cols) + 3) + "|")
     names = sorted(FIXTURES) if args.fixtures else list(adversarial.FAMILIES)
     try:
         for name in names:
@@ -78,11 +86,14 @@ def main(argv=None) -> int:
                 u = uninit_result(worker, base, answers[engine], timeout=min(args.timeout, 20.0))
                 row = {"family": name, "engine": engine, **{c: answers[engine][c] for c in CHECK_NAMES},
                        "agree": a, "uninit": u, "seconds": answers[engine]["seconds"]}
+                if cw:
+                    row["checked"] = build_only(cw, base)
                 rows.append(row)
-                cols = " | ".join(short(row[c]) for c in (*CHECK_NAMES, "agree", "uninit"))
-                print(f"| {name} | {engine} | {cols} | {row['seconds']} |", flush=True)
+                text = " | ".join(short(row[c]) for c in cols)
+                print(f"| {name} | {engine} | {text} | {row['seconds']} |", flush=True)
     finally:
         worker.close()
+        checked.close()
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
     return 0
