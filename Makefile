@@ -8,8 +8,8 @@ KERNEL_SRC := $(wildcard tvoronoi/kernels/*.pyx tvoronoi/kernels/*.pxd)
 INSTALLED  := $(VENV)/.installed
 BUILT      := $(VENV)/.kernels-built
 # The kernels with Cython's bounds checks and AddressSanitizer, built apart (tests/test_checked_build.py
-# runs the degenerate inputs against them); CHECKED_MODE=1 for bounds checks without ASan.
-CHECKED_MODE ?= asan
+# runs the degenerate inputs against them); bounds checks alone (CHECKED_MODE=1) where the compiler has no ASan.
+CHECKED_MODE ?= $(if $(wildcard $(shell $(CC) -print-file-name=libasan.so)),asan,1)
 CHECKED_DIR  := build/checked
 CHECKED      := $(CHECKED_DIR)/.built-$(CHECKED_MODE)
 
