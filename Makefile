@@ -7,8 +7,13 @@ BIN    := $(VENV)/bin
 KERNEL_SRC := $(wildcard tvoronoi/kernels/*.pyx tvoronoi/kernels/*.pxd)
 INSTALLED  := $(VENV)/.installed
 BUILT      := $(VENV)/.kernels-built
+# The kernels with Cython's bounds checks and AddressSanitizer, built apart (tests/test_checked_build.py
+# runs the degenerate inputs against them); bounds checks alone (CHECKED_MODE=1) where the compiler has no ASan.
+CHECKED_MODE ?= $(if $(wildcard $(shell $(CC) -print-file-name=libasan.so)),asan,1)
+CHECKED_DIR  := build/checked
+CHECKED      := $(CHECKED_DIR)/.built-$(CHECKED_MODE)
 
-.PHONY: run test setup bench bench-quick clean
+.PHONY: run test setup checked bench bench-quick clean
 
 setup: $(BUILT)
 
@@ -25,10 +30,19 @@ $(BUILT): $(INSTALLED) $(KERNEL_SRC)
 	$(BIN)/python setup.py -q build_ext --inplace
 	touch $@
 
+checked: $(CHECKED)
+
+$(CHECKED): $(INSTALLED) $(KERNEL_SRC) setup.py
+	mkdir -p $(CHECKED_DIR) && rm -f $(CHECKED_DIR)/.built-*
+	TVORONOI_CHECKED=$(CHECKED_MODE) $(BIN)/python setup.py -q build_ext --force \
+		--build-lib $(CHECKED_DIR) --build-temp build/checked-tmp > build/checked.log 2>&1 \
+		|| (cat build/checked.log; exit 1)
+	touch $@
+
 run: setup
 	$(BIN)/tvoronoi
 
-test: setup
+test: setup checked
 	$(BIN)/python -m pytest -q
 
 bench-quick: setup

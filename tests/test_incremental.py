@@ -1,5 +1,7 @@
 """The randomized incremental engine: invariants, the brute-force oracle and Qhull on every data set."""
 
+import re
+
 import numpy as np
 import pytest
 import scipy.spatial
@@ -7,6 +9,7 @@ from hypothesis import given, settings, strategies as st
 
 import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
+import exact_checks
 from invariants import validate
 from oracle import assert_matches_oracle
 
@@ -151,6 +154,32 @@ def test_extreme_scales_are_exact():
 def test_dynamic_range_beyond_exact_arithmetic_is_refused():
     with pytest.raises(tvoronoi.TvoronoiError, match="point 2 .* 2\\^170"):
         tvoronoi.voronoi([[0.0, 0.0], [0.0, 1.0], [1e-60, 0.5]])
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize("side", [2.0 ** 500, 1e300, 2.0 ** -701, 1e-250])
+def test_a_box_beyond_the_range_rule_is_refused(engine, side):
+    """Unit-square sites: box sides past 2^500 (ring tests multiply two box-sized differences) or, when
+    nonzero, under 2^-700 are refused with the side and its value named."""
+    pts = np.random.default_rng(0).random((30, 2))
+    with pytest.raises(tvoronoi.TvoronoiError, match=re.escape(f"bbox xmax = {side!r} is beyond the exact range")):
+        tvoronoi.voronoi(pts, bbox=(-1.0, -1.0, side, 2.0), engine=engine)
+    if side < 1:
+        # a dynamic diagram's scale comes from its box too: only a tiny side can be out of range
+        with pytest.raises(tvoronoi.TvoronoiError, match="bbox ymin"):
+            tvoronoi.DynamicVoronoi(pts, bbox=(-1.0, -side, 2.0, 2.0), engine=engine)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_the_largest_and_smallest_boxes_of_the_range_rule_build(engine):
+    pts = np.random.default_rng(0).random((30, 2))
+    big = float(np.nextafter(2.0 ** 500, 0))
+    d = tvoronoi.voronoi(pts, bbox=(-big, -big, big, big), engine=engine)
+    exact_checks.check_cells_valid(d)     # exact and scale-free (validate's box frame is not, at 3e150)
+    exact_checks.check_tiling(d)
+    small = 2.0 ** -700
+    d = tvoronoi.voronoi(np.vstack([pts, [[0.0, 0.0]]]), bbox=(-small, -small, small, small), engine=engine)
+    assert len(d.cell_polygon(30)) == 4         # the box around the site at the origin is its cell
 
 
 small_ints = st.integers(min_value=-6, max_value=6)

@@ -16,31 +16,32 @@ def power_of_two_scale(pts: np.ndarray) -> int:
 
     Scaling by a power of two is exact, and keeps the predicates' products
     (degree four in incircle) far from overflow and underflow at any scale.
-    Only the sites set it: the box enters the exact tests linearly (see
-    check_box_scale), so a box far larger than the sites costs no precision.
+    Only the sites set it: a box far larger or smaller than the sites costs no
+    precision, within the limits of check_box_scale.
     """
     top = float(np.abs(pts).max()) if len(pts) else 0.0
     return math.frexp(top)[1] if top > 0 else 0
 
 
-# Box sides in the sites' scaled unit: a product with a coordinate difference (down to 2^-223 in that
-# unit) must neither underflow nor, doubled, overflow.
-BOX_SCALED_MIN = 2.0 ** -700
-BOX_SCALED_MAX = 2.0 ** 1000
+# Box sides in the sites' scaled unit. The clipper's ring tests (orientation of ring points, which may
+# lie on the box) multiply two box-sized differences, so the box must stay within 2^500 of the sites'
+# scale; from below, a side times a coordinate difference (down to 2^-223) must not underflow.
+BOX_SCALED_MIN_EXP = -700
+BOX_SCALED_MAX_EXP = 500
 
 
 def check_box_scale(box, e: int) -> None:
     """Refuse a box whose sides the exact tests could not handle in the sites' scaled unit."""
     for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
-        try:
-            s = abs(math.ldexp(v, -e))
-        except OverflowError:
-            s = math.inf
-        if s != 0.0 and not (BOX_SCALED_MIN <= s <= BOX_SCALED_MAX):
+        if v == 0.0:
+            continue
+        # the exponent k of |v| * 2^-e = m * 2^k with 0.5 <= m < 1: exact, and no overflow at any e
+        k = math.frexp(v)[1] - e
+        if not (BOX_SCALED_MIN_EXP < k <= BOX_SCALED_MAX_EXP):
             raise TvoronoiError(
                 f"bbox {name} = {v!r} is beyond the exact range for these sites (their largest "
-                f"coordinate is about 2^{e}): a box side may be at most 2^1000 and, if not 0, at least "
-                f"2^-700 times that; choose a box nearer the sites' scale"
+                f"coordinate is about 2^{e}): a nonzero box side must lie between 2^{BOX_SCALED_MIN_EXP} "
+                f"and 2^{BOX_SCALED_MAX_EXP} times that; choose a box nearer the sites' scale"
             )
 
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox, scale_exponent
-from tvoronoi.build import assemble, collinear_dcel, sweep_checked, sweep_order
+from tvoronoi.build import assemble, check_box_scale, collinear_dcel, sweep_checked, sweep_order
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
 from tvoronoi.kernels import dcel, delaunay, dynamic, order
@@ -64,6 +64,7 @@ class DynamicVoronoi:
         # the first sites, so later sites anywhere within 2^170 of that scale stay exact
         self._e = scale_exponent(pts, self.bbox)
         check_range(pts, self._e)
+        check_box_scale(self.bbox, self._e)
         n = len(pts)
         self._xy = np.full((max(2 * n, 16), 2), np.nan)
         self._xy[:n] = pts

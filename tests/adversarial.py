@@ -1,0 +1,397 @@
+"""Adversarial families of near-degenerate input, seeded and sized, for hunting engine bugs.
+
+Each generator returns a ``Case``: the points, the user box (None for the default box) and a note.
+``FAMILIES`` maps a family name to a generator of that family at its hunt size; ``make(name, seed)``
+builds one. Every family is deterministic for a given seed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import partial
+from typing import Callable
+
+import numpy as np
+
+SEED = 20261122
+
+
+@dataclass(frozen=True)
+class Case:
+    """One input: points (n, 2) float64 and an optional box (xmin, ymin, xmax, ymax)."""
+
+    points: np.ndarray
+    bbox: tuple | None = None
+    note: str = ""
+
+
+def _pts(xy) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(xy, np.float64).reshape(-1, 2))
+
+
+# ---------------------------------------------------------------------------------------------
+# points on one line
+
+
+def near_collinear(n: int = 100, *, intercept: float = 1.0, slope: float = 2.0, seed: int = SEED) -> Case:
+    """n points on y = intercept + slope * x, x uniform in [0, 1), y rounded to a double.
+
+    Rounding y moves each point off the line by up to half an ulp: almost every triple is a
+    near-zero orientation, and the sign is decided by the last bit.
+    """
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(0.0, 1.0, n)
+    return Case(_pts(np.column_stack([x, intercept + slope * x])), note=f"y = {intercept} + {slope} x, rounded")
+
+
+def near_collinear_decimal(n: int = 100, *, slope: float = 0.1, seed: int = SEED) -> Case:
+    """x on a decimal grid (0.01 steps, themselves rounded), y = slope * x rounded: the line is never exact."""
+    rng = np.random.default_rng(seed)
+    k = rng.permutation(np.arange(1, 4 * n))[:n]
+    x = k * 0.01
+    return Case(_pts(np.column_stack([x, 0.3 + slope * x])), note="decimal x, rounded y")
+
+
+def collinear_exact(n: int = 100, *, slope: int = 2, seed: int = SEED) -> Case:
+    """n distinct integer points exactly on y = 1 + slope * x, in random order."""
+    rng = np.random.default_rng(seed)
+    x = rng.permutation(np.arange(-n // 2, n - n // 2)).astype(float)
+    return Case(_pts(np.column_stack([x, 1.0 + slope * x])), note="exactly collinear")
+
+
+def collinear_dyadic(n: int = 100, *, seed: int = SEED) -> Case:
+    """Exactly collinear with dyadic (exact) fractional steps, plus repeats of some of them."""
+    rng = np.random.default_rng(seed)
+    x = rng.permutation(n) / 64.0
+    pts = np.column_stack([x, 0.75 - 3.0 * x])
+    return Case(_pts(np.concatenate([pts, pts[: n // 10]])), note="exactly collinear, dyadic, with repeats")
+
+
+def collinear_plus_one(n: int = 100, *, seed: int = SEED) -> Case:
+    """Exactly collinear integer points and one site just off the line (one ulp above the middle one)."""
+    base = collinear_exact(n, seed=seed).points
+    mid = base[np.argsort(base[:, 0])[n // 2]]
+    off = (mid[0], np.nextafter(mid[1], np.inf))
+    return Case(_pts(np.concatenate([base, [off]])), note="collinear + one site one ulp off")
+
+
+# ---------------------------------------------------------------------------------------------
+# lattices
+
+
+def square_grid(side: int = 70, *, noise: float = 1e-17, seed: int = SEED) -> Case:
+    """A side x side integer grid plus gaussian noise of this size (1e-17 only moves the zeros)."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(i, j) for i in range(side) for j in range(side)], float)
+    if noise:
+        g = g + rng.normal(0.0, noise, g.shape)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"{side}x{side} grid, noise {noise:g}")
+
+
+def triangular_lattice(side: int = 40, *, noise: float = 0.0, seed: int = SEED) -> Case:
+    """A triangular lattice (rows offset by 1/2, height sqrt(3)/2 rounded): near-cocircular hexagons."""
+    rng = np.random.default_rng(seed)
+    h = math.sqrt(3.0) / 2.0
+    g = np.array([(i + 0.5 * (j % 2), j * h) for j in range(side) for i in range(side)], float)
+    if noise:
+        g = g + rng.normal(0.0, noise, g.shape)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"triangular lattice, noise {noise:g}")
+
+
+def rotated_grid(side: int = 40, *, degrees: float = 30.0, noise: float = 0.0, seed: int = SEED) -> Case:
+    """A square grid rotated by an angle, coordinates rounded: every unit square is near-cocircular."""
+    rng = np.random.default_rng(seed)
+    t = math.radians(degrees)
+    c, s = math.cos(t), math.sin(t)
+    g = np.array([(i, j) for i in range(side) for j in range(side)], float)
+    g = np.column_stack([c * g[:, 0] - s * g[:, 1], s * g[:, 0] + c * g[:, 1]])
+    if noise:
+        g = g + rng.normal(0.0, noise, g.shape)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"grid rotated {degrees} deg, noise {noise:g}")
+
+
+def pythagorean_grid(side: int = 30, *, seed: int = SEED) -> Case:
+    """A grid rotated by atan(3/4) with exact integer coordinates: exactly cocircular squares, rotated."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(4 * i - 3 * j, 3 * i + 4 * j) for i in range(side) for j in range(side)], float)
+    return Case(_pts(g[rng.permutation(len(g))]), note="integer grid rotated by atan(3/4)")
+
+
+# ---------------------------------------------------------------------------------------------
+# rounded random points
+
+
+def rounded_uniform(n: int = 2000, *, decimals: int = 2, seed: int = SEED) -> Case:
+    """Uniform points in the unit square rounded to a few decimals: repeats, rows, cocircular quads."""
+    rng = np.random.default_rng(seed)
+    return Case(_pts(np.round(rng.uniform(0.0, 1.0, (n, 2)), decimals)), note=f"uniform, {decimals} decimals")
+
+
+def rounded_gaussian(n: int = 2000, *, decimals: int = 1, seed: int = SEED) -> Case:
+    """Gaussian points rounded to a few decimals: dense repeats in the middle, a ragged hull."""
+    rng = np.random.default_rng(seed)
+    return Case(_pts(np.round(rng.normal(0.0, 1.0, (n, 2)), decimals)), note=f"gaussian, {decimals} decimals")
+
+
+# ---------------------------------------------------------------------------------------------
+# circles
+
+
+def circle_rounded(n: int = 500, *, radius: float = 1.0, centre=(0.0, 0.0), with_centre: bool = False,
+                   seed: int = SEED) -> Case:
+    """n points on a circle at random angles, rounded to doubles: every quadruple near-cocircular."""
+    rng = np.random.default_rng(seed)
+    t = rng.uniform(0.0, 2.0 * math.pi, n)
+    pts = np.column_stack([centre[0] + radius * np.cos(t), centre[1] + radius * np.sin(t)])
+    if with_centre:
+        pts = np.concatenate([[centre], pts])
+    return Case(_pts(pts), note=f"{n} on a circle, rounded" + (", and its centre" if with_centre else ""))
+
+
+def circle_regular(n: int = 3000, *, with_centre: bool = True, seed: int = SEED) -> Case:
+    """A regular n-gon on the unit circle (rounded) and its centre: the centre's cell has n edges."""
+    t = 2.0 * math.pi * np.arange(n) / n
+    pts = np.column_stack([np.cos(t), np.sin(t)])
+    if with_centre:
+        pts = np.concatenate([[(0.0, 0.0)], pts])
+    return Case(_pts(pts), note=f"centre inside {n} sites on a circle")
+
+
+def lattice_circle_points(r2: int) -> np.ndarray:
+    """All integer points (x, y) with x^2 + y^2 == r2, exactly."""
+    r = math.isqrt(r2)
+    out = []
+    for x in range(-r, r + 1):
+        y2 = r2 - x * x
+        y = math.isqrt(y2)
+        if y * y == y2:
+            out.append((x, y))
+            if y:
+                out.append((x, -y))
+    return np.array(sorted(out), float)
+
+
+def circle_lattice(r: int = 5525, *, with_centre: bool = True, seed: int = SEED) -> Case:
+    """Integer points exactly on x^2 + y^2 = r^2 (180 of them for r = 5525), and the centre."""
+    rng = np.random.default_rng(seed)
+    pts = lattice_circle_points(r * r)
+    pts = pts[rng.permutation(len(pts))]
+    if with_centre:
+        pts = np.concatenate([pts, [(0.0, 0.0)]])
+    return Case(_pts(pts), note=f"{len(pts)} lattice points exactly on a circle of radius {r}")
+
+
+def concentric_exact(*, seed: int = SEED) -> Case:
+    """Lattice points exactly on concentric circles of radius 5, 25, 65, 325, 1105 (with the centre)."""
+    rng = np.random.default_rng(seed)
+    pts = np.concatenate([lattice_circle_points(r * r) for r in (5, 25, 65, 325, 1105)] + [[(0.0, 0.0)]])
+    return Case(_pts(pts[rng.permutation(len(pts))]), note="concentric exact circles")
+
+
+def concentric_rounded(rings: int = 10, per_ring: int = 60, *, seed: int = SEED) -> Case:
+    """Regular polygons on concentric circles, all with the same angles (rounded): radial alignments."""
+    t = 2.0 * math.pi * np.arange(per_ring) / per_ring
+    pts = [np.column_stack([r * np.cos(t), r * np.sin(t)]) for r in range(1, rings + 1)]
+    return Case(_pts(np.concatenate(pts + [[(0.0, 0.0)]])), note=f"{rings} concentric {per_ring}-gons")
+
+
+# ---------------------------------------------------------------------------------------------
+# scale: offsets, tiny and subnormal coordinates
+
+
+def offset(n: int = 300, *, at: float = 1e9, spread: float = 1.0, seed: int = SEED) -> Case:
+    """Uniform points of a small spread far from the origin: few bits of resolution left."""
+    rng = np.random.default_rng(seed)
+    return Case(_pts(at + spread * rng.uniform(0.0, 1.0, (n, 2))), note=f"offset {at:g}, spread {spread:g}")
+
+
+def offset_grid(side: int = 12, *, at: float = 1e15, step: float = 0.125, seed: int = SEED) -> Case:
+    """A grid of ulp-sized steps at a large offset (at 1e15 one ulp is 0.125): exact grid, huge offset."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(at + i * step, at + j * step) for i in range(side) for j in range(side)], float)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"{side}x{side} grid of step {step} at {at:g}")
+
+
+def scaled(n: int = 300, *, factor: float = 1e-310, seed: int = SEED) -> Case:
+    """Uniform points in the unit square times a factor (1e-310: subnormal, a few digits of precision)."""
+    rng = np.random.default_rng(seed)
+    return Case(_pts(rng.uniform(0.0, 1.0, (n, 2)) * factor), note=f"uniform * {factor:g}")
+
+
+def cluster_in_box(n: int = 200, *, width: float = 1e-9, box: float = 1e6, seed: int = SEED) -> Case:
+    """A cluster of this width in the middle of a large user box: cells reach far out to the box."""
+    rng = np.random.default_rng(seed)
+    pts = box / 2 + width * rng.uniform(0.0, 1.0, (n, 2))
+    return Case(_pts(pts), bbox=(0.0, 0.0, box, box), note=f"{width:g} cluster in a {box:g} box")
+
+
+def cluster_with_far_sites(n: int = 200, *, width: float = 1e-9, box: float = 1e6, seed: int = SEED) -> Case:
+    """The same cluster with four sites at the corners of the large box (default box)."""
+    c = cluster_in_box(n, width=width, box=box, seed=seed).points
+    corners = [(0.0, 0.0), (box, 0.0), (box, box), (0.0, box)]
+    return Case(_pts(np.concatenate([c, corners])), note=f"{width:g} cluster and far corner sites")
+
+
+def two_sites_ulps_apart(*, at: float = 1e12, ulps: int = 2, seed: int = SEED) -> Case:
+    """Two sites at (at, at), a few ulps apart in x: the bisector sits between two doubles or on one."""
+    x1 = at
+    for _ in range(ulps):
+        x1 = float(np.nextafter(x1, np.inf))
+    return Case(_pts([(at, at), (x1, at)]), note=f"two sites {ulps} ulps apart at {at:g}")
+
+
+def subnormal_sites(*, seed: int = SEED) -> Case:
+    """A few sites on the smallest subnormals: the default box's margin rounds to zero."""
+    t = 5e-324
+    return Case(_pts([(t, t), (2 * t, t), (4 * t, 3 * t), (2 * t, 5 * t)]), note="sites at multiples of 5e-324")
+
+
+def subnormal_row(*, seed: int = SEED) -> Case:
+    """Sites on one horizontal row of subnormals: the box's height comes from the margin alone."""
+    t = 5e-324
+    return Case(_pts([(t, t), (2 * t, t), (3 * t, t)]), note="a row of subnormal sites")
+
+
+# ---------------------------------------------------------------------------------------------
+# repeats and tiny counts
+
+
+def heavy_duplicates(distinct: int = 50, copies: int = 20, *, seed: int = SEED) -> Case:
+    """A few distinct points, each repeated many times, shuffled."""
+    rng = np.random.default_rng(seed)
+    base = np.round(rng.uniform(0.0, 1.0, (distinct, 2)), 3)
+    pts = np.repeat(base, copies, axis=0)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"{distinct} points x {copies} copies")
+
+
+def duplicates_of_three(copies: int = 30, *, collinear: bool = False, seed: int = SEED) -> Case:
+    """Three places (a triangle, or three collinear places), each repeated many times."""
+    rng = np.random.default_rng(seed)
+    base = [(0.0, 0.0), (1.0, 1.0), (2.0, 2.0)] if collinear else [(0.0, 0.0), (1.0, 0.0), (0.3, 0.9)]
+    pts = np.repeat(np.array(base), copies, axis=0)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note="three places repeated")
+
+
+def few_sites(kind: str, *, seed: int = SEED) -> Case:
+    """0 to 3 sites: empty, one, two, two equal, three collinear, three in a triangle."""
+    sets = {
+        "zero": [],
+        "one": [(0.25, 0.5)],
+        "two": [(0.0, 0.0), (1.0, 0.5)],
+        "two_equal": [(0.3, 0.3), (0.3, 0.3)],
+        "three_collinear": [(0.0, 0.0), (0.5, 0.5), (1.0, 1.0)],
+        "three": [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)],
+    }
+    return Case(_pts(sets[kind]), note=f"{kind} site(s)")
+
+
+# ---------------------------------------------------------------------------------------------
+# user boxes
+
+
+def _unit_sites(n: int = 300, seed: int = SEED) -> np.ndarray:
+    return np.random.default_rng(seed).uniform(0.0, 1.0, (n, 2))
+
+
+def box_excludes_most(n: int = 300, *, seed: int = SEED) -> Case:
+    """A user box around a small part of the sites: most cells miss it."""
+    return Case(_pts(_unit_sites(n, seed)), bbox=(0.40, 0.45, 0.47, 0.50), note="a box holding a few sites")
+
+
+def box_far_away(n: int = 300, *, seed: int = SEED) -> Case:
+    """A user box far from every site: only the cells that reach out to it are there."""
+    return Case(_pts(_unit_sites(n, seed)), bbox=(40.0, -30.0, 41.5, -29.0), note="a box far from the sites")
+
+
+def box_one_ulp_thin(n: int = 300, *, seed: int = SEED) -> Case:
+    """A box one ulp high across the sites."""
+    y0 = 0.5
+    return Case(_pts(_unit_sites(n, seed)), bbox=(0.0, y0, 1.0, float(np.nextafter(y0, 1.0))),
+                note="a box one ulp thin")
+
+
+def box_huge(n: int = 300, *, seed: int = SEED) -> Case:
+    """Unit-square sites in the largest box the range rule allows them: +-(2^500 - an ulp), about 3e150."""
+    b = float(np.nextafter(2.0 ** 500, 0))
+    return Case(_pts(_unit_sites(n, seed)), bbox=(-b, -b, b, b), note="a box of +-3e150")
+
+
+def box_through_sites(n: int = 300, *, seed: int = SEED) -> Case:
+    """A box whose sides pass exactly through sites and Voronoi vertices of a grid."""
+    g = np.array([(i, j) for i in range(12) for j in range(12)], float)
+    return Case(_pts(g), bbox=(2.0, 2.5, 9.5, 9.0), note="box sides through grid sites and vertices")
+
+
+# ---------------------------------------------------------------------------------------------
+# the registry: family name -> generator at its hunt size
+
+
+FAMILIES: dict[str, Callable[..., Case]] = {
+    # one line
+    "near_collinear_slope2": partial(near_collinear, 100, intercept=1.0, slope=2.0),
+    "near_collinear_slope_third": partial(near_collinear, 100, intercept=0.1, slope=1.0 / 3.0),
+    "near_collinear_slope_pi": partial(near_collinear, 100, intercept=-0.7, slope=math.pi),
+    "near_collinear_flat": partial(near_collinear, 100, intercept=0.3, slope=1e-3),
+    "near_collinear_steep": partial(near_collinear, 100, intercept=0.3, slope=1e3),
+    "near_collinear_decimal": partial(near_collinear_decimal, 100, slope=0.1),
+    "collinear_exact": partial(collinear_exact, 100, slope=2),
+    "collinear_dyadic_repeats": partial(collinear_dyadic, 100),
+    "collinear_plus_one_ulp": partial(collinear_plus_one, 100),
+    # lattices
+    "grid70_noise1e-17": partial(square_grid, 70, noise=1e-17),
+    "grid10_noise1e-17": partial(square_grid, 10, noise=1e-17),
+    "grid30_noise1e-12": partial(square_grid, 30, noise=1e-12),
+    "grid30_noise1e-6": partial(square_grid, 30, noise=1e-6),
+    "triangular40": partial(triangular_lattice, 40),
+    "triangular30_noise1e-15": partial(triangular_lattice, 30, noise=1e-15),
+    "rotated_grid_30deg": partial(rotated_grid, 30, degrees=30.0),
+    "rotated_grid_45deg": partial(rotated_grid, 30, degrees=45.0),
+    "rotated_grid_1deg_noise1e-9": partial(rotated_grid, 30, degrees=1.0, noise=1e-9),
+    "pythagorean_grid": partial(pythagorean_grid, 30),
+    # rounded random
+    "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
+    "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
+    "uniform_3dec": partial(rounded_uniform, 2000, decimals=3),
+    "gaussian_1dec": partial(rounded_gaussian, 2000, decimals=1),
+    "gaussian_2dec": partial(rounded_gaussian, 2000, decimals=2),
+    # circles
+    "circle_rounded": partial(circle_rounded, 500),
+    "circle_rounded_offset": partial(circle_rounded, 300, radius=1e-3, centre=(1e4, -1e4)),
+    "circle_lattice_5525": partial(circle_lattice, 5525),
+    "concentric_exact": concentric_exact,
+    "concentric_rounded": partial(concentric_rounded, 10, 60),
+    "circle_centre_3000": partial(circle_regular, 3000),
+    "circle_centre_5000": partial(circle_regular, 5000),
+    # scale
+    "offset_1e6": partial(offset, 300, at=1e6, spread=1.0),
+    "offset_1e9": partial(offset, 300, at=1e9, spread=1.0),
+    "offset_1e12": partial(offset, 300, at=1e12, spread=1.0),
+    "offset_1e15": partial(offset, 300, at=1e15, spread=10.0),
+    "offset_grid_1e15": partial(offset_grid, 12, at=1e15, step=0.125),
+    "tiny_1e-300": partial(scaled, 300, factor=1e-300),
+    "subnormal_1e-310": partial(scaled, 300, factor=1e-310),
+    "cluster_1e-9_in_1e6_box": partial(cluster_in_box, 200),
+    "cluster_1e-9_far_corners": partial(cluster_with_far_sites, 200),
+    "two_sites_1e12_2ulps": partial(two_sites_ulps_apart, at=1e12, ulps=2),
+    "two_sites_1e12_1ulp": partial(two_sites_ulps_apart, at=1e12, ulps=1),
+    "subnormal_default_box": subnormal_sites,
+    "subnormal_row_default_box": subnormal_row,
+    # repeats and tiny counts
+    "heavy_duplicates": partial(heavy_duplicates, 50, 20),
+    "duplicates_of_triangle": partial(duplicates_of_three, 30),
+    "duplicates_of_collinear": partial(duplicates_of_three, 30, collinear=True),
+    **{f"sites_{kind}": partial(few_sites, kind)
+       for kind in ("zero", "one", "two", "two_equal", "three_collinear", "three")},
+    # user boxes
+    "box_excludes_most": box_excludes_most,
+    "box_far_away": box_far_away,
+    "box_one_ulp_thin": box_one_ulp_thin,
+    "box_huge_3e150": box_huge,
+    "box_through_grid": box_through_sites,
+}
+
+
+def make(name: str, seed: int = SEED) -> Case:
+    """The case of a family at its hunt size."""
+    return FAMILIES[name](seed=seed)
