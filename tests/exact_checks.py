@@ -166,6 +166,60 @@ def check_delaunay_exact(d) -> None:
 GEOS_TINY = 2.0 ** -500
 
 
+# GEOS decides on doubles (with double-double filters): a diagram whose nonzero coordinates span more
+# binary orders than this (unit sites in a box of 1e300) is beyond it, and the validity and coverage of
+# its cells are checked exactly here instead.
+GEOS_SPAN_BITS = 60
+
+
+def magnitude_span(d) -> int:
+    """Binary orders between the largest and the smallest nonzero coordinate of the cells and the box."""
+    v = np.abs(np.concatenate([np.asarray(d.cell_points, np.float64).ravel(), np.asarray(d.bbox, np.float64)]))
+    v = v[v > 0]
+    return int(np.frexp(v.max())[1] - np.frexp(v.min())[1]) if len(v) else 0
+
+
+def _segments_meet(ex: ExactPoints, p: int, q: int, r: int, s: int) -> bool:
+    """Closed segments pq and rs share a point (exact)."""
+    def on(a, b, c):
+        return (min(ex.x[a], ex.x[b]) <= ex.x[c] <= max(ex.x[a], ex.x[b])
+                and min(ex.y[a], ex.y[b]) <= ex.y[c] <= max(ex.y[a], ex.y[b]))
+    sg = [(o > 0) - (o < 0) for o in (ex.orient(p, q, r), ex.orient(p, q, s), ex.orient(r, s, p), ex.orient(r, s, q))]
+    if sg[0] * sg[1] < 0 and sg[2] * sg[3] < 0:
+        return True
+    return ((sg[0] == 0 and on(p, q, r)) or (sg[1] == 0 and on(p, q, s))
+            or (sg[2] == 0 and on(r, s, p)) or (sg[3] == 0 and on(r, s, q)))
+
+
+def ring_is_simple_exact(ex: ExactPoints, k: int) -> bool:
+    """No two edges of the ring meet but consecutive ones at their common point (exact)."""
+    for a in range(k):
+        for b in range(a + 2, k):
+            if a == 0 and b == k - 1:
+                continue
+            if _segments_meet(ex, a, (a + 1) % k, b, (b + 1) % k):
+                return False
+    return True
+
+
+def covers_exact(ring: np.ndarray, point) -> bool:
+    """The closed polygon holds the point (exact crossing count; the boundary counts as inside)."""
+    ex = ExactPoints(np.vstack([ring, np.asarray(point, np.float64).reshape(1, 2)]))
+    k, t = len(ring), len(ring)
+    inside = False
+    for a in range(k):
+        b = (a + 1) % k
+        o = ex.orient(a, b, t)
+        if o == 0 and (min(ex.x[a], ex.x[b]) <= ex.x[t] <= max(ex.x[a], ex.x[b])
+                       and min(ex.y[a], ex.y[b]) <= ex.y[t] <= max(ex.y[a], ex.y[b])):
+            return True
+        if (ex.y[a] > ex.y[t]) != (ex.y[b] > ex.y[t]):
+            # the edge crosses the horizontal through t: on t's right when the turn says so
+            if (o > 0) == (ex.y[b] > ex.y[a]):
+                inside = not inside
+    return inside
+
+
 def geos_exponent(d) -> int:
     """k such that coordinates * 2**k are what shapely sees: 0 (raw) unless every coordinate is tiny."""
     top = max(float(np.abs(d.cell_points).max()) if len(d.cell_points) else 0.0,
@@ -210,6 +264,7 @@ def check_cells_valid(d) -> None:
     in the box; a repeated point's later copies have no cell; a site in the box has a cell."""
     inside = in_box(np.asarray(d.sites, float), d.bbox) if d.n_sites else np.zeros(0, bool)
     k = geos_exponent(d)
+    exact = magnitude_span(d) > GEOS_SPAN_BITS
     first = np.asarray(d.site_of) == np.arange(d.n_sites)
     for i in range(d.n_sites):
         ring = d.cell_polygon(i)
@@ -227,6 +282,11 @@ def check_cells_valid(d) -> None:
         a2 = ring_area2(ex.x, ex.y)
         assert a2 > 0, f"cell {i} is {'flat' if a2 == 0 else 'clockwise'} (exact area {a2})"
         # (orientation is the exact test above: shapely's is_ccw under/overflows at extreme scales)
+        if exact:
+            assert ring_is_simple_exact(ex, len(ring)), f"cell {i} is not simple (exact test)"
+            if inside[i]:
+                assert covers_exact(ring, d.sites[i]), f"site {i} {tuple(d.sites[i].tolist())} is outside its cell"
+            continue
         poly = shapely.Polygon(for_geos(ring, k))
         assert poly.is_valid, f"cell {i} invalid: {shapely.is_valid_reason(poly)}"
         if inside[i]:
@@ -273,10 +333,52 @@ def check_tiling(d) -> None:
     want = Fraction(box2, den * den)
     err = abs(total - want) / want
     assert err <= AREA_RTOL, f"cells cover {_num(total / 2)}, the box {_num(want / 2)} (relative {float(err):.3g})"
+    if magnitude_span(d) > GEOS_SPAN_BITS:
+        check_shared_edges(d, rings)
+        return
     k = geos_exponent(d)
     polys = shapely.polygons([shapely.linearrings(for_geos(r, k)) for r in rings])
     assert shapely.coverage_is_valid(shapely.GeometryCollection(list(polys))), \
         "shapely: the cells do not form a valid coverage (overlap or slivers)"
+
+
+def _collinear(a, b, p) -> bool:
+    ex = ExactPoints([a, b, p])
+    return ex.orient(0, 1, 2) == 0
+
+
+def check_shared_edges(d, rings) -> None:
+    """Exact coverage where GEOS cannot decide: every cell edge off the box boundary is run along, the
+    other way, by edges of other cells: one twin edge, or collinear edges whose union covers it (where
+    rounding put a neighbour's vertex on the edge, or this edge's ends on a neighbour's edge). With every
+    cell simple and counter-clockwise (check_cells_valid) and the exact areas adding up to the box's
+    (check_tiling), the cells then cover the box exactly once."""
+    xmin, ymin, xmax, ymax = d.bbox
+    owner: dict[tuple, int] = {}
+    for c, r in enumerate(rings):
+        pts = [tuple(p) for p in r.tolist()]
+        for a, b in zip(pts, pts[1:] + pts[:1]):
+            assert (a, b) not in owner, f"two cells run along the edge {a} -> {b}"
+            owner[(a, b)] = c
+    edges = list(owner.items())
+    for (a, b), c in edges:
+        if (a[0] == b[0] and a[0] in (xmin, xmax)) or (a[1] == b[1] and a[1] in (ymin, ymax)) or (b, a) in owner:
+            continue
+        axis = 0 if a[0] != b[0] else 1
+        lo, hi = sorted((a[axis], b[axis]))
+        forward = b[axis] > a[axis]
+        cover = []
+        for (u, v), k in edges:
+            if k == c or (v[axis] > u[axis]) == forward or max(u[axis], v[axis]) <= lo or min(u[axis], v[axis]) >= hi:
+                continue
+            if _collinear(a, b, u) and _collinear(a, b, v):
+                cover.append(tuple(sorted((u[axis], v[axis]))))
+        reach = lo
+        for s0, s1 in sorted(cover):
+            if s0 > reach:
+                break
+            reach = max(reach, s1)
+        assert reach >= hi, f"the edge {a} -> {b} of a cell has no neighbour on its other side"
 
 
 # ---------------------------------------------------------------------------------------------

@@ -119,3 +119,36 @@ def test_ties_round_to_even():
     check_triangles(tris)
     got = kernel_circumcentres(tris[:1])
     assert got[0, 0] == big        # 2^52 + 1/2 -> the even neighbour, 2^52
+
+
+def exact_orientation(a, b, c) -> int:
+    ax, ay, bx, by, cx, cy = (Fraction(v) for v in (*a, *b, *c))
+    o = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    return (o > 0) - (o < 0)
+
+
+# doubles of every magnitude the clipper's rings can hold: box sides up to 1.3e300, sites down to 2^-900
+wide = st.one_of(
+    st.floats(min_value=-1.3e300, max_value=1.3e300, allow_nan=False, allow_infinity=False),
+    st.floats(min_value=-1.0, max_value=1.0, allow_nan=False, allow_infinity=False, allow_subnormal=False),
+    st.sampled_from([0.0, 1.0, -1.0, 1e300, -1e300, 2.0 ** -900, 1.0 + 2.0 ** -52, 1e-300]),
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.tuples(wide, wide), st.tuples(wide, wide), st.tuples(wide, wide))
+def test_ring_turns_are_exact_at_any_span(a, b, c):
+    """Points of a ring on a box of 1e300 around unit sites: products of box-sized differences overflow
+    and those of tiny ones underflow in plain expansions; the clipper's turn is exact anyway."""
+    assert clip.ring_turn(*a, *b, *c) == exact_orientation(a, b, c)
+
+
+@pytest.mark.parametrize("scale", [2.0 ** -1000, 2.0 ** -300, 1.0, 2.0 ** 300, 2.0 ** 996])
+def test_ring_turns_see_one_ulp_beside_a_huge_segment(scale):
+    """A point one ulp off the line through the origin and a far point: the spans of the largest ring."""
+    far = (1e300, 1e300)
+    on = (scale, scale)
+    off = (scale, float(np.nextafter(scale, np.inf)))
+    assert clip.ring_turn(0.0, 0.0, *far, *on) == 0
+    assert clip.ring_turn(0.0, 0.0, *far, *off) == 1
+    assert clip.ring_turn(*far, 0.0, 0.0, *off) == -1

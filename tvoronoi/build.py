@@ -23,11 +23,13 @@ def power_of_two_scale(pts: np.ndarray) -> int:
     return math.frexp(top)[1] if top > 0 else 0
 
 
-# Box sides in the sites' scaled unit. The clipper's ring tests (orientation of ring points, which may
-# lie on the box) multiply two box-sized differences, so the box must stay within 2^500 of the sites'
-# scale; from below, a side times a coordinate difference (down to 2^-223) must not underflow.
-BOX_SCALED_MIN_EXP = -700
-BOX_SCALED_MAX_EXP = 500
+# Box sides in the sites' scaled unit. From above, the exact products split a box coordinate into
+# halves by multiplying it with 2^27 + 1 (Dekker), which must not overflow: about 2^997, a little
+# under (1.3e300 for sites of unit size). From below, a side times a coordinate difference (down to
+# 2^-223) must not underflow. Ring tests between points of the box and the sites, whose magnitudes
+# may then span 2^1700, are exact at any span (clipper.turn).
+BOX_SCALED_MIN = 2.0 ** -700
+BOX_SCALED_MAX = math.ldexp(1.0 - 2.0 ** -20, 997)
 
 
 def check_box_scale(box, e: int) -> None:
@@ -35,13 +37,14 @@ def check_box_scale(box, e: int) -> None:
     for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
         if v == 0.0:
             continue
-        # the exponent k of |v| * 2^-e = m * 2^k with 0.5 <= m < 1: exact, and no overflow at any e
+        # |v| * 2^-e without overflow or underflow, whatever e: compare the exponents first
         k = math.frexp(v)[1] - e
-        if not (BOX_SCALED_MIN_EXP < k <= BOX_SCALED_MAX_EXP):
+        s = abs(math.ldexp(math.frexp(v)[0], k)) if -1000 < k < 1000 else math.inf if k > 0 else 0.0
+        if not (BOX_SCALED_MIN <= s <= BOX_SCALED_MAX):
             raise TvoronoiError(
                 f"bbox {name} = {v!r} is beyond the exact range for these sites (their largest "
-                f"coordinate is about 2^{e}): a nonzero box side must lie between 2^{BOX_SCALED_MIN_EXP} "
-                f"and 2^{BOX_SCALED_MAX_EXP} times that; choose a box nearer the sites' scale"
+                f"coordinate is about 2^{e}): a nonzero box side must lie between 2^-700 and about "
+                f"2^997 (1.3e300) times that; choose a box nearer the sites' scale"
             )
 
 

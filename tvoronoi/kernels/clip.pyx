@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from libc.math cimport hypot
 from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.clipper cimport (
@@ -175,8 +176,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 if h == face_edge[i]:
                     break
             if h == face_edge[i] and cnt > 0:
-                k = finish_ring(&ring[n_ring], cnt, &pts[0, 0], e)
-                if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0], e) >= 0:
+                k = finish_ring(&ring[n_ring], cnt, &pts[0, 0])
+                if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
                     n_bent += 1
                 n_ring += k
                 continue
@@ -201,8 +202,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             if k < 0:
                 status = 1
                 continue
-            k = finish_ring(&ring[n_ring], k, &pts[0, 0], e)
-            if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0], e) >= 0:
+            k = finish_ring(&ring[n_ring], k, &pts[0, 0])
+            if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
                 n_bent += 1
             n_ring += k
         offsets[n] = n_ring
@@ -216,11 +217,11 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         kind[:m][on_side] = 1                            # a vertex on the boundary
         kind[m:corner0] = 1                              # a crossing
         kind[corner0:] = 0                               # a corner
-        offs, rings = straighten(points, offs, rings, kind, e)
+        offs, rings = straighten(points, offs, rings, kind)
     return points, offs, rings, status
 
 
-def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind, int e):
+def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind):
     """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
     cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
     neighbours and an edge of the ring crosses another).
@@ -254,16 +255,17 @@ def straighten(const double[:, ::1] points, offsets, rings, const signed char[::
             cnt = <int> (ov[i + 1] - lo)
             if cnt == 0:
                 continue
-            if first_right_turn(&rv[lo], cnt, xy, e) < 0 or ring_is_simple(&rv[lo], cnt, xy, e):
+            if first_right_turn(&rv[lo], cnt, xy) < 0 or ring_is_simple(&rv[lo], cnt, xy):
                 continue
             for k in range(cnt):
                 v = rv[lo + k]
                 u = rv[lo + (k + cnt - 1) % cnt]
                 w = rv[lo + (k + 1) % cnt]
-                if turn(xy, u, v, w, e) >= 0:
+                if turn(xy, u, v, w) >= 0:
                     continue
-                du = (xy[2 * u] - xy[2 * v]) ** 2 + (xy[2 * u + 1] - xy[2 * v + 1]) ** 2
-                dw = (xy[2 * w] - xy[2 * v]) ** 2 + (xy[2 * w + 1] - xy[2 * v + 1]) ** 2
+                # hypot: no overflow of the squares on boxes up to 2^1000 times the sites
+                du = hypot(xy[2 * u] - xy[2 * v], xy[2 * u + 1] - xy[2 * v + 1])
+                dw = hypot(xy[2 * w] - xy[2 * v], xy[2 * w + 1] - xy[2 * v + 1])
                 t = u if (du < dw or (du == dw and before(xy, kind, u, w))) else w
                 ru = find(&parent[0], v)
                 rt = find(&parent[0], t)
@@ -284,14 +286,14 @@ def straighten(const double[:, ::1] points, offsets, rings, const signed char[::
         rv = rings
         ov = offsets
         nv = new_rings
-        cdef_fill(ov, rv, new_offsets, nv, xy, e)
+        cdef_fill(ov, rv, new_offsets, nv, xy)
         offsets = new_offsets
         rings = new_rings[:new_offsets[-1]].copy()
     return offsets, rings
 
 
 cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_offsets, int32_t[::1] nv,
-                    const double* xy, int e):
+                    const double* xy):
     cdef int i, k, n_cells = ov.shape[0] - 1
     cdef int64_t out = 0, lo
     for i in range(n_cells):
@@ -300,18 +302,18 @@ cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_off
         k = <int> (ov[i + 1] - lo)
         for j in range(k):
             nv[out + j] = rv[lo + j]
-        out += finish_ring(&nv[out], k, xy, e)
+        out += finish_ring(&nv[out], k, xy)
     new_offsets[n_cells] = out
 
 
-cdef bint ring_is_simple(const int32_t* ring, int k, const double* xy, int e) noexcept nogil:
+cdef bint ring_is_simple(const int32_t* ring, int k, const double* xy) noexcept nogil:
     # no two edges that do not follow each other meet (exact; rings are small, pairs are checked)
     cdef int a, b
     for a in range(k):
         for b in range(a + 2, k):
             if a == 0 and b == k - 1:
                 continue
-            if segments_meet(xy, ring[a], ring[(a + 1) % k], ring[b], ring[(b + 1) % k], e):
+            if segments_meet(xy, ring[a], ring[(a + 1) % k], ring[b], ring[(b + 1) % k]):
                 return False
     return True
 
@@ -322,9 +324,9 @@ cdef inline bint on_segment(const double* xy, int p, int q, int r) noexcept nogi
             and min(xy[2 * p + 1], xy[2 * q + 1]) <= xy[2 * r + 1] <= max(xy[2 * p + 1], xy[2 * q + 1]))
 
 
-cdef bint segments_meet(const double* xy, int p, int q, int r, int s, int e) noexcept nogil:
-    cdef int o1 = turn(xy, p, q, r, e), o2 = turn(xy, p, q, s, e)
-    cdef int o3 = turn(xy, r, s, p, e), o4 = turn(xy, r, s, q, e)
+cdef bint segments_meet(const double* xy, int p, int q, int r, int s) noexcept nogil:
+    cdef int o1 = turn(xy, p, q, r), o2 = turn(xy, p, q, s)
+    cdef int o3 = turn(xy, r, s, p), o4 = turn(xy, r, s, q)
     if o1 * o2 < 0 and o3 * o4 < 0:
         return True
     return ((o1 == 0 and on_segment(xy, p, q, r)) or (o2 == 0 and on_segment(xy, p, q, s))
@@ -357,3 +359,11 @@ def bisector_crossing(double ax, double ay, double bx, double by, double t, bint
     """Where the bisector of sites a and b crosses the line x = t (returns its y) or, with along_y,
     the line y = t (returns its x): the correctly rounded value, times 2^e (for tests)."""
     return bisector_at(ax, ay, bx, by, t, along_y, e)
+
+
+def ring_turn(double ax, double ay, double bx, double by, double cx, double cy) -> int:
+    """The clipper's orientation of three ring points (+1 left, -1 right, 0 collinear), exact at any
+    magnitudes (for tests)."""
+    cdef double p[6]
+    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy
+    return turn(p, 0, 1, 2)

@@ -17,9 +17,10 @@
 # boundary of the cell leaves the box (an exit) and comes back (the next entry), the ring follows the
 # box boundary from the one to the other, through the corners between them.
 
-from libc.math cimport ldexp
+from libc.math cimport frexp, ldexp
 from libc.stdint cimport int32_t
 
+from tvoronoi.kernels.exact_integers cimport tvb_orient
 from tvoronoi.kernels.construct cimport (
     P_MAX, Q_MAX, bisector_at, bisector_side, bisector_offset, circumcentre_side, circumcentre_numerator,
     circumcentre_denominator,
@@ -400,16 +401,45 @@ cdef inline int sgn(double v) noexcept nogil:
     return (v > 0.0) - (v < 0.0)
 
 
-cdef inline int turn(const double* pts, int a, int b, int c, int e) noexcept nogil:
-    """Exact orientation of three output points, taken in the scaled unit 2^-e where no product under-
-    or overflows (the user's unit itself when e is moderate: scaling changes no sign)."""
-    if -300 < e < 300:
-        return orient2d(pts[2 * a], pts[2 * a + 1], pts[2 * b], pts[2 * b + 1], pts[2 * c], pts[2 * c + 1])
-    return orient2d(ldexp(pts[2 * a], -e), ldexp(pts[2 * a + 1], -e), ldexp(pts[2 * b], -e),
-                    ldexp(pts[2 * b + 1], -e), ldexp(pts[2 * c], -e), ldexp(pts[2 * c + 1], -e))
+# The band of magnitudes (as exponents) where orient2d's expansions neither overflow nor underflow:
+# differences stay under 2^451, and a nonzero difference of such doubles is at least 2^-392, so every
+# product and its rounding error remain normal doubles.
+DEF TURN_TOP = 450
+DEF TURN_BOTTOM = -340
 
 
-cdef inline bint folds_back(const double* pts, int a, int b, int c, int e) noexcept nogil:
+cdef inline int turn(const double* pts, int a, int b, int c) noexcept nogil:
+    """Exact orientation of three output points (+1 left turn, -1 right, 0 collinear) at any magnitudes.
+
+    The points are scaled by one power of two (exact) into the band where orient2d is exact; points whose
+    magnitudes span more than that band (a ring on a box 2^1000 times its sites' scale) are settled in
+    exact integers (exact_integers.pxd)."""
+    cdef double p[6]
+    cdef int i, k, lo = 100000, hi = -100000, s, r
+    p[0] = pts[2 * a]; p[1] = pts[2 * a + 1]; p[2] = pts[2 * b]
+    p[3] = pts[2 * b + 1]; p[4] = pts[2 * c]; p[5] = pts[2 * c + 1]
+    for i in range(6):
+        if p[i] != 0.0:
+            frexp(p[i], &k)
+            lo = min(lo, k)
+            hi = max(hi, k)
+    if hi < lo:
+        return 0                                   # three times the origin
+    if TURN_BOTTOM <= lo and hi <= TURN_TOP:
+        return orient2d(p[0], p[1], p[2], p[3], p[4], p[5])
+    if hi - lo <= TURN_TOP - TURN_BOTTOM:
+        s = hi - TURN_TOP if hi > TURN_TOP else lo - TURN_BOTTOM
+        return orient2d(ldexp(p[0], -s), ldexp(p[1], -s), ldexp(p[2], -s),
+                        ldexp(p[3], -s), ldexp(p[4], -s), ldexp(p[5], -s))
+    r = tvb_orient(p)
+    if r == 2:                                     # no memory for the integers: the nearest exact band
+        s = hi - TURN_TOP
+        return orient2d(ldexp(p[0], -s), ldexp(p[1], -s), ldexp(p[2], -s),
+                        ldexp(p[3], -s), ldexp(p[4], -s), ldexp(p[5], -s))
+    return r
+
+
+cdef inline bint folds_back(const double* pts, int a, int b, int c) noexcept nogil:
     """a -> b -> c turns back on itself (degenerate case: exact vertices closer than rounding, so a
     convex turn became a spike): c equals a, or the three are collinear and the path reverses.
     The points are in the user's unit; the orientation is taken on them scaled by 2^-e (exact), where
@@ -420,10 +450,10 @@ cdef inline bint folds_back(const double* pts, int a, int b, int c, int e) noexc
     # are exact); a convex turn of a ring mostly reverses at most one, so the exact test is rare
     if not (rx <= 0 and ry <= 0 and (rx < 0 or ry < 0)):
         return False
-    return turn(pts, a, b, c, e) == 0
+    return turn(pts, a, b, c) == 0
 
 
-cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noexcept nogil:
+cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
     """Make a ring of rounded points a valid polygon and give it its canonical start.
 
     Repeated consecutive points (by value) are dropped, and so is the tip of a spike -- a point where
@@ -436,7 +466,7 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noex
         p = ring[k]
         if j > 0 and same_point(pts, ring[j - 1], p):
             continue
-        while j > 1 and folds_back(pts, ring[j - 2], ring[j - 1], p, e):
+        while j > 1 and folds_back(pts, ring[j - 2], ring[j - 1], p):
             j -= 1
             if same_point(pts, ring[j - 1], p):
                 break
@@ -448,9 +478,9 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noex
     for guard in range(n):
         if j > 1 and same_point(pts, ring[j - 1], ring[0]):
             j -= 1
-        elif j > 2 and folds_back(pts, ring[j - 2], ring[j - 1], ring[0], e):
+        elif j > 2 and folds_back(pts, ring[j - 2], ring[j - 1], ring[0]):
             j -= 1
-        elif j > 2 and folds_back(pts, ring[j - 1], ring[0], ring[1], e):
+        elif j > 2 and folds_back(pts, ring[j - 1], ring[0], ring[1]):
             for k in range(j - 1):
                 ring[k] = ring[k + 1]
             j -= 1
@@ -470,12 +500,12 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts, int e) noex
     return j
 
 
-cdef inline int first_right_turn(const int32_t* ring, int n, const double* pts, int e) noexcept nogil:
+cdef inline int first_right_turn(const int32_t* ring, int n, const double* pts) noexcept nogil:
     """The position in a finished ring of its first right turn (a vertex that rounding moved across the
     line of its neighbours: the cell around it is thinner than the rounding there), or -1: every turn
     is to the left and the ring is convex."""
     cdef int k
     for k in range(n):
-        if turn(pts, ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n], e) < 0:
+        if turn(pts, ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]) < 0:
             return k
     return -1

@@ -766,7 +766,7 @@ cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
                       b.nby, b.ring)
     if count <= 0:
         return 0
-    return finish_ring(b.ring, count, b.pts, box.e)
+    return finish_ring(b.ring, count, b.pts)
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -1,0 +1,51 @@
+"""The exact checks themselves catch what they are for, at spans GEOS cannot handle (unit sites, a 1e300 box)."""
+
+import types
+
+import numpy as np
+import pytest
+
+import exact_checks as ec
+import tvoronoi
+
+
+def huge_box_diagram():
+    pts = np.random.default_rng(5).random((40, 2))
+    d = tvoronoi.voronoi(pts, bbox=(-1e300, -1e300, 1e300, 1e300))
+    assert ec.magnitude_span(d) > ec.GEOS_SPAN_BITS
+    return d
+
+
+def with_cells(d, rings):
+    """A stand-in diagram with the same sites and box and the given rings."""
+    offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
+    points = np.vstack([r for r in rings if len(r)]) if any(len(r) for r in rings) else np.zeros((0, 2))
+    return types.SimpleNamespace(
+        sites=d.sites, site_of=d.site_of, n_sites=d.n_sites, bbox=d.bbox, cell_points=points,
+        cell_polygon=lambda i: points[offsets[i]:offsets[i + 1]])
+
+
+def test_the_huge_box_diagram_passes():
+    d = huge_box_diagram()
+    ec.check_cells_valid(d)
+    ec.check_tiling(d)
+
+
+def test_a_moved_shared_vertex_is_caught():
+    """One cell's copy of a finite vertex moved by a little: its edges no longer meet the neighbours'."""
+    d = huge_box_diagram()
+    rings = [d.cell_polygon(i).copy() for i in range(d.n_sites)]
+    i = next(i for i, r in enumerate(rings) if len(r) and np.abs(r).max() < 10)
+    rings[i][0] = rings[i][0] + 1e-3 * (rings[i][1] - rings[i][0])
+    with pytest.raises(AssertionError, match="(no neighbour|cover)"):
+        ec.check_tiling(with_cells(d, rings))
+
+
+def test_a_self_intersecting_cell_is_caught():
+    d = huge_box_diagram()
+    rings = [d.cell_polygon(i).copy() for i in range(d.n_sites)]
+    i = next(i for i, r in enumerate(rings) if len(r) >= 5 and np.abs(r).max() > 1e299)
+    r = rings[i]
+    r[[1, 2]] = r[[2, 1]]                 # a bow tie
+    with pytest.raises(AssertionError, match="(not simple|clockwise|flat)"):
+        ec.check_cells_valid(with_cells(d, rings))
