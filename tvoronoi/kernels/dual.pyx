@@ -65,17 +65,28 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] dual_of = np.empty(n_he_d, np.int32)     # Voronoi half-edge -> Delaunay half-edge
     cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
     cdef int32_t[::1] finite = np.empty(n_tri, np.int32)
+    cdef int32_t[::1] slot = np.full(n_tri, -1, np.int32)      # finite triangle -> its index in finite
+    cdef double[:, ::1] centre = np.empty((n_tri, 2), np.float64)
     cdef double[:, ::1] vertices
-    cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, g, merges = 0
-    cdef double vx, vy
+    cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, f2, g, merges = 0
 
     with nogil:
-        # merge the triangles of each cocircular group into one Voronoi vertex
         for t in range(n_tri):
             parent[t] = t
             if tv[3 * t] != inf and tv[3 * t + 1] != inf and tv[3 * t + 2] != inf:
+                slot[t] = n_finite
                 finite[n_finite] = t
                 n_finite += 1
+        # every finite triangle's circumcentre, correctly rounded (construct.circumcentre)
+        for f in range(n_finite):
+            if (f & POLL_MASK) == 0:
+                poll_signals()
+            t = finite[f]
+            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &centre[f, 0], &centre[f, 1])
+        # merge the triangles of each cocircular group into one Voronoi vertex. Equal exact centres round
+        # to equal doubles, so only neighbours whose rounded centres agree can be cocircular: the exact
+        # in-circle test runs on those alone
         for f in range(n_finite):
             if (f & POLL_MASK) == 0:
                 poll_signals()
@@ -83,12 +94,13 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             for e in range(3 * t, 3 * t + 3):
                 o = opp[e]
                 t2 = o // 3
-                if t2 < t:
+                f2 = slot[t2]
+                if t2 < t or f2 < 0:
                     continue
-                d = tv[prv(o)]
-                if d == inf:
+                if centre[f, 0] != centre[f2, 0] or centre[f, 1] != centre[f2, 1]:
                     continue
                 a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+                d = tv[prv(o)]
                 # degenerate case: four cocircular sites, a zero-length Voronoi edge
                 if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0:
                     r = find(&parent[0], t)
@@ -96,36 +108,34 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     if r != g:
                         parent[g] = r
                         merges += 1
-        # each group's vertex: the circumcentre of one of its triangles (all give the same exact
-        # point, hence the same correctly rounded one); with no cocircular sites, one per triangle
+        # each group's vertex: the centre of one of its triangles (all have the same exact centre, hence
+        # the same rounded one); with no cocircular sites, one vertex per finite triangle, in order
         if merges == 0:
             m = n_finite
-        for f in range(n_finite if merges > 0 else 0):
-            t = finite[f]
-            r = find(&parent[0], t)
-            if tri_vertex[r] == -1:
-                tri_vertex[r] = m
-                m += 1
-                group_tri[r] = t
-    vertices = np.empty((m, 2), np.float64)
-    with nogil:
-        for f in range(n_finite):
-            if (f & POLL_MASK) == 0:
-                poll_signals()
-            t = finite[f]
-            if merges == 0:
-                r = t
-                tri_vertex[t] = f
-            else:
+            for f in range(n_finite):
+                tri_vertex[finite[f]] = f
+        else:
+            for f in range(n_finite):
+                t = finite[f]
                 r = find(&parent[0], t)
+                if tri_vertex[r] == -1:
+                    tri_vertex[r] = m
+                    m += 1
+                    group_tri[r] = t
                 tri_vertex[t] = tri_vertex[r]
-                if group_tri[r] != t:
-                    continue
-            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &vx, &vy)
-            vertices[tri_vertex[r], 0] = vx
-            vertices[tri_vertex[r], 1] = vy
+    if merges == 0:
+        vertices = centre[:n_finite]
+    else:
+        vertices = np.empty((m, 2), np.float64)
+        with nogil:
+            for f in range(n_finite):
+                t = finite[f]
+                r = find(&parent[0], t)
+                if group_tri[r] == t:
+                    vertices[tri_vertex[t], 0] = centre[f, 0]
+                    vertices[tri_vertex[t], 1] = centre[f, 1]
 
+    with nogil:
         # one Voronoi half-edge per Delaunay half-edge between two sites,
         # unless both sides share a vertex (a zero-length edge)
         for e in range(n_he_d):
@@ -155,7 +165,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
     tri = np.asarray(tv).reshape(-1, 3)[np.asarray(finite)[:n_finite]]
     return {
-        "vertices": np.asarray(vertices),
+        "vertices": np.asarray(vertices) if merges else np.asarray(centre)[:n_finite],
         "he_origin": np.asarray(he_origin)[:h].copy(),
         "he_twin": np.asarray(he_twin)[:h].copy(),
         "he_next": np.asarray(he_next)[:h].copy(),
