@@ -30,14 +30,18 @@ output:
 
   An existing OUTPUT or --delaunay FILE is not replaced unless --force is
   given, and then only by renaming a complete new file over it: a failed run
-  leaves every existing file as it was, and no half-written file behind.
+  leaves every existing file as it was, and no half-written file behind. A
+  symbolic link keeps pointing where it pointed; the file it names is
+  replaced. Character devices (/dev/null), named pipes, /dev/stdout and "-"
+  are written directly, with or without --force, and never replaced.
 
   A progress display appears on stderr for inputs of 200,000 points or more
   when stderr is a terminal and -q is not given.
 
 exit status:
   0    success (warnings may have been printed)
-  1    an output could not be written (disk full, permission denied, ...)
+  1    an output could not be written (disk full, permission denied, ...),
+       or the reader of a pipe left early (| head), which is not reported
   2    bad input or options: unreadable or malformed point file, bad --bbox,
        unknown or unavailable engine, an existing output without --force
   130  interrupted

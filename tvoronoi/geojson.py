@@ -2,23 +2,19 @@
 
 from __future__ import annotations
 
-import errno
-import os
-import secrets
-import stat
-import sys
-from contextlib import contextmanager
-from typing import BinaryIO, Callable, Iterator
+from typing import Callable
 
 import numpy as np
 import orjson
 
 from tvoronoi.bulk import gc_paused
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.writers.targets import STDOUT, TEMP_SUFFIX, AtomicFile, StdoutFile, open_output, output_file
 
-__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT"]
+# the output targets live in tvoronoi.writers.targets and stay importable from here
+__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT",
+           "AtomicFile", "StdoutFile", "TEMP_SUFFIX"]
 
-STDOUT = "-"
 # features serialized per orjson call: large enough to amortise numpy and orjson
 # calls, small enough that a chunk of text stays a few megabytes
 CHUNK_FEATURES = 10_000
@@ -26,9 +22,6 @@ CHUNK_FEATURES = 10_000
 MIN_RING_POINTS = 3
 # property names tvoronoi writes itself; a site property of the same name is renamed
 RESERVED = ("site", "duplicates")
-TEMP_SUFFIX = ".tmp"
-NEW_FILE_MODE = 0o666  # before the umask, as open() would create it
-WRITE_BUFFER = 1 << 20
 
 ProgressCallback = Callable[[int, int], None]
 
@@ -39,141 +32,6 @@ _POLYGON = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]
 _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
-
-
-# ---------------------------------------------------------------------------
-# output files
-
-
-class AtomicFile:
-    """A binary file written under a temporary name beside its target, renamed into place on commit.
-
-    The temporary file ``.NAME.tvoronoi-XXXXXXXX.tmp`` lives in the target's
-    directory, so that ``os.replace`` is a rename within one file system: the
-    target either keeps its old content or gets the complete new one.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The target. A symbolic link is followed: the file it points to is replaced.
-    overwrite : bool
-        Replace an existing target; if False, ``FileExistsError`` is raised when the
-        target exists, on opening and again just before the rename.
-
-    Raises
-    ------
-    FileExistsError
-        The target exists and ``overwrite`` is False.
-    OSError
-        The directory is missing or not writable, or the target is a directory.
-    """
-
-    def __init__(self, path: str | os.PathLike, *, overwrite: bool = True):
-        self.path = os.fspath(path)
-        self.target = os.path.realpath(self.path) if os.path.islink(self.path) else self.path
-        self.overwrite = overwrite
-        self.done = False
-        self._check_target()
-        directory, name = os.path.split(os.path.abspath(self.target))
-        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-        while True:
-            self.temp = os.path.join(directory, f".{name}.tvoronoi-{secrets.token_hex(4)}{TEMP_SUFFIX}")
-            try:
-                fd = os.open(self.temp, flags, NEW_FILE_MODE)
-            except FileExistsError:  # a name another run holds: draw again
-                continue
-            break
-        self.file: BinaryIO = os.fdopen(fd, "wb", buffering=WRITE_BUFFER)
-
-    def _check_target(self) -> None:
-        if os.path.isdir(self.target):
-            raise IsADirectoryError(errno.EISDIR, "is a directory", self.path)
-        if not self.overwrite and os.path.lexists(self.path):
-            raise FileExistsError(errno.EEXIST, "file exists", self.path)
-
-    def commit(self) -> None:
-        """Flush the data to disk and rename the file into place (keeping an old target's mode)."""
-        try:
-            self.file.flush()
-            os.fsync(self.file.fileno())
-            self.file.close()
-            self._check_target()
-            try:
-                os.chmod(self.temp, stat.S_IMODE(os.stat(self.target).st_mode))
-            except FileNotFoundError:
-                pass
-            os.replace(self.temp, self.target)
-        except BaseException:
-            self.discard()
-            raise
-        self.done = True
-
-    def discard(self) -> None:
-        """Close and remove the temporary file; the target is left as it was. No-op after commit."""
-        if self.done:
-            return
-        self.done = True
-        try:
-            self.file.close()
-        except OSError:
-            pass
-        try:
-            os.unlink(self.temp)
-        except FileNotFoundError:
-            pass
-
-
-class StdoutFile:
-    """Standard output with the interface of :class:`AtomicFile` (it cannot be atomic: commit flushes)."""
-
-    path = STDOUT
-
-    def __init__(self):
-        self.file: BinaryIO = sys.stdout.buffer
-
-    def commit(self) -> None:
-        self.file.flush()
-
-    def discard(self) -> None:
-        pass
-
-
-def output_file(out, *, overwrite: bool = True) -> AtomicFile | StdoutFile:
-    """An :class:`AtomicFile` for a path, a :class:`StdoutFile` for ``"-"``.
-
-    Write to ``.file``, then call ``.commit()`` on success or ``.discard()`` on failure.
-    """
-    if isinstance(out, str) and out == STDOUT:
-        return StdoutFile()
-    return AtomicFile(out, overwrite=overwrite)
-
-
-@contextmanager
-def open_output(out, *, overwrite: bool = True) -> Iterator[BinaryIO]:
-    """A binary stream for ``out``: a path (written atomically), ``"-"`` (stdout) or an open binary file.
-
-    A path is written through an :class:`AtomicFile`: it is renamed into place
-    when the block ends normally and removed when the block raises, so a
-    failure never leaves half a file and never touches an existing one.
-    Standard output is flushed at the end; an open file is used as it is.
-
-    Raises
-    ------
-    FileExistsError
-        If ``overwrite`` is False and the path exists.
-    OSError
-        If the file cannot be created or written.
-    """
-    if hasattr(out, "write"):
-        yield out
-        return
-    target = output_file(out, overwrite=overwrite)
-    try:
-        yield target.file
-    except BaseException:
-        target.discard()
-        raise
-    target.commit()
 
 
 # ---------------------------------------------------------------------------
