@@ -187,7 +187,7 @@ def test_csv_two_quoted_columns(tmp_path):
     np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
 
 
-def test_csv_extra_columns_are_converted(tmp_path):
+def test_csv_extra_columns_are_typed_per_column(tmp_path):
     content = (
         "x,y,i,f,mixed,s,e,big,nan\n"
         "0,0,1,1.5,1,abc,,123456789012345678901234567890,nan\n"
@@ -195,32 +195,33 @@ def test_csv_extra_columns_are_converted(tmp_path):
         "2,2,+3,-1e3,hello, ,,2,3\n"
     )
     points = read(tmp_path, "p.csv", content)
+    # a column with a word is text throughout; a number column with a non-integer is float throughout
     assert points.properties(0) == {
-        "i": 1, "f": 1.5, "mixed": 1, "s": "abc", "e": None,
+        "i": 1, "f": 1.5, "mixed": "1", "s": "abc", "e": None,
         "big": "123456789012345678901234567890", "nan": None,
     }
     row1 = points.properties(1)
     assert row1["i"] == -2 and type(row1["i"]) is int
-    assert row1["f"] == 2 and type(row1["f"]) is int
-    assert row1["mixed"] == 2.5 and row1["s"] == "x y" and row1["nan"] is None
+    assert row1["f"] == 2 and type(row1["f"]) is float
+    assert row1["mixed"] == "2.5" and row1["s"] == "x y" and row1["nan"] is None
     row2 = points.properties(2)
     # a blank (whitespace-only) field is empty too
-    assert row2 == {"i": 3, "f": -1000.0, "mixed": "hello", "s": None, "e": None, "big": 2, "nan": 3}
-    assert type(row2["f"]) is float
+    assert row2 == {"i": 3, "f": -1000.0, "mixed": "hello", "s": None, "e": None, "big": "2", "nan": 3.0}
+    assert type(row2["f"]) is float and type(row2["nan"]) is float
 
 
-def test_csv_int_column_stays_int_and_float_column_keeps_int_literals(tmp_path):
+def test_csv_int_column_stays_int_and_float_column_is_float(tmp_path):
     points = read(tmp_path, "p.csv", "x,y,a,b\n0,0,7,0.5\n1,1,8,2\n2,2,9,1e-3\n")
     a = [points.properties(i)["a"] for i in range(3)]
     b = [points.properties(i)["b"] for i in range(3)]
     assert a == [7, 8, 9] and all(type(v) is int for v in a)
-    assert b == [0.5, 2, 0.001] and [type(v) for v in b] == [float, int, float]
+    assert b == [0.5, 2.0, 0.001] and all(type(v) is float for v in b)
 
 
 def test_csv_properties_are_json_ready(tmp_path):
     points = read(tmp_path, "p.csv", "x,y,a,b,c\n0,0,nan,1e999,\n1,1,2,x,7\n")
     text = json.dumps([points.properties(i) for i in range(2)], allow_nan=False)
-    assert json.loads(text) == [{"a": None, "b": None, "c": None}, {"a": 2, "b": "x", "c": 7}]
+    assert json.loads(text) == [{"a": None, "b": "1e999", "c": None}, {"a": 2.0, "b": "x", "c": 7}]
 
 
 def test_csv_blank_lines_crlf_bom_and_spaces(tmp_path):
@@ -771,3 +772,38 @@ def test_unterminated_quote(tmp_path):
 def test_control_characters_are_shown_escaped(tmp_path):
     message = error(tmp_path, "p.csv", "x,y\n1,2\n3,4\x00\n")
     assert 'p.csv, line 3: "4\\u0000" in column "y" is not a number' in message
+
+
+# ---------------------------------------------------------------------------
+# columns typed per column
+
+
+def test_zip_codes_keep_their_leading_zeros(tmp_path):
+    points = read(tmp_path, "p.csv", "zip,x,y\n01000,0,0\n02134,1,0\n90210,0,1\n")
+    assert [points.properties(i)["zip"] for i in range(3)] == ["01000", "02134", "90210"]
+
+
+def test_a_column_is_integer_only_if_every_value_is(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,n,m,t\n0,0,1,1,7\n1,0,,2.5,7a\n0,1,3,,8\n")
+    assert [points.properties(i)["n"] for i in range(3)] == [1, None, 3]
+    assert [type(points.properties(i)["m"]) for i in range(3)] == [float, float, type(None)]
+    assert [points.properties(i)["t"] for i in range(3)] == ["7", "7a", "8"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.one_of(st.integers(-10**20, 10**20).map(str), st.from_regex(r"0[0-9]{1,5}", fullmatch=True),
+                          st.floats(allow_nan=False, allow_infinity=False).map(repr), st.just(""),
+                          st.text("abc ", min_size=1, max_size=4)),
+                min_size=1, max_size=12))
+def test_every_column_has_one_type(values):
+    from tvoronoi.readers.pointset import _convert_column
+
+    for plain in (True, False):
+        out = _convert_column(values, plain)
+        assert [v is None for v in out] == [not v.strip() for v in values]
+        kinds = {type(v) for v in out} - {type(None)}
+        assert len(kinds) <= 1
+        if kinds == {str}:
+            assert all(o == v for o, v in zip(out, values) if o is not None)
+        if any(v.strip().startswith("0") and v.strip()[1:2].isdigit() for v in values):
+            assert kinds <= {str}
