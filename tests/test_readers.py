@@ -807,3 +807,77 @@ def test_every_column_has_one_type(values):
             assert all(o == v for o, v in zip(out, values) if o is not None)
         if any(v.strip().startswith("0") and v.strip()[1:2].isdigit() for v in values):
             assert kinds <= {str}
+
+
+# ---------------------------------------------------------------------------
+# column choice: names, id-like columns, separators
+
+
+@pytest.mark.parametrize("header, expect", [
+    ("name,Easting,Northing", ("Easting", "Northing")),
+    ("name,E,N", ("E", "N")),
+    ("name,X,Y", ("X", "Y")),
+    ("name,Longitude,Latitude", ("Longitude", "Latitude")),
+    ("name,lng,lat", ("lng", "lat")),
+])
+def test_coordinate_columns_recognised_by_name(tmp_path, header, expect):
+    points = read(tmp_path, "p.csv", f"{header}\na,5,7\nb,6,8\n")
+    np.testing.assert_array_equal(points.xy, [[5, 7], [6, 8]])
+    assert points.property_names == ["name"]
+    assert points.choice is None or f'x = "{expect[0]}", y = "{expect[1]}" (by name)' in points.choice
+
+
+def test_n_alone_is_not_a_northing(tmp_path):
+    points = read(tmp_path, "p.csv", "a,n,x\n5,1,7\n6,2,8\n")
+    # "n" (a count) has no "e" beside it: y is the first free numeric column
+    np.testing.assert_array_equal(points.xy, [[7, 5], [8, 6]])
+    assert points.property_names == ["n"]
+
+
+@pytest.mark.parametrize("id_name", ["id", "FID", "index", "row", "OBJECTID", "station_id", "Unnamed: 0"])
+def test_id_like_columns_are_never_taken_by_position(tmp_path, id_name):
+    points = read(tmp_path, "p.csv", f"{id_name},a,b\n1,5,7\n2,6,8\n3,1,1\n")
+    np.testing.assert_array_equal(points.xy, [[5, 7], [6, 8], [1, 1]])
+    assert points.choice.startswith('x = "a", y = "b" (the first numeric columns); skipped the id-like column')
+    assert f'"{id_name}"' in points.choice
+
+
+def test_only_id_columns_left_is_an_error_naming_them(tmp_path):
+    message = error(tmp_path, "p.csv", "id,value,name\n1,5,a\n2,6,b\n")
+    assert "id-like columns are not taken: id" in message and "--x/--y" in message
+
+
+def test_semicolon_csv_with_decimal_commas(tmp_path):
+    points = read(tmp_path, "p.csv", "Name;X;Y;Pop\nA;1,5;2,25;1000\nB;3;4,75;2000\n")
+    np.testing.assert_array_equal(points.xy, [[1.5, 2.25], [3.0, 4.75]])
+    assert points.properties(1) == {"Name": "B", "Pop": 2000}
+
+
+def test_semicolon_csv_bad_value_is_named_as_written(tmp_path):
+    message = error(tmp_path, "p.csv", "x;y\n1,5;2\n1,5,3;4\n")
+    assert 'line 3: "1,5,3" in column "x" is not a number' in message
+
+
+def test_tsv_and_explicit_delimiter(tmp_path):
+    points = read(tmp_path, "p.tsv", "x\ty\tname\n1\t2\ta b\n3\t4\t\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(0) == {"name": "a b"} and points.properties(1) == {"name": None}
+    points = read(tmp_path, "p.txt", "x|y|name\n1|2|a\n3|4|b\n", delimiter="|")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+@pytest.mark.parametrize("name, content, what", [
+    ("p.gpkg", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+    ("p.dat", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+    ("p.shp", b"\x00\x00\x27\x0a" + bytes(96), "shapefile"),
+    ("p.zip", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.csv", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.xlsx", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.kml", b"<?xml version='1.0'?><kml/>", "KML"),
+    ("p.csv.gz", b"\x1f\x8b\x08" + bytes(20), "gzip"),
+])
+def test_unsupported_formats_are_named_with_a_conversion(tmp_path, name, content, what):
+    message = error(tmp_path, name, content)
+    assert what in message and "does not read" in message
+    assert "ogr2ogr" in message or "gunzip" in message or "unzip" in message
+    assert "UTF-8" not in message

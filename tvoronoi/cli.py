@@ -7,11 +7,12 @@ import math
 import os
 import signal
 import sys
+import warnings
 from contextlib import contextmanager
 
 from tvoronoi import __version__
 from tvoronoi.api import ENGINES, INSERTION_ORDERS
-from tvoronoi.errors import TvoronoiError
+from tvoronoi.errors import CoordinateRangeError, TvoronoiError
 from tvoronoi.readers import FORMATS
 
 PROG = "tvoronoi"
@@ -78,6 +79,19 @@ def parse_bbox(text: str) -> tuple[float, float, float, float]:
     return xmin, ymin, xmax, ymax
 
 
+def parse_delimiter(text: str) -> str:
+    """Parse ``--delimiter``: one character, or "tab" / "\\t" for a tab.
+
+    >>> parse_delimiter("tab"), parse_delimiter(";")
+    ('\\t', ';')
+    """
+    named = {"tab": "\t", "\\t": "\t", "comma": ",", "semicolon": ";", "pipe": "|", "space": " "}
+    value = named.get(text.lower(), text)
+    if len(value) != 1 or value in "\r\n\"":
+        raise argparse.ArgumentTypeError(f"{text!r}: give one character, e.g. ';' or 'tab'")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
@@ -104,6 +118,9 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
     batch.add_argument("--y", metavar="COL", help="y column of a table: a name, a 0-based index or colN")
     batch.add_argument("--format", choices=FORMATS, help="input format; default: from the extension, else the content")
+    batch.add_argument("--delimiter", metavar="CHAR", type=parse_delimiter,
+                       help='field separator of a CSV input: ",", ";", "tab", "|", ...; default: a tab for .tsv, '
+                            "else found from the first rows (a ;-separated file may use decimal commas)")
     batch.add_argument("--insertion", choices=INSERTION_ORDERS, default="brio",
                        help="incremental engine: insertion order (default: %(default)s)")
     batch.add_argument("--seed", type=int, default=0, help="seed of the insertion order (default: %(default)s)")
@@ -175,6 +192,16 @@ def run_batch(args) -> int:
 def _batch(args, phases: Phases) -> int:
     import numpy as np
 
+    # a value at the edge of the double range overflows in the box arithmetic; the checks
+    # that follow report it in words, so numpy's own warnings are not printed
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _batch_run(args, phases)
+
+
+def _batch_run(args, phases: Phases) -> int:
+    import numpy as np
+
     from tvoronoi import geojson
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
@@ -198,12 +225,17 @@ def _batch(args, phases: Phases) -> int:
         if args.input != STDIO and _size(args.input) >= PROGRESS_MIN_BYTES:
             phases.show()
         with phases.phase("read") as done:
-            points = read_points(args.input, x=args.x, y=args.y, fmt=args.format)
+            points = read_points(args.input, x=args.x, y=args.y, fmt=args.format, delimiter=args.delimiter)
             done(f"{len(points):,} points")
+        if points.choice is not None and not args.quiet:
+            phases.note(f"{points.source}: {points.choice}")
         if len(points) >= PROGRESS_MIN_POINTS:
             phases.show()
         with phases.phase("build") as done:
-            diagram = voronoi(points.xy, **options)
+            try:
+                diagram = voronoi(points.xy, **options)
+            except CoordinateRangeError as e:
+                raise TvoronoiError(f"{points.source}, {e.explain(points.place)}") from None
             done(f"{len(diagram.triangles):,} triangles")
 
         repeats = diagram.n_sites - int(np.count_nonzero(diagram.site_of == np.arange(diagram.n_sites)))
@@ -338,8 +370,14 @@ class Phases:
         yield progress
         self.progress.update(task, total=1, completed=1)
 
+    def note(self, message: str) -> None:
+        """Tell what was chosen for the user (e.g. the x and y columns)."""
+        self._print(f"{PROG}: {message}")
+
     def warn(self, message: str) -> None:
-        line = f"{PROG}: warning: {message}"
+        self._print(f"{PROG}: warning: {message}")
+
+    def _print(self, line: str) -> None:
         if self.progress is not None:
             self.progress.console.print(line, markup=False, highlight=False)
         else:

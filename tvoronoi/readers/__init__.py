@@ -24,6 +24,8 @@ __all__ = ["FORMATS", "PointSet", "read_points"]
 FORMATS = ("csv", "text", "geojson", "npy")
 EXTENSIONS = {
     ".csv": "csv",
+    ".tsv": "csv",
+    ".tab": "csv",
     ".txt": "text",
     ".xy": "text",
     ".dat": "text",
@@ -31,6 +33,35 @@ EXTENSIONS = {
     ".geojson": "geojson",
     ".json": "geojson",
     ".npy": "npy",
+}
+# the separator of a CSV file with this extension (others are found from the first rows)
+DELIMITER_OF = {".tsv": "\t", ".tab": "\t"}
+_GDAL = "ogr2ogr -f GeoJSON points.geojson {source} (GDAL), or geopandas: read_file(...).to_parquet(...)"
+# formats that are not read, by their first bytes and by extension: (name, how to convert)
+UNSUPPORTED_MAGIC = (
+    (b"SQLite format 3\x00", "GeoPackage (SQLite database)", _GDAL),
+    (b"\x00\x00\x27\x0a", "shapefile", _GDAL),
+    (b"fgb\x03", "FlatGeobuf", _GDAL),
+    (b"\x1f\x8b", "gzip-compressed",
+     "gunzip -k {source}, or pipe it: gunzip -c {source} | tvoronoi batch - -o ..."),
+    (b"PK\x03\x04", "zip archive",
+     "unzip it and give the point file inside (a zipped shapefile converts directly: "
+     "ogr2ogr -f GeoJSON points.geojson /vsizip/{source})"),
+)
+UNSUPPORTED_EXTENSIONS = {
+    ".gpkg": ("GeoPackage", _GDAL),
+    ".shp": ("shapefile", _GDAL),
+    ".shx": ("shapefile index", "give the .shp file to " + _GDAL),
+    ".dbf": ("shapefile attribute table (dBASE)", "give the .shp file to " + _GDAL),
+    ".fgb": ("FlatGeobuf", _GDAL),
+    ".kml": ("KML", _GDAL),
+    ".kmz": ("KMZ (zipped KML)", _GDAL),
+    ".gml": ("GML", _GDAL),
+    ".zip": UNSUPPORTED_MAGIC[-1][1:],
+    ".gz": UNSUPPORTED_MAGIC[-2][1:],
+    ".xlsx": ("Excel workbook", "save the sheet as CSV (File > Save As > CSV)"),
+    ".xls": ("Excel workbook", "save the sheet as CSV (File > Save As > CSV)"),
+    ".ods": ("OpenDocument spreadsheet", "save the sheet as CSV (File > Save As > CSV)"),
 }
 STDIN = "-"
 STDIN_SOURCE = "<stdin>"
@@ -43,6 +74,7 @@ def read_points(
     x: str | int | None = None,
     y: str | int | None = None,
     fmt: str | None = None,
+    delimiter: str | None = None,
 ) -> PointSet:
     """Read sites from a CSV, whitespace-text, GeoJSON or .npy file, or standard input.
 
@@ -57,6 +89,10 @@ def read_points(
         numeric columns.
     fmt : {None, "csv", "text", "geojson", "npy"}
         The format; ``None`` detects it from the extension, else from the content.
+    delimiter : str, optional
+        The field separator of a CSV file (one character); by default a tab for
+        ``.tsv``, else the one of ",", ";", tab and "|" that splits the first rows
+        evenly. In a ";"-separated file, coordinates may have a decimal comma.
 
     Returns
     -------
@@ -67,21 +103,43 @@ def read_points(
     ------
     InputFileError
         If the file is missing or unreadable, has no points, or holds a value that
-        is not a finite coordinate; the message names the file, the line (or the
-        feature or row) and the fix.
+        is not a finite coordinate, or is in a format tvoronoi does not read
+        (GeoPackage, shapefile, zip, ...); the message names the file, the line
+        (or the feature or row) and the fix.
     TvoronoiError
         If ``fmt`` is unknown, or ``x``/``y`` are given for a GeoJSON file.
     """
     if fmt is not None and fmt not in FORMATS:
         raise TvoronoiError(f"unknown format {fmt!r}; choose one of: {', '.join(FORMATS)}")
+    if delimiter is not None and len(delimiter) != 1:
+        raise TvoronoiError(f"--delimiter {delimiter!r}: give one character, e.g. ';' or '\\t'")
     source, suffix, data = _read_bytes(path)
+    _refuse_unsupported(data, suffix if fmt is None else "", source)
     if fmt is None:
         fmt = EXTENSIONS.get(suffix) or _sniff_format(data)
+    if delimiter is not None and fmt not in ("csv", "text"):
+        raise TvoronoiError(f"{source}: --delimiter applies to CSV files, and this is read as {fmt}")
+    if delimiter is not None or suffix in DELIMITER_OF:
+        fmt = "csv"
+        delimiter = delimiter or DELIMITER_OF[suffix]
     if fmt == "npy":
         return _read_npy(data, source, x, y)
     if fmt == "geojson":
         return _read_geojson(data, source, x, y, _loads_json)
-    return _read_table(_decode(data, source), source, fmt, x, y)
+    return _read_table(_decode(data, source), source, fmt, x, y, delimiter)
+
+
+def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
+    """Name a format that is not read, and how to convert it, rather than fail on its bytes."""
+    found = next(((name, how) for magic, name, how in UNSUPPORTED_MAGIC if data.startswith(magic)), None)
+    if found is None:
+        found = UNSUPPORTED_EXTENSIONS.get(suffix)
+    if found is not None:
+        name, how = found
+        raise InputFileError(
+            f"{source}: this is a {name} file, which tvoronoi does not read; convert it to GeoJSON, "
+            f"GeoParquet or CSV first, e.g. {how.format(source=source)}"
+        )
 
 
 # ---------------------------------------------------------------------------

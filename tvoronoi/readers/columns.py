@@ -95,8 +95,11 @@ def _check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str =
         raise TvoronoiError(f'{source}: x and y are the same {noun} "{names[ix]}"; choose two {noun}s')
 
 
-def describe_choice(names: list[str], ix: int, iy: int, how: str, skipped: list[str] = ()) -> str:
-    """The line that tells which columns became x and y, e.g. 'x = "lon", y = "lat" (by name)'."""
+def describe_choice(names: list[str], ix: int, iy: int, how: str, skipped: list[str] = ()) -> str | None:
+    """The line that tells which columns became x and y, e.g. 'x = "lon", y = "lat" (by name)';
+    None for columns named x and y, which leave nothing to tell."""
+    if how == "by name" and names[ix].lower() == "x" and names[iy].lower() == "y":
+        return None
     text = f'x = "{names[ix]}", y = "{names[iy]}" ({how})'
     if skipped:
         text += f"; skipped the id-like {'column' if len(skipped) == 1 else 'columns'} " + ", ".join(

@@ -89,9 +89,13 @@ class PointSet:
             return dict(self.records[i])
         return {name: values[i] for name, values in self.columns.items()}
 
+    def place(self, i: int) -> str:
+        """Where site ``i`` is in its file, for a message: "line 7", "features[3]", "row 3 (0-based)"."""
+        return self.where(i) if self.where is not None else f"row {i} (0-based)"
+
     def locate(self, i: int) -> str:
-        """Where site ``i`` is in its file, for a message: "data.csv, line 7"."""
-        return f"{self.source}, {self.where(i) if self.where is not None else f'row {i} (0-based)'}"
+        """Where site ``i`` is, with the file: "data.csv, line 7"."""
+        return f"{self.source}, {self.place(i)}"
 
 
 # ---------------------------------------------------------------------------
