@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import signal
 import sys
 import warnings
@@ -47,6 +48,19 @@ exit status:
        unknown or unavailable engine, an existing output without --force
   130  interrupted
 """
+
+
+# output formats: --to names, and the extensions that choose them
+OUTPUT_FORMATS = ("geojson", "geojsonseq", "geojsonl", "parquet")
+OUTPUT_EXTENSIONS = {
+    ".geojson": "geojson", ".json": "geojson",
+    ".geojsons": "geojsonseq", ".geojsonseq": "geojsonseq",
+    ".geojsonl": "geojsonl", ".jsonl": "geojsonl", ".ndjson": "geojsonl",
+    ".parquet": "parquet", ".geoparquet": "parquet", ".pq": "parquet",
+}
+GEOJSON_LAYOUT = {"geojson": "collection", "geojsonseq": "seq", "geojsonl": "lines"}
+CRS84 = "OGC:CRS84"
+LONLAT_BOX = (-180.0, -90.0, 180.0, 90.0)
 
 
 class OutputError(Exception):
@@ -124,6 +138,14 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--insertion", choices=INSERTION_ORDERS, default="brio",
                        help="incremental engine: insertion order (default: %(default)s)")
     batch.add_argument("--seed", type=int, default=0, help="seed of the insertion order (default: %(default)s)")
+    batch.add_argument("--to", choices=OUTPUT_FORMATS,
+                       help="output format of OUTPUT and --delaunay FILE; default: from the extension "
+                            "(.geojson, .geojsons, .geojsonl/.jsonl, .parquet), else geojson")
+    batch.add_argument("--precision", type=int, metavar="N",
+                       help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles)")
+    batch.add_argument("--crs", metavar="AUTH:CODE",
+                       help="the CRS of the input coordinates, e.g. EPSG:3857, recorded in GeoParquet "
+                            "(default: the input's own, else OGC:CRS84 for lon/lat columns, else unknown)")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress display and no warnings")
     batch.add_argument("--force", action="store_true", help="replace an existing OUTPUT or --delaunay FILE")
     return parser
@@ -212,6 +234,15 @@ def _batch_run(args, phases: Phases) -> int:
         raise TvoronoiError('-o and --delaunay cannot both be "-": stdout takes one of them')
     if len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1]):
         raise TvoronoiError(f"-o and --delaunay name the same file {names[0]}; choose two names")
+    if args.precision is not None and not 0 <= args.precision <= 17:
+        raise TvoronoiError(f"--precision {args.precision}: give a number of decimal digits from 0 to 17")
+    if args.crs is not None and not _CRS_CODE.fullmatch(args.crs):
+        raise TvoronoiError(f"--crs {args.crs!r}: give an authority and a code, e.g. EPSG:3857 or OGC:CRS84")
+    formats = {name: _output_format(name, args.to) for name in names}
+    if "parquet" in formats.values():
+        from tvoronoi.writers.geoparquet import require_pyarrow
+
+        require_pyarrow()
     options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
     # the engine and its options pass the API's own checks before a large file is read
     voronoi(np.empty((0, 2)), **options)
@@ -229,6 +260,18 @@ def _batch_run(args, phases: Phases) -> int:
             done(f"{len(points):,} points")
         if points.choice is not None and not args.quiet:
             phases.note(f"{points.source}: {points.choice}")
+        crs = args.crs or points.crs or (CRS84 if points.lonlat else None)
+        if crs is not None and crs.upper() in ("EPSG:4326", "OGC:CRS84"):
+            crs = CRS84
+        geojson_out = [name for name, fmt in formats.items() if fmt != "parquet"]
+        if crs not in (None, CRS84) and geojson_out and not args.quiet:
+            phases.warn(
+                f"{', '.join(geojson_out)}: RFC 7946 GeoJSON has no CRS and is read as lon/lat, but the "
+                f"coordinates are {crs}; write GeoParquet (.parquet) to keep the CRS"
+            )
+        if bbox is None and crs == CRS84:
+            # lon/lat: the default box stops at the antimeridian and the poles
+            options["bbox"] = _lonlat_box(points.xy)
         if len(points) >= PROGRESS_MIN_POINTS:
             phases.show()
         with phases.phase("build") as done:
@@ -250,10 +293,24 @@ def _batch_run(args, phases: Phases) -> int:
             phases.warn(f'{missing} {which} outside --bbox): written with "geometry": null')
 
         with phases.counter("write cells") as progress, _writing(args.output):
-            geojson.write_cells(diagram, points, outputs[args.output].file, progress=progress)
+            stream = outputs[args.output].file
+            if formats[args.output] == "parquet":
+                from tvoronoi.writers.geoparquet import write_cells_parquet
+
+                write_cells_parquet(diagram, points, stream, crs=crs)
+            else:
+                geojson.write_cells(diagram, points, stream, progress=progress, precision=args.precision,
+                                    layout=GEOJSON_LAYOUT[formats[args.output]])
         if args.delaunay is not None:
             with phases.counter("write triangles") as progress, _writing(args.delaunay):
-                geojson.write_delaunay(diagram, outputs[args.delaunay].file, progress=progress)
+                stream = outputs[args.delaunay].file
+                if formats[args.delaunay] == "parquet":
+                    from tvoronoi.writers.geoparquet import write_delaunay_parquet
+
+                    write_delaunay_parquet(diagram, stream, crs=crs)
+                else:
+                    geojson.write_delaunay(diagram, stream, progress=progress, precision=args.precision,
+                                           layout=GEOJSON_LAYOUT[formats[args.delaunay]])
         for name, output in outputs.items():
             with _writing(name):
                 output.commit()
@@ -262,6 +319,28 @@ def _batch_run(args, phases: Phases) -> int:
             output.discard()
         raise
     return EXIT_OK
+
+
+_CRS_CODE = re.compile(r"[A-Za-z]+:[A-Za-z0-9]+")
+
+
+def _output_format(name: str, to: str | None) -> str:
+    """The format of an output: --to, else its extension, else GeoJSON."""
+    if to is not None:
+        return to
+    return OUTPUT_EXTENSIONS.get(os.path.splitext(name)[1].lower(), "geojson")
+
+
+def _lonlat_box(xy) -> tuple[float, float, float, float] | None:
+    """The default box of lon/lat sites, kept within [-180, 180] x [-90, 90] (None: sites outside it)."""
+    from tvoronoi.api import default_bbox
+
+    xmin, ymin, xmax, ymax = default_bbox(xy)
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    if lo[0] < -180 or lo[1] < -90 or hi[0] > 180 or hi[1] > 90:
+        return None
+    box = (max(xmin, -180.0), max(ymin, -90.0), min(xmax, 180.0), min(ymax, 90.0))
+    return box if box[0] < box[2] and box[1] < box[3] else None
 
 
 def _size(path: str) -> int:

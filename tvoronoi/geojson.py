@@ -32,6 +32,42 @@ _POLYGON = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]
 _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
+# GeoJSON text sequences (RFC 8142): each feature opens with a record separator and ends a line
+RS = b"\x1e"
+# how features are framed: a FeatureCollection, an RFC 8142 sequence, or one feature per line
+LAYOUTS = ("collection", "seq", "lines")
+
+
+class _Framing:
+    """Writes features in chunks as a FeatureCollection or as a GeoJSON sequence."""
+
+    def __init__(self, stream, layout: str, bbox: bytes):
+        if layout not in LAYOUTS:
+            raise TvoronoiError(f"unknown GeoJSON layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
+        self.stream, self.layout, self.first = stream, layout, True
+        if layout == "collection":
+            stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+
+    def write(self, features: list[bytes]) -> None:
+        if not features:
+            return
+        if self.layout == "collection":
+            if not self.first:
+                self.stream.write(_SEPARATOR)
+            self.stream.write(_SEPARATOR.join(features))
+        else:
+            prefix = RS if self.layout == "seq" else b""
+            self.stream.write(b"".join(b"%b%b\n" % (prefix, feature) for feature in features))
+        self.first = False
+
+    def close(self) -> None:
+        if self.layout == "collection":
+            self.stream.write(b"\n]}\n")
+
+
+def _rounded(xy: np.ndarray, precision: int | None) -> np.ndarray:
+    """Coordinates rounded to ``precision`` decimal digits (None: as computed)."""
+    return xy if precision is None else np.round(xy, precision)
 
 
 # ---------------------------------------------------------------------------
@@ -160,7 +196,7 @@ def _bbox_member(bbox) -> bytes:
 
 
 def write_cells(diagram, points, out, *, progress: ProgressCallback | None = None,
-                overwrite: bool = True) -> int:
+                overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
     """Write the Voronoi cells as an RFC 7946 GeoJSON FeatureCollection.
 
     One Polygon feature per distinct site, in input order, one feature per
@@ -189,6 +225,15 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
         Called with the number of features written so far and in all.
     overwrite : bool
         Replace an existing file at ``out``.
+    precision : int, optional
+        Round coordinates to this many decimal digits (smaller files; a cell
+        narrower than the rounding may then collapse or self-touch).
+    layout : {"collection", "seq", "lines"}
+        A FeatureCollection; or a GeoJSON text sequence (RFC 8142), each feature
+        after a record separator (0x1E) and ending a line, as GDAL writes
+        ``.geojsons``; or newline-delimited features, as GDAL writes
+        ``.geojsonl`` and jq reads without options. GDAL's GeoJSONSeq driver
+        reads both.
 
     Returns
     -------
@@ -210,15 +255,16 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     total = int(distinct.sum())
     done = 0
     with open_output(out, overwrite=overwrite) as stream, gc_paused():
-        bbox = _bbox_member(diagram.bbox) if has_ring.any() else b""
-        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+        bbox = _bbox_member(_rounded(np.asarray(diagram.bbox, np.float64), precision)) if has_ring.any() else b""
+        frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)
         for a in range(0, n_sites, CHUNK_FEATURES):
             b = min(a + CHUNK_FEATURES, n_sites)
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
-            text, starts, stops = _ring_texts(*_closed_rings(diagram, a, b, keep))
+            xy, first, last = _closed_rings(diagram, a, b, keep)
+            text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
             features = []
             for i, ring in zip(rows[a:b][distinct[a:b]].tolist(), keep[distinct[a:b]].tolist()):
@@ -229,23 +275,21 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
                     features.append(_NULL % properties(i))
             if not features:
                 continue
-            if done:
-                stream.write(_SEPARATOR)
-            stream.write(_SEPARATOR.join(features))
+            frame.write(features)
             done += len(features)
             if progress is not None:
                 progress(done, total)
-        stream.write(b"\n]}\n")
+        frame.close()
     return done
 
 
 def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
-                   overwrite: bool = True) -> int:
+                   overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
     """Write the Delaunay triangles as a GeoJSON FeatureCollection of Polygons.
 
     Each triangle is a closed counter-clockwise ring of its three sites, with
-    properties ``{"sites": [i, j, k]}`` (0-based input rows). Output, progress
-    and errors as in :func:`write_cells`.
+    properties ``{"sites": [i, j, k]}`` (0-based input rows). Output, progress,
+    precision, layout and errors as in :func:`write_cells`.
 
     Returns
     -------
@@ -260,8 +304,8 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
             used = np.zeros(diagram.n_sites, bool)
             used[triangles.ravel()] = True
             corners = diagram.sites[used]
-            bbox = _bbox_member([*corners.min(axis=0), *corners.max(axis=0)])
-        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+            bbox = _bbox_member(_rounded(np.array([*corners.min(axis=0), *corners.max(axis=0)]), precision))
+        frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)
         for a in range(0, total, CHUNK_FEATURES):
@@ -269,15 +313,13 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
             # ring i, j, k, i
             xy = np.take(diagram.sites, chunk[:, [0, 1, 2, 0]].ravel(), axis=0)
             first = np.arange(0, 4 * len(chunk), 4, dtype=np.int64)
-            text, starts, stops = _ring_texts(xy, first, first + 3)
+            text, starts, stops = _ring_texts(_rounded(xy, precision), first, first + 3)
             features = [
                 _TRIANGLE % (text[start:stop], i, j, k)
                 for start, stop, (i, j, k) in zip(starts, stops, chunk.tolist())
             ]
-            if a:
-                stream.write(_SEPARATOR)
-            stream.write(_SEPARATOR.join(features))
+            frame.write(features)
             if progress is not None:
                 progress(a + len(chunk), total)
-        stream.write(b"\n]}\n")
+        frame.close()
     return total

@@ -97,8 +97,8 @@ def _check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str =
 
 def describe_choice(names: list[str], ix: int, iy: int, how: str, skipped: list[str] = ()) -> str | None:
     """The line that tells which columns became x and y, e.g. 'x = "lon", y = "lat" (by name)';
-    None for columns named x and y, which leave nothing to tell."""
-    if how == "by name" and names[ix].lower() == "x" and names[iy].lower() == "y":
+    None for columns named x and y, or a file of two columns, which leave nothing to tell."""
+    if how == "the two columns" or (how == "by name" and names[ix].lower() == "x" and names[iy].lower() == "y"):
         return None
     text = f'x = "{names[ix]}", y = "{names[iy]}" ({how})'
     if skipped:
