@@ -25,7 +25,11 @@ EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 BATCH_EPILOG = """\
 output:
-  OUTPUT is an RFC 7946 FeatureCollection: one Polygon per distinct site, in
+  OUTPUT (by extension or --to) is an RFC 7946 FeatureCollection (.geojson),
+  an RFC 8142 GeoJSON sequence with a record separator before each feature
+  (.geojsons, as GDAL writes it), one feature per line (.geojsonl, .jsonl:
+  GDAL's GeoJSONSeq driver and jq read both), or GeoParquet 1.1 (.parquet,
+  needs pyarrow). Each holds one Polygon per distinct site, in
   input order, with properties {"site": ROW, ...the row's other columns} and
   "duplicates": [ROWS] where later rows repeat the site. A cell that misses
   a --bbox leaving its site outside has "geometry": null.
@@ -115,14 +119,16 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     batch = commands.add_parser(
         "batch",
-        help="write the Voronoi cells of a point file as GeoJSON",
-        description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON.",
+        help="write the Voronoi cells of a point file as GeoJSON or GeoParquet",
+        description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON, "
+                    "a GeoJSON sequence or GeoParquet.",
         epilog=BATCH_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    batch.add_argument("input", metavar="INPUT", help='point file (CSV, text, GeoJSON or .npy), or "-" for stdin')
+    batch.add_argument("input", metavar="INPUT",
+                       help='point file (CSV, TSV, text, GeoJSON, .npy, (Geo)Parquet), or "-" for stdin')
     batch.add_argument("-o", "--output", required=True, metavar="OUTPUT",
-                       help='GeoJSON file of the cells, or "-" for stdout')
+                       help='file of the cells (.geojson, .geojsons, .geojsonl, .parquet), or "-" for stdout')
     batch.add_argument("--engine", choices=ENGINES, default="incremental", help="default: %(default)s")
     batch.add_argument("--bbox", metavar="XMIN,YMIN,XMAX,YMAX",
                        help="the box bounding the cells; default: the points' bounding box grown by 10%% "

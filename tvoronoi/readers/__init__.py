@@ -11,6 +11,7 @@ from pathlib import Path
 from ..errors import InputFileError, TvoronoiError
 from .geojson import _read_geojson
 from .npy import NPY_MAGIC, _read_npy
+from .parquet import PARQUET_MAGIC, _read_parquet
 from .pointset import PointSet
 from .tabular import COMMENT, _read_table
 
@@ -21,7 +22,7 @@ from .tabular import _fast_table, _line_offset, _slow_table, _table_layout  # no
 
 __all__ = ["FORMATS", "PointSet", "read_points"]
 
-FORMATS = ("csv", "text", "geojson", "npy")
+FORMATS = ("csv", "text", "geojson", "npy", "parquet")
 EXTENSIONS = {
     ".csv": "csv",
     ".tsv": "csv",
@@ -33,6 +34,9 @@ EXTENSIONS = {
     ".geojson": "geojson",
     ".json": "geojson",
     ".npy": "npy",
+    ".parquet": "parquet",
+    ".geoparquet": "parquet",
+    ".pq": "parquet",
 }
 # the separator of a CSV file with this extension (others are found from the first rows)
 DELIMITER_OF = {".tsv": "\t", ".tab": "\t"}
@@ -76,7 +80,10 @@ def read_points(
     fmt: str | None = None,
     delimiter: str | None = None,
 ) -> PointSet:
-    """Read sites from a CSV, whitespace-text, GeoJSON or .npy file, or standard input.
+    """Read sites from a CSV, whitespace-text, GeoJSON, .npy or (Geo)Parquet file, or standard input.
+
+    A GeoParquet file gives the points of its primary geometry column and its CRS;
+    a plain Parquet file its x/y columns, chosen as a CSV file's are.
 
     Parameters
     ----------
@@ -87,7 +94,7 @@ def read_points(
         (int or digit string) or ``"colN"`` (1-based). By default the columns
         named x/lon/lng/long/longitude and y/lat/latitude, else the first two
         numeric columns.
-    fmt : {None, "csv", "text", "geojson", "npy"}
+    fmt : {None, "csv", "text", "geojson", "npy", "parquet"}
         The format; ``None`` detects it from the extension, else from the content.
     delimiter : str, optional
         The field separator of a CSV file (one character); by default a tab for
@@ -124,6 +131,8 @@ def read_points(
         delimiter = delimiter or DELIMITER_OF[suffix]
     if fmt == "npy":
         return _read_npy(data, source, x, y)
+    if fmt == "parquet":
+        return _read_parquet(data, source, x, y)
     if fmt == "geojson":
         return _read_geojson(data, source, x, y, _loads_json)
     return _read_table(_decode(data, source), source, fmt, x, y, delimiter)
@@ -174,6 +183,8 @@ def _sniff_format(data: bytes) -> str:
     """Guess the format from the first bytes: npy magic, a JSON object, a comma, else text."""
     if data.startswith(NPY_MAGIC):
         return "npy"
+    if data.startswith(PARQUET_MAGIC):
+        return "parquet"
     head = _decode_lenient(data[:SNIFF_BYTES]).lstrip()
     if head.startswith("{"):
         return "geojson"
