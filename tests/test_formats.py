@@ -142,3 +142,40 @@ def test_missing_pyarrow_names_the_extra(tmp_path, points_csv, capsys, monkeypat
     err = capsys.readouterr().err
     assert "tvoronoi[parquet]" in err and err.count("\n") == 1
     assert not (tmp_path / "c.parquet").exists()
+
+
+def test_unknown_crs_fails_before_the_build(tmp_path, points_csv, capsys):
+    pytest.importorskip("pyproj")
+    assert cli.main(["batch", str(points_csv), "-o", str(tmp_path / "c.parquet"), "--crs", "EPSG:999999"]) == 2
+    assert "EPSG:999999" in capsys.readouterr().err and not (tmp_path / "c.parquet").exists()
+
+
+def test_crs_code_without_pyproj_names_the_extra(tmp_path, points_csv, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyproj", None)
+    assert cli.main(["batch", str(points_csv), "-o", str(tmp_path / "c.parquet"), "--crs", "EPSG:3857"]) == 2
+    assert "tvoronoi[parquet]" in capsys.readouterr().err
+
+
+def test_geopandas_reads_cells_with_crs_types_and_covering(tmp_path):
+    gpd = pytest.importorskip("geopandas")
+    path = tmp_path / "p.csv"
+    path.write_text("name,Easting,Northing,zip\na,500000,100,01000\nb,500100,120,02000\nc,500050,190,\nd,500020,40,04000\n")
+    assert run(path, "-o", tmp_path / "c.parquet", "--crs", "EPSG:27700") == 0
+    frame = gpd.read_parquet(tmp_path / "c.parquet")
+    assert frame.crs.to_epsg() == 27700
+    assert frame.geometry.is_valid.all() and len(frame) == 4
+    assert frame["zip"].tolist()[:2] == ["01000", "02000"] and frame["zip"].isna().tolist()[2]
+    # the default box: 10% of the larger side (150) on every side
+    assert frame.total_bounds.tolist() == pytest.approx([500000 - 15, 40 - 15, 500100 + 15, 190 + 15])
+
+
+@pytest.mark.parametrize("suffix", [".geojsons", ".geojsonl", ".geojson"])
+def test_gdal_reads_every_geojson_layout(tmp_path, points_csv, suffix):
+    pyogrio = pytest.importorskip("pyogrio")
+    out = tmp_path / f"cells{suffix}"
+    assert run(points_csv, "-o", out) == 0
+    info = pyogrio.read_info(out)
+    assert info["driver"] == ("GeoJSON" if suffix == ".geojson" else "GeoJSONSeq")
+    assert info["features"] == 50
+    frame = pyogrio.read_dataframe(out)
+    assert frame["zip"].tolist()[:3] == ["00000", "00001", "00002"]

@@ -233,6 +233,7 @@ def _batch_run(args, phases: Phases) -> int:
     from tvoronoi import geojson
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
+    from tvoronoi.writers.geoparquet import crs_name, projjson
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)
     names = [name for name in (args.output, args.delaunay) if name is not None]
@@ -267,15 +268,16 @@ def _batch_run(args, phases: Phases) -> int:
         if points.choice is not None and not args.quiet:
             phases.note(f"{points.source}: {points.choice}")
         crs = args.crs or points.crs or (CRS84 if points.lonlat else None)
-        if crs is not None and crs.upper() in ("EPSG:4326", "OGC:CRS84"):
-            crs = CRS84
+        lonlat = crs is not None and crs_name(crs) in ("OGC:CRS84", "EPSG:4326")
+        if "parquet" in formats.values():
+            projjson(crs)  # a CRS pyproj does not know fails here, before the build
         geojson_out = [name for name, fmt in formats.items() if fmt != "parquet"]
-        if crs not in (None, CRS84) and geojson_out and not args.quiet:
+        if crs is not None and not lonlat and geojson_out and not args.quiet:
             phases.warn(
                 f"{', '.join(geojson_out)}: RFC 7946 GeoJSON has no CRS and is read as lon/lat, but the "
-                f"coordinates are {crs}; write GeoParquet (.parquet) to keep the CRS"
+                f"coordinates are {crs_name(crs)}; write GeoParquet (.parquet) to keep the CRS"
             )
-        if bbox is None and crs == CRS84:
+        if bbox is None and lonlat:
             # lon/lat: the default box stops at the antimeridian and the poles
             options["bbox"] = _lonlat_box(points.xy)
         if len(points) >= PROGRESS_MIN_POINTS:

@@ -31,18 +31,10 @@ def _read_parquet(data: bytes, source: str, x, y) -> PointSet:
     if geo is not None and x is None and y is None:
         meta = orjson.loads(geo)
         column = meta.get("primary_column", "geometry")
+        # no crs member means OGC:CRS84; null means unknown; else PROJJSON, carried as it is
         crs = meta.get("columns", {}).get(column, {}).get("crs", "OGC:CRS84")
-        return _geometry_table(table, column, source, _crs_name(crs))
+        return _geometry_table(table, column, source, crs)
     return _xy_table(table, source, x, y)
-
-
-def _crs_name(crs):
-    """"OGC:CRS84" or "EPSG:3857" for a PROJJSON with such an id; the PROJJSON itself otherwise."""
-    if isinstance(crs, dict) and isinstance(crs.get("id"), dict):
-        ident = crs["id"]
-        name = f"{ident.get('authority')}:{ident.get('code')}"
-        return "OGC:CRS84" if name in ("OGC:CRS84", "EPSG:4326") else name
-    return crs
 
 
 def _geometry_table(table, column: str, source: str, crs) -> PointSet:
@@ -71,7 +63,9 @@ def _geometry_table(table, column: str, source: str, crs) -> PointSet:
     _check_finite(xy, source)
     others = [name for name in table.column_names if name not in (column, "bbox")]
     columns = {name: table.column(name).to_pylist() for name in others}
-    lonlat = crs == "OGC:CRS84"
+    ident = crs.get("id") if isinstance(crs, dict) else None
+    name = f"{ident.get('authority')}:{ident.get('code')}".upper() if isinstance(ident, dict) else crs
+    lonlat = name in ("OGC:CRS84", "EPSG:4326")
     return PointSet(xy, source, columns, crs=crs, lonlat=lonlat, where=lambda i: f"row {i} (0-based)")
 
 

@@ -8,10 +8,11 @@ from tvoronoi.errors import TvoronoiError
 
 from .targets import open_output
 
-__all__ = ["write_cells_parquet", "write_delaunay_parquet", "require_pyarrow", "CRS84_PROJJSON"]
+__all__ = ["write_cells_parquet", "write_delaunay_parquet", "require_pyarrow", "projjson", "crs_name", "is_crs84",
+           "CRS84_PROJJSON"]
 
 GEOPARQUET_VERSION = "1.1.0"
-INSTALL_HINT = "pip install 'tvoronoi[parquet]' (or pip install pyarrow)"
+INSTALL_HINT = "pip install 'tvoronoi[parquet]' (or pip install pyarrow pyproj)"
 # OGC:CRS84, lon/lat on WGS 84, as the GeoParquet specification spells it
 CRS84_PROJJSON = {
     "$schema": "https://proj.org/schemas/v0.7/projjson.schema.json",
@@ -56,26 +57,49 @@ def require_pyarrow():
     return pyarrow
 
 
+def is_crs84(crs) -> bool:
+    """Whether a CRS (a name or PROJJSON) is WGS 84 longitude/latitude: OGC:CRS84 or EPSG:4326."""
+    return crs_name(crs) in ("OGC:CRS84", "EPSG:4326")
+
+
+def crs_name(crs) -> str | None:
+    """"EPSG:3857" for a name or a PROJJSON with that id; a PROJJSON's name without one; None if unknown."""
+    if crs is None:
+        return None
+    if isinstance(crs, dict):
+        ident = crs.get("id")
+        if isinstance(ident, dict):
+            return f"{ident.get('authority')}:{ident.get('code')}".upper()
+        return str(crs.get("name", "a CRS without an id"))
+    return crs.upper()
+
+
 def projjson(crs) -> dict | None:
     """The PROJJSON of a CRS ("OGC:CRS84", "EPSG:3857" or a PROJJSON dict); None when unknown.
 
-    An authority code needs pyproj to be spelled out; without it the CRS is recorded
-    only by its id, which GDAL and pyproj resolve.
+    An authority code other than OGC:CRS84 is spelled out by pyproj (part of the
+    ``parquet`` extra): a PROJJSON with only an id is not readable by PROJ.
+
+    Raises
+    ------
+    TvoronoiError
+        pyproj is missing, or does not know the code.
     """
     if crs is None or isinstance(crs, dict):
         return crs
-    if crs.upper() in ("OGC:CRS84", "EPSG:4326"):
-        return CRS84_PROJJSON if crs.upper() == "OGC:CRS84" else _by_id(crs)
-    return _by_id(crs)
-
-
-def _by_id(crs: str) -> dict:
+    if crs.upper() == "OGC:CRS84":
+        return CRS84_PROJJSON
     try:
         from pyproj import CRS
+        from pyproj.exceptions import CRSError
     except ImportError:
-        authority, _, code = crs.partition(":")
-        return {"id": {"authority": authority.upper(), "code": int(code) if code.isdigit() else code}}
-    return CRS.from_user_input(crs).to_json_dict()
+        raise TvoronoiError(
+            f"recording {crs} in GeoParquet needs pyproj, which is not installed: {INSTALL_HINT}"
+        ) from None
+    try:
+        return CRS.from_user_input(crs).to_json_dict()
+    except CRSError as e:
+        raise TvoronoiError(f"{crs}: not a CRS pyproj knows ({e}); give one like EPSG:3857") from None
 
 
 def _typed_column(pa, values: list):
@@ -146,8 +170,8 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     ``duplicates`` (list of later rows at the same place, null where none),
     ``geometry`` (WKB Polygon, null for a cell that misses the box) and ``bbox``
     (struct xmin, ymin, xmax, ymax: the covering columns of GeoParquet 1.1).
-    The ``geo`` metadata records the CRS: ``crs`` (a CRS name or PROJJSON),
-    or null when the coordinates have no known CRS.
+    The ``geo`` metadata records the CRS: ``crs`` (a CRS name or PROJJSON,
+    see :func:`projjson`), or null when the coordinates have no known CRS.
 
     Returns
     -------
