@@ -107,3 +107,7 @@ def test_a_reader_leaving_early_ends_the_run_quietly(tmp_path):
     err = proc.stderr.read()
     assert proc.wait(timeout=120) == 1
     assert err == b""
+
+
+def test_dev_null_may_take_both_outputs(points, capsys):
+    assert cli.main(["batch", str(points), "-o", "/dev/null", "--delaunay", "/dev/null", "-q"]) == 0

@@ -881,3 +881,25 @@ def test_unsupported_formats_are_named_with_a_conversion(tmp_path, name, content
     assert what in message and "does not read" in message
     assert "ogr2ogr" in message or "gunzip" in message or "unzip" in message
     assert "UTF-8" not in message
+
+
+def test_a_binary_file_is_named_as_such(tmp_path):
+    message = error(tmp_path, "points", b"\x7fELF\x02\x01\x01\x00" + bytes(64) + b"\xd0\x8f\xff" + bytes(64))
+    assert "a binary file" in message and "UTF-8" not in message
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.sampled_from([",", ";", "\t", "|"]),
+       st.lists(st.tuples(st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
+                          st.text("ab ,;|", max_size=5)), min_size=1, max_size=20))
+def test_any_separator_is_found_from_the_rows(tmp_path_factory, delimiter, rows):
+    out = io.StringIO()
+    writer = csv.writer(out, delimiter=delimiter, lineterminator="\n")
+    writer.writerow(["x", "y", "label"])
+    writer.writerows(rows)
+    path = write(tmp_path_factory.mktemp("sep"), "p.csv", out.getvalue())
+    points = read_points(path)
+    np.testing.assert_array_equal(points.xy, [[x, y] for x, y, _ in rows])
+    assert [points.properties(i)["label"] for i in range(len(rows))] == [
+        label if label.strip() else None for _, _, label in rows
+    ]

@@ -234,12 +234,14 @@ def _batch_run(args, phases: Phases) -> int:
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
     from tvoronoi.writers.geoparquet import crs_name, projjson
+    from tvoronoi.writers.targets import descriptor_of, is_direct
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)
     names = [name for name in (args.output, args.delaunay) if name is not None]
     if names.count(STDIO) > 1:
         raise TvoronoiError('-o and --delaunay cannot both be "-": stdout takes one of them')
-    if len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1]):
+    if (len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1])
+            and not (is_direct(names[0]) and descriptor_of(names[0]) is None)):  # /dev/null takes both
         raise TvoronoiError(f"-o and --delaunay name the same file {names[0]}; choose two names")
     if args.precision is not None and not 0 <= args.precision <= 17:
         raise TvoronoiError(f"--precision {args.precision}: give a number of decimal digits from 0 to 17")

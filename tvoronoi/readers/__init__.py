@@ -143,6 +143,11 @@ def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
     found = next(((name, how) for magic, name, how in UNSUPPORTED_MAGIC if data.startswith(magic)), None)
     if found is None:
         found = UNSUPPORTED_EXTENSIONS.get(suffix)
+    if found is None and _is_binary(data):
+        raise InputFileError(
+            f"{source}: a binary file, not a point file; tvoronoi reads CSV, text, GeoJSON, .npy and "
+            f"(Geo)Parquet: give one of those"
+        )
     if found is not None:
         name, how = found
         raise InputFileError(
@@ -177,6 +182,21 @@ def _read_bytes(path) -> tuple[str, str, bytes]:
     except OSError as e:
         raise InputFileError(f"{source}: cannot read the file: {e.strerror or e}") from None
     return source, p.suffix.lower(), data
+
+
+def _is_binary(data: bytes) -> bool:
+    """Whether the first bytes hold a NUL and are not UTF-8 (nor UTF-16, .npy, Parquet): a binary file.
+
+    A text file with a stray NUL is still text: the reader names the line that holds it.
+    """
+    head = data[:SNIFF_BYTES]
+    if b"\x00" not in head or head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE, NPY_MAGIC, PARQUET_MAGIC)):
+        return False
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as e:
+        return e.start < len(head) - 4  # not a character cut at the end of the head
+    return False
 
 
 def _sniff_format(data: bytes) -> str:
