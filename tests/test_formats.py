@@ -7,6 +7,8 @@ import json
 import sys
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 import pytest
 import shapely
 
@@ -179,3 +181,18 @@ def test_gdal_reads_every_geojson_layout(tmp_path, points_csv, suffix):
     assert info["features"] == 50
     frame = pyogrio.read_dataframe(out)
     assert frame["zip"].tolist()[:3] == ["00000", "00001", "00002"]
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.integers(3, 9), min_size=1, max_size=30), st.integers(0, 2**32 - 1))
+def test_bulk_wkb_is_shapely_wkb(ring_sizes, seed):
+    from tvoronoi.writers.geoparquet import _wkb_polygons
+
+    rng = np.random.default_rng(seed)
+    rings = [np.vstack([pts, pts[:1]]) for pts in (rng.normal(size=(k, 2)) * 1e3 for k in ring_sizes)]
+    offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
+    xy = np.vstack(rings)
+    ours = _wkb_polygons(pa, xy, offsets).to_pylist()
+    polygons = shapely.from_ragged_array(shapely.GeometryType.POLYGON, xy,
+                                         (offsets, np.arange(len(rings) + 1, dtype=np.int64)))
+    assert ours == list(shapely.to_wkb(polygons, byte_order=1))
