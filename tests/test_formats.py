@@ -196,3 +196,15 @@ def test_bulk_wkb_is_shapely_wkb(ring_sizes, seed):
     polygons = shapely.from_ragged_array(shapely.GeometryType.POLYGON, xy,
                                          (offsets, np.arange(len(rings) + 1, dtype=np.int64)))
     assert ours == list(shapely.to_wkb(polygons, byte_order=1))
+
+
+def test_parquet_input_binary_and_decimal_columns(tmp_path):
+    import decimal
+
+    table = pa.table({"x": [0.0, 1, 0], "y": [0.0, 0, 1], "raw": [b"\x00", b"\x01", b"\x02"],
+                      "price": pa.array([decimal.Decimal("1.25"), None, decimal.Decimal("3")], pa.decimal128(5, 2))})
+    pq.write_table(table, tmp_path / "p.parquet")
+    assert run(tmp_path / "p.parquet", "-o", tmp_path / "c.geojson") == 0
+    doc = json.loads((tmp_path / "c.geojson").read_text())
+    assert [f["properties"] for f in doc["features"]] == [
+        {"site": 0, "price": 1.25}, {"site": 1, "price": None}, {"site": 2, "price": 3.0}]

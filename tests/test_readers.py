@@ -903,3 +903,18 @@ def test_any_separator_is_found_from_the_rows(tmp_path_factory, delimiter, rows)
     assert [points.properties(i)["label"] for i in range(len(rows))] == [
         label if label.strip() else None for _, _, label in rows
     ]
+
+
+@pytest.mark.parametrize("content, rows_lines", [
+    ("x,y\n1,2\n3,4\n5,6\n", [(0, 2), (2, 4)]),  # fast path, one line per row
+    ("\nx,y\n\n1,2\n\n3,4\n5,6", [(0, 4), (1, 6), (2, 7)]),  # blank lines
+    ('x,y,n\n1,2,"a\nb"\n3,4,c\n', [(0, 2), (1, 4)]),  # a field over two lines
+    ("x,y\n1,2\n3,abc\n", None),  # the slow path names the line itself
+])
+def test_each_site_knows_its_line(tmp_path, content, rows_lines):
+    if rows_lines is None:
+        assert "line 3" in error(tmp_path, "p.csv", content)
+        return
+    points = read(tmp_path, "p.csv", content)
+    for row, line in rows_lines:
+        assert points.place(row) == f"line {line}"

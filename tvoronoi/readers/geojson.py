@@ -138,15 +138,18 @@ def _point_features(features: list):
 
 
 def _checked_sites(doc, source: str):
-    """(xs, ys, properties) of any GeoJSON document, each feature checked."""
+    """(xs, ys, properties, where) of any GeoJSON document, each feature checked; ``where`` names
+    the feature (and MultiPoint part) of each site."""
     xs: list = []
     ys: list = []
     records: list[dict] = []
-    for _, part, position, properties in _geojson_sites(doc, source):
+    wheres: list[str] = []
+    for where, part, position, properties in _geojson_sites(doc, source):
         xs.append(position[0])
         ys.append(position[1])
         records.append(properties if part is None else {**properties, "part": part})
-    return xs, ys, records
+        wheres.append(where if part is None else f"{where}, point {part}")
+    return xs, ys, records, wheres.__getitem__
 
 
 def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
@@ -166,7 +169,9 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
             sites = _point_features(doc["features"])
         if sites is None:
             sites = _checked_sites(doc, source)
-    xs, ys, records = sites
+        else:  # Point features only: site i is feature i
+            sites = (*sites, "features[{}]".format)
+    xs, ys, records, where = sites
     if not xs:
         raise InputFileError(f"{source}: no points found (no Point or MultiPoint features)")
     xy = np.empty((len(xs), 2), dtype=np.float64)
@@ -188,17 +193,9 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
             f"{source}, {where}: {role} is {position[0 if role == 'x' else 1]}; tvoronoi needs finite coordinates"
         )
     crs = _crs_member(doc, source)
-    points = PointSet(xy, source, {}, records if any(records) else None, crs=crs, lonlat=crs is None or crs == CRS84)
-    points.where = lambda i: _where(doc, source, i)
-    return points
-
-
-def _where(doc, source: str, i: int) -> str:
-    """The feature (and point of a MultiPoint) that holds site ``i``."""
-    for k, (where, part, _, _) in enumerate(_geojson_sites(doc, source)):
-        if k == i:
-            return where if part is None else f"{where}, point {part}"
-    return f"site {i}"
+    # the document is not kept: ``where`` holds one label per site at most
+    return PointSet(xy, source, {}, records if any(records) else None, crs=crs,
+                    lonlat=crs is None or crs == CRS84, where=where)
 
 
 def _crs_member(doc, source: str) -> str | None:

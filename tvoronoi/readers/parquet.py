@@ -61,8 +61,8 @@ def _geometry_table(table, column: str, source: str, crs) -> PointSet:
     if len(xy) == 0:
         raise InputFileError(f"{source}: no points found (the table has 0 rows)")
     _check_finite(xy, source)
-    others = [name for name in table.column_names if name not in (column, "bbox")]
-    columns = {name: table.column(name).to_pylist() for name in others}
+    others = [j for j, name in enumerate(table.column_names) if name not in (column, "bbox")]
+    columns = _properties(table, others)
     ident = crs.get("id") if isinstance(crs, dict) else None
     name = f"{ident.get('authority')}:{ident.get('code')}".upper() if isinstance(ident, dict) else crs
     lonlat = name in ("OGC:CRS84", "EPSG:4326")
@@ -107,7 +107,7 @@ def _xy_table(table, source: str, x, y) -> PointSet:
             raise InputFileError(f'{source}, row {i} (0-based): column "{names[j]}" is null; tvoronoi needs finite coordinates')
         xy[:, k] = values.to_numpy()
     _check_finite(xy, source)
-    columns = {names[j]: table.column(j).to_pylist() for j in range(len(names)) if j not in (ix, iy)}
+    columns = _properties(table, [j for j in range(len(names)) if j not in (ix, iy)])
     lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
     return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, where=lambda i: f"row {i} (0-based)")
@@ -118,3 +118,21 @@ def _check_finite(xy: np.ndarray, source: str) -> None:
     if not finite.all():
         i, k = (int(v) for v in np.argwhere(~finite)[0])
         raise InputFileError(f"{source}, row {i} (0-based): {'xy'[k]} is {xy[i, k]}; tvoronoi needs finite coordinates")
+
+
+def _properties(table, indices: list[int]) -> dict[str, list]:
+    """The columns that travel as properties, as Python values: decimals become floats, and
+    binary columns (another geometry, raw bytes) are left out, having no JSON form."""
+    import pyarrow as pa
+    import pyarrow.types as pt
+
+    out = {}
+    for j in indices:
+        field = table.schema.field(j)
+        values = table.column(j)
+        if pt.is_binary(field.type) or pt.is_large_binary(field.type) or pt.is_fixed_size_binary(field.type):
+            continue
+        if pt.is_decimal(field.type):
+            values = values.cast(pa.float64())
+        out[field.name] = values.to_pylist()
+    return out

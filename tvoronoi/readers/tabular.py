@@ -30,6 +30,8 @@ from tvoronoi.bulk import gc_paused
 from .pointset import PointSet, _convert_column
 
 LAYOUT_CHARS = 1 << 16
+# a table text up to this size is kept to name the line of a site in a later message
+KEEP_TEXT_CHARS = 8 << 20
 QUOTE = '"'
 COMMENT = "#"
 # field separators a CSV file may use, in order of preference when several fit
@@ -78,22 +80,43 @@ def _read_table(text: str, source: str, kind: str, x, y, delimiter: str | None =
         points = _slow_table(text, source, kind, layout)
     else:
         points = PointSet(fast[0], source, fast[1])
+        points.where = _fast_lines(text, body, source, kind, layout, len(points))
+    if points.where is not None:
+        points.where = _line_label(points.where)
     names = [name.strip().lower() for name in (layout.names[layout.ix], layout.names[layout.iy])]
     points.lonlat = layout.has_header and names[0] in LON_NAMES and names[1] in LAT_NAMES
     points.choice = layout.choice
-    points.where = lambda i: _where(text, source, kind, layout, i)
     return points
 
 
-def _where(text: str, source: str, kind: str, layout: _Layout, i: int) -> str:
-    """The line of data row ``i``, found by walking the rows again (for a message only)."""
-    records = _records(text, kind, source, layout.delimiter)
-    if layout.has_header:
-        next(records, None)
-    for k, (line_no, _) in enumerate(records):
-        if k == i:
-            return f"line {line_no}"
-    return f"row {i} (0-based)"
+def _fast_lines(text: str, body: str, source: str, kind: str, layout: _Layout, n_rows: int):
+    """The line of each row, as a function of the row, for messages about a site.
+
+    When every row is one line (no blank line, comment or field over lines) it is
+    arithmetic; else a walk of the rows, kept only for a text of up to KEEP_TEXT_CHARS
+    (a large text is not held for a message: None, and rows are named by index).
+    """
+    breaks = body.count("\n")
+    if "\r" not in body.replace("\r\n", "") and breaks - (0 if body.endswith("\n") else -1) == n_rows:
+        first = layout.first_line
+        return lambda i: first + i
+    if len(text) > KEEP_TEXT_CHARS:
+        return None
+
+    def line_of(i: int) -> int:
+        records = _records(text, kind, source, layout.delimiter)
+        if layout.has_header:
+            next(records, None)
+        for k, (line_no, _) in enumerate(records):
+            if k == i:
+                return line_no
+        raise IndexError(i)
+
+    return line_of
+
+
+def _line_label(line_of):
+    return lambda i: f"line {int(line_of(i))}"
 
 
 def sniff_delimiter(head: str) -> str:
@@ -323,7 +346,9 @@ def _fast_table(body: str, kind: str, layout: _Layout):
 
 
 def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
-    """Read a table row by row, keeping line numbers, and raise on the first row that is not a site."""
+    """Read a table row by row, keeping line numbers, and raise on the first row that is not a site.
+
+    The sites' ``where`` gives the line number of each row (not yet a label)."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     n_cols = len(names)
     records = _records(text, kind, source, layout.delimiter)
@@ -356,7 +381,9 @@ def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
             text = columns[j][r]
             _coordinate(_decimal_points([text], layout.delimiter)[0], role, names[j], line_nos[r], source,
                         layout.has_header, text)
-    return PointSet(xy, source, _extras(columns, layout, text))
+    points = PointSet(xy, source, _extras(columns, layout, text))
+    points.where = np.asarray(line_nos, np.int64).__getitem__
+    return points
 
 
 def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
