@@ -154,8 +154,15 @@ def _convert_column(values, plain: bool) -> list:
             for i in np.flatnonzero(~np.isfinite(floats)):
                 out[i] = None
             return out
-    # empty values, text or both: convert each distinct value once, then settle the column's type
-    memo = {v: _convert_value(v) for v in set(values)}
+    distinct = set(values)
+    if _is_text(distinct):
+        # a text column: as written, empty values null
+        blank = [v for v in distinct if not v.strip()]
+        if not blank:
+            return list(values)
+        return [None if not v.strip() else v for v in values]
+    # numbers and empty values: convert each distinct value once, then settle the column's type
+    memo = {v: _convert_value(v) for v in distinct}
     kinds = {type(value) for value in memo.values()} - {type(None)}
     if kinds <= {int}:
         pass
@@ -164,6 +171,16 @@ def _convert_column(values, plain: bool) -> list:
     else:
         memo = {v: None if not v.strip() else v for v in memo}
     return list(map(memo.__getitem__, values))
+
+
+def _is_text(distinct) -> bool:
+    """Whether a column holds a value that is not a number, or a number with a leading zero
+    (stops at the first: a text column is told from its first values)."""
+    for v in distinct:
+        t = v.strip()
+        if t and (_LEADING_ZERO.match(t) or not _FLOAT_LITERAL.fullmatch(t)):
+            return True
+    return False
 
 
 def _json_column(values: np.ndarray) -> list:
