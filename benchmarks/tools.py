@@ -85,16 +85,12 @@ def _tv_full(engine: str, insertion: str = "brio"):
     """tvoronoi's engine and DCEL (Voronoi vertices, half-edges), before cells are clipped."""
 
     def build(pts, box):
-        from tvoronoi import build
+        from tvoronoi import engines
         from tvoronoi.api import as_points
 
         pts = as_points(pts)
-        e = build.power_of_two_scale(pts)
-        xs, ys = np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e)
-        if engine == "incremental":
-            _, _, _, out = build.incremental_dcel(xs, ys, insertion=insertion, seed=0)
-        else:
-            _, _, _, out = build.fortune_dcel(xs, ys)
+        t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion)
+        e, out = t.sites.exponent, t.voronoi()
         return e, out
 
     return build

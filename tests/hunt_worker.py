@@ -46,9 +46,9 @@ def _use_kernels(directory: str) -> None:
     if not os.path.isdir(kdir):
         raise SystemExit(f"no kernels in {kdir}")
     tvoronoi.kernels.__path__.insert(0, kdir)
-    from tvoronoi.kernels import clip, dcel, delaunay, fortune  # noqa: F401
+    from tvoronoi.kernels import clip, dual, fortune, incremental  # noqa: F401
 
-    for mod in (clip, dcel, delaunay, fortune):
+    for mod in (clip, dual, fortune, incremental):
         assert mod.__file__.startswith(kdir), f"{mod.__name__} loaded from {mod.__file__}, not {kdir}"
 
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tvoronoi.kernels import clip, dcel
+from tvoronoi.kernels import clip, dual
 
 
 def exact_circumcentre(a, b, c):
@@ -30,7 +30,7 @@ def kernel_circumcentres(tris, e=0):
     xs = np.ascontiguousarray(tris[:, :, 0].ravel())
     ys = np.ascontiguousarray(tris[:, :, 1].ravel())
     idx = np.arange(3 * len(tris), dtype=np.int32).reshape(-1, 3)
-    return dcel.circumcentres(xs, ys, idx, e)
+    return dual.circumcentres(xs, ys, idx, e)
 
 
 def collinear(a, b, c):

@@ -9,8 +9,8 @@ import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
 from invariants import validate
 from oracle import assert_matches_oracle
-from tvoronoi.build import sweep_order
-from tvoronoi.kernels import delaunay, fortune
+from tvoronoi.engines import sweep_order
+from tvoronoi.kernels import fortune, incremental
 
 
 def assert_same_diagram(a, b):
@@ -70,7 +70,7 @@ def test_legalize_restores_delaunay(rng):
     """Spoil a Delaunay triangulation with flips; the exact repair brings it back."""
     pts = DATASETS["uniform"]
     xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
-    _, tv, opp, _ = delaunay.triangulate(xs, ys)
+    _, tv, opp, _ = incremental.triangulate(xs, ys)
     want = {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()}
     n, spoiled = len(pts), 0
     for e in rng.permutation(len(tv)):

@@ -13,8 +13,8 @@ from hypothesis import given, settings, strategies as st
 
 import tvoronoi
 from test_fortune import assert_same_diagram  # noqa: F401 (used on the fixtures)
-from tvoronoi.build import sweep_order
-from tvoronoi.kernels import delaunay, fortune
+from tvoronoi.engines import sweep_order
+from tvoronoi.kernels import fortune, incremental
 
 FIXTURES = Path(__file__).parent / "fixtures"
 SEED = 20261123
@@ -146,8 +146,8 @@ def check_against_incremental(pts):
     if cocircular:
         assert_same_cells(tvoronoi.voronoi(pts, engine="fortune"), tvoronoi.voronoi(pts, engine="incremental"))
         return
-    status, tv, _, _ = delaunay.triangulate(xs, ys)
-    assert status == delaunay.STATUS_OK
+    status, tv, _, _ = incremental.triangulate(xs, ys)
+    assert status == incremental.STATUS_OK
     n = len(xs)
 
     def triangles(t):
@@ -460,7 +460,7 @@ def test_property_on_a_few_circles(polar, centre):
 
 _FINISH = textwrap.dedent("""
     import sys, numpy as np, tvoronoi
-    from tvoronoi.build import sweep_order
+    from tvoronoi.engines import sweep_order
     from tvoronoi.kernels import fortune
     kind = sys.argv[1]
     rng = np.random.default_rng(7)

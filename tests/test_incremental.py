@@ -10,7 +10,7 @@ from hypothesis import given, settings, strategies as st
 import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
 import exact_checks
-from tvoronoi.build import BOX_SCALED_MAX
+from tvoronoi.engines import BOX_SCALED_MAX
 from invariants import validate
 from oracle import assert_matches_oracle
 

@@ -1,4 +1,4 @@
-"""``python -m tvoronoi``: the console script."""
+"""`python -m tvoronoi`: the same as the `tvoronoi` command."""
 
 import sys
 

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from tvoronoi.diagram import Diagram
+from tvoronoi.engines import scale_exponent
 from tvoronoi.errors import CoordinateRangeError, EngineError, TvoronoiError
 
 ENGINES = ("incremental", "fortune")
@@ -19,12 +20,6 @@ BBOX_MARGIN = 0.10
 # coordinate differences; so that no product under- or overflows, a nonzero coordinate must lie within
 # 2^170 (about 1.5e51) of 2^e either way.
 RANGE_BITS = 170
-
-
-def scale_exponent(*values) -> int:
-    """The exponent e of the scale 2^e of these coordinates: the largest magnitude is below 2^e."""
-    top = max((float(np.abs(np.asarray(v, np.float64)).max()) for v in values if np.size(v)), default=0.0)
-    return math.frexp(top)[1] if top > 0 else 0
 
 
 def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:

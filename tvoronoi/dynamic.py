@@ -6,11 +6,12 @@ import math
 
 import numpy as np
 
-from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox, scale_exponent
-from tvoronoi.build import assemble, check_box_scale, collinear_dcel, sweep_checked, sweep_order
+from tvoronoi import engines
+from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox
+from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError, TvoronoiError
-from tvoronoi.kernels import dcel, delaunay, dynamic, order
+from tvoronoi.kernels import dual, dynamic
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
     """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
@@ -62,9 +63,9 @@ class DynamicVoronoi:
         self.bbox = default_bbox(pts) if bbox is None else as_bbox(bbox)
         # the one range rule (tvoronoi.api): the mesh holds sites scaled by 2^-e, e fixed by the box and
         # the first sites, so later sites anywhere within 2^170 of that scale stay exact
-        self._e = scale_exponent(pts, self.bbox)
+        self._e = engines.scale_exponent(pts, self.bbox)
         check_range(pts, self._e)
-        check_box_scale(self.bbox, self._e)
+        engines.check_box_scale(self.bbox, self._e)
         n = len(pts)
         self._xy = np.full((max(2 * n, 16), 2), np.nan)
         self._xy[:n] = pts
@@ -115,24 +116,10 @@ class DynamicVoronoi:
         self._copies.clear()
         if len(ids) == 0:
             return
-        xs = np.ascontiguousarray(np.ldexp(self._xy[ids, 0], -self._e))
-        ys = np.ascontiguousarray(np.ldexp(self._xy[ids, 1], -self._e))
-        if self.engine == "fortune":
-            perm = sweep_order(xs, ys)
-            sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
-            res = sweep_checked(sx, sy)
-            ok, tv, opp, dup = "tv" in res, res.get("tv"), res.get("opp"), res["dup"]
-        else:
-            # a biased randomized insertion order, as in the batch engine
-            perm = order.brio_order(xs, ys, 0)
-            sx, sy = np.ascontiguousarray(xs[perm]), np.ascontiguousarray(ys[perm])
-            status, tv, opp, dup = delaunay.triangulate(sx, sy)
-            ok = status == delaunay.STATUS_OK
-        order_ids = ids[perm]
-        if not ok:
-            from tvoronoi.build import first_copies
-
-            dup = first_copies(sx, sy)
+        # the batch engine's order (a biased randomized insertion order, or the sweep's)
+        t = engines.run(self._xy[ids, 0], self._xy[ids, 1], engine=self.engine, exponent=self._e)
+        sx, sy, dup, ok = t.sites.xs, t.sites.ys, t.dup, not t.flat
+        order_ids = ids[t.sites.perm]
         # repeats: the smallest id at a place holds it
         groups: dict[int, list[int]] = {}
         for k in np.flatnonzero(dup >= 0).tolist():
@@ -147,7 +134,7 @@ class DynamicVoronoi:
         if not ok:
             return
         mesh = dynamic.DynamicMesh(max(len(self._xy), 16))
-        mesh.load(sx, sy, order_ids.astype(np.int32), tv, opp, len(sx))
+        mesh.load(sx, sy, order_ids.astype(np.int32), t.tv, t.opp, len(sx))
         for k, holder in holder_of_vertex.items():
             if holder != int(order_ids[k]):
                 mesh.relabel(int(order_ids[k]), holder)
@@ -310,15 +297,10 @@ class DynamicDiagram:
         if o._mesh is not None:
             tv, opp = o._mesh.export()
             tv = np.where(tv == dynamic.INFINITE, n, tv).astype(np.int32)
-            out = dcel.voronoi_from_delaunay(xs, ys, tv, opp, o._e)
+            out = dual.voronoi_from_delaunay(xs, ys, tv, opp, o._e)
         else:
             holders = o._holders()
-            sub = collinear_dcel(xs[holders], ys[holders])
-            out = dict(sub)
-            out["he_face"] = holders[sub["he_face"]].astype(np.int32)
-            face_edge = np.full(n, -1, np.int32)
-            face_edge[holders] = sub["face_edge"]
-            out["face_edge"] = face_edge
+            out = engines.lift_dcel(engines.collinear_dcel(xs[holders], ys[holders]), holders, n)
         out["dup"] = dup
         return assemble(pts, self.bbox, o._e, np.arange(n, dtype=np.int32), xs, ys, out,
                         engine=o.engine, present=present, first_row_holds=False)

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from tvoronoi.api import as_points, default_bbox, as_bbox
-from tvoronoi.build import assemble, collinear_dcel, power_of_two_scale, sweep_order
+from tvoronoi import engines
+from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
-from tvoronoi.kernels import dcel, delaunay, fortune, order
+from tvoronoi.kernels import dual, fortune, incremental
 
 KIND_NAMES = {0: "site", 1: "circle", 2: "repeat"}
 
@@ -61,7 +62,7 @@ def circumcentres(p, q, r):
     xs = np.ascontiguousarray(np.concatenate((p[:, 0], q[:, 0], r[:, 0])))
     ys = np.ascontiguousarray(np.concatenate((p[:, 1], q[:, 1], r[:, 1])))
     tri = np.ascontiguousarray(np.arange(3 * k, dtype=np.int32).reshape(3, k).T)
-    return dcel.circumcentres(xs, ys, tri, 0)
+    return dual.circumcentres(xs, ys, tri, 0)
 
 
 @dataclass(frozen=True)
@@ -114,12 +115,10 @@ class FortuneTrace:
 
     def __init__(self, points):
         self.points = as_points(points)
-        self._perm = sweep_order(self.points[:, 0], self.points[:, 1])
         # the kernel sweeps sites scaled by 2^-e, as in a batch build (the one range rule); what a
         # step shows is in the user's unit
-        self._e = power_of_two_scale(self.points)
-        self._xs = np.ascontiguousarray(np.ldexp(self.points[self._perm, 0], -self._e))
-        self._ys = np.ascontiguousarray(np.ldexp(self.points[self._perm, 1], -self._e))
+        sites = engines.prepare(self.points[:, 0], self.points[:, 1], engine="fortune")
+        self._perm, self._e, self._xs, self._ys = sites.perm, sites.exponent, sites.xs, sites.ys
         self.n_steps = int(fortune.sweep(self._xs, self._ys)["steps"])
 
     def __len__(self) -> int:
@@ -133,7 +132,7 @@ class FortuneTrace:
         pts = self.points[perm]
         xs, ys = pts[:, 0], pts[:, 1]
         tri = np.ascontiguousarray(st["triangles"], dtype=np.int32).reshape(-1, 3)
-        centres = dcel.circumcentres(self._xs, self._ys, tri, e)
+        centres = dual.circumcentres(self._xs, self._ys, tri, e)
         beach = st["beach"]
         sweep_y = math.ldexp(float(st["sweep_y"]), e)
         bps = np.array([breakpoint_xy(pts[beach[i]], pts[beach[i + 1]], sweep_y)
@@ -211,13 +210,10 @@ class IncrementalTrace:
         self.points = as_points(points)
         self.bbox = default_bbox(self.points) if bbox is None else as_bbox(bbox)
         n = len(self.points)
-        self._e = power_of_two_scale(self.points)
-        xs = np.ldexp(self.points[:, 0], -self._e)
-        ys = np.ldexp(self.points[:, 1], -self._e)
-        # the batch engine's insertion order (build.incremental_dcel)
-        self._perm = order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed)
-        self._xs = np.ascontiguousarray(xs[self._perm])
-        self._ys = np.ascontiguousarray(ys[self._perm])
+        # the batch engine's insertion order and scale
+        sites = engines.prepare(self.points[:, 0], self.points[:, 1], engine="incremental", seed=seed)
+        self._perm, self._e, self._xs, self._ys = sites.perm, sites.exponent, sites.xs, sites.ys
+        engines.check_box_scale(self.bbox, self._e)
         self.n_steps = n
 
     def __len__(self) -> int:
@@ -227,24 +223,24 @@ class IncrementalTrace:
         """The state after k insertions, 0 <= k <= len(self)."""
         n = self.n_steps
         k = max(0, min(int(k), n))
-        res = delaunay.triangulate(self._xs, self._ys, stop_after=k) if n >= 3 else (delaunay.STATUS_COLLINEAR,)
-        if res[0] == delaunay.STATUS_OK and k >= 3:
+        res = incremental.triangulate(self._xs, self._ys, stop_after=k) if n >= 3 else (incremental.STATUS_COLLINEAR,)
+        if res[0] == incremental.STATUS_OK and k >= 3:
             _, tv, opp, dup, trace = res
             order = trace["order"]
             present = np.zeros(n, bool)
             present[order[:k]] = True
-            out = dcel.voronoi_from_delaunay(self._xs, self._ys, tv, opp, self._e)
+            out = dual.voronoi_from_delaunay(self._xs, self._ys, tv, opp, self._e)
             out["dup"] = dup
             cavity = trace["cavity"] if k > 3 else np.empty((0, 3), np.int32)
             fan = tv.reshape(-1, 3)[trace["fan"]] if k > 3 else tv.reshape(-1, 3)[:1]
             new_site = order[k - 1]
         else:
             # the first sites (or a collinear start): strips between them
-            order = np.arange(n) if res[0] != delaunay.STATUS_OK else res[-1]["order"]
+            order = np.arange(n) if res[0] != incremental.STATUS_OK else res[-1]["order"]
             present = np.zeros(n, bool)
             present[order[:k]] = True
             idx = np.flatnonzero(present)
-            out = _lift(collinear_dcel(self._xs[idx], self._ys[idx]), idx, n)
+            out = engines.lift_dcel(engines.collinear_dcel(self._xs[idx], self._ys[idx]), idx, n)
             cavity = fan = np.empty((0, 3), np.int32)
             new_site = order[k - 1] if k else -1
         d = assemble(self.points, self.bbox, self._e, self._perm, self._xs, self._ys, out,
@@ -265,18 +261,3 @@ def _finite(tri: np.ndarray, inf: int) -> np.ndarray:
     """The rows of a (k, 3) triangle array that do not use the vertex at infinity."""
     tri = tri.reshape(-1, 3)
     return tri[np.all(tri != inf, axis=1)]
-
-
-def _lift(sub: dict, idx: np.ndarray, n: int) -> dict:
-    """A DCEL over a subset of the sites, renumbered to the full numbering."""
-    out = dict(sub)
-    out["he_face"] = idx[sub["he_face"]].astype(np.int32)
-    face_edge = np.full(n, -1, np.int32)
-    face_edge[idx] = sub["face_edge"]
-    out["face_edge"] = face_edge
-    dup = np.full(n, -1, np.int32)
-    sd = sub["dup"]
-    dup[idx[sd >= 0]] = idx[sd[sd >= 0]]
-    out["dup"] = dup
-    out["triangles"] = np.empty((0, 3), np.int32)
-    return out

@@ -5,6 +5,7 @@ import numpy as np
 from libc.math cimport hypot
 from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
+from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
     finish_ring, first_right_turn, turn,
@@ -163,6 +164,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
 
         # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries
         for i in range(n):
+            if (i & POLL_MASK) == 0:
+                poll_signals()
             offsets[i] = n_ring
             if not active[i]:
                 continue

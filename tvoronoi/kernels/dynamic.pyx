@@ -6,9 +6,10 @@ from libc.stdint cimport int8_t, int32_t, int64_t, uint64_t
 from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
-from tvoronoi.kernels.mesh cimport (
-    Mesh, nxt, prv, is_infinite, strictly_between, locate, insert_site, find_cavity, fill_cavity,
-)
+from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between
+from tvoronoi.kernels.location cimport locate
+from tvoronoi.kernels.cavity cimport find_cavity
+from tvoronoi.kernels.fill cimport insert_site, fill_cavity
 from libc.stdlib cimport malloc, free
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge,

@@ -12,6 +12,8 @@ from libc.stdint cimport int8_t, int32_t, int64_t
 from libc.math cimport sqrt, INFINITY
 from libc.stdlib cimport malloc, free
 
+from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
+
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.circle_events cimport circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_sign, quad
@@ -33,7 +35,7 @@ from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, 
 # engine also builds: each circle event is a Voronoi vertex, stored as the
 # Delaunay triangle of its three sites, and the records link the triangles
 # into a half-edge structure (tv, opp, with vertex n at infinity closing the
-# hull). dcel.voronoi_from_delaunay turns it into the Voronoi DCEL.
+# hull). dual.voronoi_from_delaunay turns it into the Voronoi DCEL.
 #
 # Every decision is exact: which arc a site falls on (parabola_order and
 # coordinate comparisons), whether three arcs converge (orient2d), and the
@@ -528,6 +530,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
                 if not step(&s, &next_site):
                     break
                 steps += 1
+                if (steps & POLL_MASK) == 0:
+                    poll_signals()
     finally:
         free(s.ev_fine)
         s.ev_fine = NULL

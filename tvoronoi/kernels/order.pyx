@@ -4,6 +4,8 @@ import numpy as np
 
 from libc.stdint cimport int32_t, uint64_t
 from libc.stdlib cimport malloc, free
+
+from tvoronoi.kernels.interrupt cimport poll_signals
 from libc.string cimport memcpy
 
 cdef enum:
@@ -241,39 +243,42 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
     cdef Py_ssize_t count[MAX_ROUNDS + 1]
     cdef int r, last
     cdef double e[2]
-    with nogil:
-        # the rounds: n/2 sites expected in the last, n/4 in the one before, ..., the rest in the first
-        while (n >> (n_rounds + 1)) >= FIRST_ROUND and n_rounds + 1 < MAX_ROUNDS:
-            n_rounds += 1
-        last = <int>n_rounds
-        for r in range(last + 2):
-            count[r] = 0
-        for k in range(n):
-            word = next_random(&state)
-            r = 0
-            while r < last and (word >> r) & 1 == 0:
-                r += 1
-            # r trailing zeros: round last - r, so that round last - r has probability 2^-(r + 1)
-            round_of[k] = last - r
-            count[last - r + 1] += 1
-        for r in range(last + 1):
-            count[r + 1] += count[r]
-        # the sites, round by round (count[r] is where round r starts)
-        for k in range(n):
-            r = round_of[k]
-            a[count[r]].c[0] = xs[k]
-            a[count[r]].c[1] = ys[k]
-            a[count[r]].i = <int32_t>k
-            count[r] += 1
-        # each round along the curve, its first axis the longer side of the whole set
-        extents(a, 0, n, &state, e)
-        start = 0
-        for r in range(last + 1):
-            end = count[r]
-            hilbert_sort(a, b, a, start, end, 0 if e[0] >= e[1] else 1, 1.0, 1.0, &state)
-            start = end
-        for k in range(n):
-            perm[k] = a[k].i
-    free(a)
-    free(b)
+    try:
+        with nogil:
+            # the rounds: n/2 sites expected in the last, n/4 in the one before, ..., the rest in the first
+            while (n >> (n_rounds + 1)) >= FIRST_ROUND and n_rounds + 1 < MAX_ROUNDS:
+                n_rounds += 1
+            last = <int>n_rounds
+            for r in range(last + 2):
+                count[r] = 0
+            for k in range(n):
+                word = next_random(&state)
+                r = 0
+                while r < last and (word >> r) & 1 == 0:
+                    r += 1
+                # r trailing zeros: round last - r, so that round last - r has probability 2^-(r + 1)
+                round_of[k] = last - r
+                count[last - r + 1] += 1
+            for r in range(last + 1):
+                count[r + 1] += count[r]
+            # the sites, round by round (count[r] is where round r starts)
+            for k in range(n):
+                r = round_of[k]
+                a[count[r]].c[0] = xs[k]
+                a[count[r]].c[1] = ys[k]
+                a[count[r]].i = <int32_t>k
+                count[r] += 1
+            # each round along the curve, its first axis the longer side of the whole set
+            extents(a, 0, n, &state, e)
+            start = 0
+            for r in range(last + 1):
+                end = count[r]
+                poll_signals()
+                hilbert_sort(a, b, a, start, end, 0 if e[0] >= e[1] else 1, 1.0, 1.0, &state)
+                start = end
+            for k in range(n):
+                perm[k] = a[k].i
+    finally:
+        free(a)
+        free(b)
     return np.asarray(perm)

@@ -5,6 +5,7 @@ import numpy as np
 from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.construct cimport circumcentre
+from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 
@@ -39,7 +40,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     Parameters
     ----------
     xs, ys : (n,) float64, the sites.
-    tv, opp : (3 * n_tri,) int32, the triangulation of delaunay.triangulate
+    tv, opp : (3 * n_tri,) int32, the triangulation of incremental.triangulate or fortune.sweep
         (vertex n is the vertex at infinity).
     exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
         returned in the user's unit, each coordinate correctly rounded.
@@ -76,6 +77,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 finite[n_finite] = t
                 n_finite += 1
         for f in range(n_finite):
+            if (f & POLL_MASK) == 0:
+                poll_signals()
             t = finite[f]
             for e in range(3 * t, 3 * t + 3):
                 o = opp[e]
@@ -107,6 +110,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     vertices = np.empty((m, 2), np.float64)
     with nogil:
         for f in range(n_finite):
+            if (f & POLL_MASK) == 0:
+                poll_signals()
             t = finite[f]
             if merges == 0:
                 r = t

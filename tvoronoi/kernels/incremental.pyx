@@ -1,11 +1,18 @@
-"""Randomized incremental Delaunay triangulation: Bowyer-Watson cavities decided by exact predicates."""
+"""The randomized incremental engine: Delaunay triangulation by Bowyer-Watson insertion, every decision exact.
+
+One insertion = locate (location.pxd), find the cavity (cavity.pxd), fill it (fill.pxd); the mesh layout is
+mesh.pxd, and dual.pyx turns the triangles into the Voronoi DCEL.
+"""
 
 import numpy as np
 
 from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.predicates cimport orient2d
-from tvoronoi.kernels.mesh cimport Mesh, locate, list_site, insert_site
+from tvoronoi.kernels.mesh cimport Mesh
+from tvoronoi.kernels.location cimport locate, list_site
+from tvoronoi.kernels.fill cimport insert_site
+from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 
 cdef enum:
     # status codes returned to the API layer
@@ -15,7 +22,7 @@ cdef enum:
 STATUS_OK = OK
 STATUS_COLLINEAR = COLLINEAR
 
-cdef int build(Mesh* m, int32_t* order, int stop_after) noexcept nogil:
+cdef int build(Mesh* m, int32_t* order, int stop_after) except -1 nogil:
     """Triangulate the sites in the given insertion order (modified: the first
     three become a non-degenerate triangle), stopping after stop_after sites
     when it is not negative. Returns a status code."""
@@ -68,10 +75,14 @@ cdef int build(Mesh* m, int32_t* order, int stop_after) noexcept nogil:
             s = order[q]
             list_site(m, locate(m, 0, m.x[s], m.y[s]), s)
         for q in range(3, end):
+            if (q & POLL_MASK) == 0:
+                poll_signals()
             s = order[q]
             insert_site(m, s, m.where[s])
     else:
         for q in range(3, end):
+            if (q & POLL_MASK) == 0:
+                poll_signals()
             s = order[q]
             insert_site(m, s, locate(m, m.last, m.x[s], m.y[s]))
     return OK

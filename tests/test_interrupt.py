@@ -1,0 +1,140 @@
+"""Long kernel runs answer signals: each phase stops inside its loop, with the handler's exception.
+
+A SIGALRM handler stands in for Ctrl-C (KeyboardInterrupt) and for the CLI's SIGTERM handler: the timer
+fires while a kernel runs on a million sites, and the exception must come out of the kernel's own poll
+(kernels/interrupt.pxd) -- not after the phase has finished, which is what a kernel that never looks at
+signals would give. The batch CLI is then checked end to end with a real SIGINT and SIGTERM.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import traceback
+
+import numpy as np
+import pytest
+
+import tvoronoi
+from tvoronoi import engines
+from tvoronoi.api import default_bbox
+from tvoronoi.kernels import clip, fortune, incremental, order
+
+N = 1_000_000
+pytestmark = pytest.mark.skipif(not hasattr(signal, "setitimer"), reason="needs signal.setitimer")
+
+
+class Alarm(Exception):
+    pass
+
+
+@pytest.fixture(scope="module")
+def points():
+    return np.random.default_rng(7).random((N, 2))
+
+
+@pytest.fixture
+def alarm():
+    """Arm a timer whose handler raises Alarm; yields the arming function."""
+
+    def handler(signum, frame):
+        raise Alarm
+
+    previous = signal.signal(signal.SIGALRM, handler)
+
+    def arm(seconds: float):
+        signal.setitimer(signal.ITIMER_REAL, seconds)
+
+    yield arm
+    signal.setitimer(signal.ITIMER_REAL, 0)
+    signal.signal(signal.SIGALRM, previous)
+
+
+def stopped_in_kernel(arm, run) -> str:
+    """Run the call with the timer armed; the handler must run from the kernels' poll (interrupt.pxd).
+
+    Returns the file of the kernel frame that polled. The timer may land in the Python set-up around the
+    kernel on a slow machine, so a few delays are tried; a kernel that never polls fails them all.
+    """
+    seen = []
+    for delay in (0.02, 0.05, 0.1, 0.2, 0.4):
+        arm(delay)
+        try:
+            run()
+        except Alarm as exc:
+            files = [frame.filename for frame in traceback.extract_tb(exc.__traceback__)]
+            # the last frame is the handler; the one below it is where Python ran it
+            if files[-2].endswith("interrupt.pxd"):
+                return files[-3]
+            seen.append(files[-2])
+        else:
+            seen.append("finished")
+        finally:
+            arm(0)
+    pytest.fail(f"the signal was never handled inside a kernel: {seen}")
+
+
+def test_order_answers_signals(points, alarm):
+    xs, ys = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
+    assert stopped_in_kernel(alarm, lambda: order.brio_order(xs, ys, 0)).endswith("order.pyx")
+
+
+def test_incremental_answers_signals(points, alarm):
+    s = engines.prepare(points[:, 0], points[:, 1], engine="incremental")
+    assert stopped_in_kernel(alarm, lambda: incremental.triangulate(s.xs, s.ys)).endswith("incremental.pyx")
+
+
+def test_fortune_answers_signals(points, alarm):
+    s = engines.prepare(points[:, 0], points[:, 1], engine="fortune")
+    assert stopped_in_kernel(alarm, lambda: fortune.sweep(s.xs, s.ys)).endswith("fortune.pyx")
+
+
+def test_dual_and_clip_answer_signals(points, alarm):
+    t = engines.run(points[:, 0], points[:, 1], engine="incremental")
+    assert stopped_in_kernel(alarm, t.voronoi).endswith("dual.pyx")
+    out = t.voronoi()
+    s = t.sites
+    first = (out["dup"] < 0).astype(np.int8)
+    box = default_bbox(points)
+    assert stopped_in_kernel(alarm, lambda: clip.clip_cells(
+        s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
+        out["he_face"], out["face_edge"], first, box, s.exponent,
+    )).endswith("clip.pyx")
+
+
+def test_a_build_after_an_interrupted_one_is_whole(points, alarm):
+    """Nothing a stopped kernel left behind changes the next build."""
+    sub = points[:20_000]
+    want = tvoronoi.voronoi(sub)
+    s = engines.prepare(points[:, 0], points[:, 1], engine="incremental")
+    stopped_in_kernel(alarm, lambda: incremental.triangulate(s.xs, s.ys))
+    got = tvoronoi.voronoi(sub)
+    assert np.array_equal(got.cell_points, want.cell_points)
+    assert np.array_equal(got.cell_offsets, want.cell_offsets)
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, None)])
+def test_batch_stops_on_signal_and_leaves_no_file(tmp_path, sig, code):
+    """`tvoronoi batch` on 2,000,000 points, signalled while its kernels run: it ends at once, writes nothing."""
+    src = tmp_path / "points.npy"
+    np.save(src, np.random.default_rng(3).random((2_000_000, 2)))
+    out = tmp_path / "cells.geojson"
+    proc = subprocess.Popen([sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.5)                          # start-up and reading done; the engine is running
+    proc.send_signal(sig)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:       # a kernel that ignores signals would not end: fail, don't hang
+        proc.kill()
+        proc.communicate()
+        pytest.fail("the batch did not stop on the signal")
+    assert proc.returncode != 0, err
+    if code is not None:
+        assert proc.returncode == code, err
+    assert not out.exists()
+    assert not [p for p in os.listdir(tmp_path) if p not in ("points.npy",)], os.listdir(tmp_path)
+    assert "Traceback" not in err, err

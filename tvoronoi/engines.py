@@ -1,0 +1,206 @@
+"""Run an engine: scale the sites exactly, put them in the engine's order, triangulate, and return a typed result.
+
+Every caller that needs a triangulation (batch builds, dynamic diagrams, the step traces, the benchmarks)
+goes through here, so the range rule, the insertion order and the status handling are written once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.kernels import dual, fortune, incremental, order
+
+# Box sides in the sites' scaled unit. From above, the exact products split a box coordinate into
+# halves by multiplying it with 2^27 + 1 (Dekker), which must not overflow: about 2^997, a little
+# under (1.3e300 for sites of unit size). From below, a side times a coordinate difference (down to
+# 2^-223) must not underflow. Ring tests between points of the box and the sites, whose magnitudes
+# may then span 2^1700, are exact at any span (clipper.turn).
+BOX_SCALED_MIN = 2.0 ** -700
+BOX_SCALED_MAX = math.ldexp(1.0 - 2.0 ** -20, 997)
+
+
+def scale_exponent(*values) -> int:
+    """The exponent e of the scale 2^e of these coordinates: the largest magnitude is below 2^e.
+
+    Scaling by 2^-e is exact, and keeps the predicates' products (degree four in incircle) far from
+    overflow and underflow at any scale. For a batch diagram only the sites set it: a box far larger
+    or smaller than the sites costs no precision, within the limits of check_box_scale.
+    """
+    top = max((float(np.abs(np.asarray(v, np.float64)).max()) for v in values if np.size(v)), default=0.0)
+    return math.frexp(top)[1] if top > 0 else 0
+
+
+def check_box_scale(box, e: int) -> None:
+    """Refuse a box whose sides the exact tests could not handle in the sites' scaled unit."""
+    for name, v in zip(("xmin", "ymin", "xmax", "ymax"), box):
+        if v == 0.0:
+            continue
+        # |v| * 2^-e without overflow or underflow, whatever e: compare the exponents first
+        k = math.frexp(v)[1] - e
+        s = abs(math.ldexp(math.frexp(v)[0], k)) if -1000 < k < 1000 else math.inf if k > 0 else 0.0
+        if not (BOX_SCALED_MIN <= s <= BOX_SCALED_MAX):
+            raise TvoronoiError(
+                f"bbox {name} = {v!r} is beyond the exact range for these sites (their largest "
+                f"coordinate is about 2^{e}): a nonzero box side must lie between 2^-700 and about "
+                f"2^997 (1.3e300) times that; choose a box nearer the sites' scale"
+            )
+
+
+def first_copies(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """For each point, the first earlier index with identical coordinates, or -1."""
+    n = len(xs)
+    dup = np.full(n, -1, np.int32)
+    if n < 2:
+        return dup
+    by_place = np.lexsort((ys, xs))            # stable: earlier indices first within a tie
+    same = (xs[by_place][1:] == xs[by_place][:-1]) & (ys[by_place][1:] == ys[by_place][:-1])
+    if not same.any():
+        return dup
+    # the start of each run of equal points, carried along the run
+    start = np.maximum.accumulate(np.where(np.concatenate(([True], ~same)), np.arange(n), 0))
+    first = by_place[start]
+    dup[by_place] = np.where(first != by_place, first, -1)
+    return dup
+
+
+def collinear_dcel(xs: np.ndarray, ys: np.ndarray) -> dict:
+    """Voronoi DCEL of 0, 1, 2 or more collinear sites (parallel strips), repeats included."""
+    dup = first_copies(xs, ys)
+    distinct = np.flatnonzero(dup < 0)
+    line = distinct[np.lexsort((ys[distinct], xs[distinct]))]   # sorted by x then y: line order
+    out = dual.voronoi_collinear(np.ascontiguousarray(xs[line]), np.ascontiguousarray(ys[line]))
+    out["he_face"] = line[out["he_face"]].astype(np.int32)
+    face_edge = np.full(len(xs), -1, np.int32)
+    face_edge[line] = out["face_edge"]
+    out["face_edge"] = face_edge
+    out["dup"] = dup
+    return out
+
+
+def lift_dcel(sub: dict, idx: np.ndarray, n: int) -> dict:
+    """A DCEL over the sites idx of n (a subset, numbered 0..len(idx)-1), renumbered to all n sites."""
+    out = dict(sub)
+    out["he_face"] = idx[sub["he_face"]].astype(np.int32)
+    face_edge = np.full(n, -1, np.int32)
+    face_edge[idx] = sub["face_edge"]
+    out["face_edge"] = face_edge
+    dup = np.full(n, -1, np.int32)
+    sd = sub["dup"]
+    dup[idx[sd >= 0]] = idx[sd[sd >= 0]]
+    out["dup"] = dup
+    out["triangles"] = np.empty((0, 3), np.int32)
+    return out
+
+
+def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Event order of Fortune's sweep: by y, then x (int32)."""
+    perm = np.argsort(ys)
+    sy = ys[perm]
+    if len(sy) > 1 and np.any(sy[1:] == sy[:-1]):
+        # rows of equal y: order them by x (a complex sort compares real, then imaginary parts)
+        perm = np.argsort(ys + 1j * xs, kind="stable")
+    return perm.astype(np.int32)
+
+
+def engine_order(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio",
+                 seed: int = 0) -> np.ndarray:
+    """The order in which an engine takes the sites: perm[k] is the k-th site (int32).
+
+    Fortune's sweep takes them by y then x; the incremental engine in a biased randomized
+    insertion order along a space-filling curve ("brio"), or fully at random ("random").
+    """
+    if engine == "fortune":
+        return sweep_order(xs, ys)
+    if insertion == "brio":
+        return order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed)
+    return np.random.default_rng(seed).permutation(len(xs)).astype(np.int32)
+
+
+@dataclass(frozen=True)
+class Sites:
+    """Sites ready for an engine: scaled by 2^-exponent (exact) and in the engine's order."""
+
+    exponent: int
+    perm: np.ndarray    # (n,) int32: engine site k is input site perm[k]
+    xs: np.ndarray      # (n,) float64 scaled coordinates, in engine order, C-contiguous
+    ys: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.perm)
+
+
+def prepare(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0,
+            exponent: int | None = None) -> Sites:
+    """Scale the sites (input order) by 2^-exponent (default: their own scale) and order them for an engine."""
+    xs = np.asarray(xs, np.float64)
+    ys = np.asarray(ys, np.float64)
+    e = scale_exponent(xs, ys) if exponent is None else exponent
+    sx, sy = np.ldexp(xs, -e), np.ldexp(ys, -e)
+    perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed)
+    return Sites(e, perm, np.ascontiguousarray(sx[perm]), np.ascontiguousarray(sy[perm]))
+
+
+@dataclass(frozen=True)
+class Triangulation:
+    """An engine's result on prepared sites, numbered in engine order.
+
+    tv, opp are the triangles' vertices (n stands for the vertex at infinity) and twin half-edges, or
+    None when the distinct sites are collinear (fewer than three, or all on one line); dup[k] is the
+    earlier site that site k repeats, or -1.
+    """
+
+    engine: str
+    sites: Sites
+    tv: np.ndarray | None
+    opp: np.ndarray | None
+    dup: np.ndarray
+
+    @property
+    def flat(self) -> bool:
+        """True when the distinct sites are collinear: no triangle, parallel strips for cells."""
+        return self.tv is None
+
+    def voronoi(self) -> dict:
+        """The Voronoi DCEL (vertices in the user's unit, correctly rounded) with ``dup``, in engine order."""
+        s = self.sites
+        if self.flat:
+            return collinear_dcel(s.xs, s.ys)
+        out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent)
+        out["dup"] = self.dup
+        return out
+
+
+def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triangulation:
+    """Run an engine on prepared sites.
+
+    Raises
+    ------
+    TvoronoiError
+        Fortune's sweep reached a state it could not complete (a defect to report; the
+        incremental engine is the fallback the message names).
+    """
+    if engine == "fortune":
+        result = fortune.sweep(sites.xs, sites.ys)
+        if result["status"] != fortune.STATUS_OK:
+            raise TvoronoiError(
+                f"{fortune.STATUS_MESSAGES[result['status']]} on {len(sites)} points; "
+                "build with engine='incremental' instead, and please report the input"
+            )
+        if "tv" not in result:
+            return Triangulation(engine, sites, None, None, first_copies(sites.xs, sites.ys))
+        return Triangulation(engine, sites, result["tv"], result["opp"], result["dup"])
+    status, tv, opp, dup = incremental.triangulate(sites.xs, sites.ys, conflict_lists=(insertion == "random"))
+    if status != incremental.STATUS_OK:
+        return Triangulation(engine, sites, None, None, first_copies(sites.xs, sites.ys))
+    return Triangulation(engine, sites, tv, opp, dup)
+
+
+def run(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0,
+        exponent: int | None = None) -> Triangulation:
+    """prepare, then triangulate: the Delaunay triangulation of sites given in input order."""
+    sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, exponent=exponent)
+    return triangulate(sites, engine=engine, insertion=insertion)

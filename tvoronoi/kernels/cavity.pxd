@@ -1,0 +1,83 @@
+# The conflict region (cavity) of a new site: every triangle whose circumcircle strictly holds it,
+# decided by the exact in-circle test; inline, compiled where cimported.
+
+from libc.stdint cimport int32_t
+
+from tvoronoi.kernels.predicates cimport orient2d, incircle
+from tvoronoi.kernels.mesh cimport Mesh, is_infinite, nxt, strictly_between
+
+
+cdef inline bint in_conflict(Mesh* m, int t, double px, double py) noexcept nogil:
+    """Site p lies strictly inside the circumcircle of t (its cavity takes t).
+
+    For an infinite triangle (u, w, inf) the 'circle' is the open half-plane
+    left of u->w (outside the hull), plus the open segment uw itself.
+    """
+    cdef int a = m.tv[3 * t], b = m.tv[3 * t + 1], c = m.tv[3 * t + 2]
+    cdef int u, w, o
+    if a == m.inf:
+        u = b
+        w = c
+    elif b == m.inf:
+        u = c
+        w = a
+    elif c == m.inf:
+        u = a
+        w = b
+    else:
+        return incircle(m.x[a], m.y[a], m.x[b], m.y[b], m.x[c], m.y[c], px, py) > 0
+    o = orient2d(m.x[u], m.y[u], m.x[w], m.y[w], px, py)
+    if o > 0:
+        return True
+    # degenerate case: p on the line of a hull edge
+    return o == 0 and strictly_between(m, u, w, px, py)
+
+
+cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
+    """The conflict region of site i, which contains triangle t0; False for a repeated point.
+
+    # the cavity: every triangle whose circumcircle strictly contains i,
+    # found by a search over edges from t0 (the region is connected and
+    # star-shaped from i); its boundary is a cycle of k + 2 edges for k
+    # triangles (m.cavity, m.bnd_a, m.bnd_b, m.bnd_twin; m.n_cav, m.n_bnd)
+    """
+    cdef double px = m.x[i], py = m.y[i]
+    cdef int32_t conflict, tested
+    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, a
+    # degenerate case: a repeated point; the walk ends on a triangle that has it as a vertex
+    if not is_infinite(m, t0):
+        for k in range(3):
+            a = m.tv[3 * t0 + k]
+            if m.x[a] == px and m.y[a] == py:
+                m.dup[i] = a
+                if m.head != NULL:
+                    m.where[i] = -1
+                return False
+    m.epoch += 1
+    conflict = 2 * m.epoch
+    tested = conflict + 1
+    m.stamp[t0] = conflict
+    m.cavity[0] = t0
+    while j < n_cav:
+        t = m.cavity[j]
+        j += 1
+        for k in range(3):
+            e = 3 * t + k
+            o = m.opp[e]
+            nt = o // 3
+            if m.stamp[nt] == conflict:
+                continue
+            if m.stamp[nt] != tested:
+                if in_conflict(m, nt, px, py):
+                    m.stamp[nt] = conflict
+                    m.cavity[n_cav] = nt
+                    n_cav += 1
+                    continue
+                m.stamp[nt] = tested
+            m.bnd_a[n_bnd] = m.tv[e]
+            m.bnd_b[n_bnd] = m.tv[nxt(e)]
+            m.bnd_twin[n_bnd] = o
+            n_bnd += 1
+    m.n_cav = n_cav
+    m.n_bnd = n_bnd
+    return True
