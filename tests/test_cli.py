@@ -338,3 +338,62 @@ def test_subprocess_exit_status_and_no_traceback(tmp_path, existing):
     assert "Traceback" not in proc.stderr and proc.stderr.count("\n") == 1
     assert snapshot(existing) == before
     assert temp_files(tmp_path) == []
+
+
+# ---------------------------------------------------------------------------
+# column choice and coordinate errors, as a user sees them
+
+
+def test_chosen_columns_are_reported_unless_quiet(capsys, tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("id,easting,northing,name\n1,0,0,a\n2,10,0,b\n3,0,10,c\n4,7,7,d\n")
+    status, _, err = run(capsys, "batch", path, "-o", tmp_path / "a.geojson")
+    assert status == 0
+    assert err == f'tvoronoi: {path}: x = "easting", y = "northing" (by name); choose others with --x/--y\n'
+    status, _, err = run(capsys, "batch", path, "-o", tmp_path / "b.geojson", "-q")
+    assert (status, err) == (0, "")
+
+
+def test_id_column_is_skipped_and_said(capsys, tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("fid,a,b\n1,0,0\n2,10,0\n3,0,10\n")
+    status, _, err = run(capsys, "batch", path, "-o", tmp_path / "a.geojson")
+    assert status == 0 and 'x = "a", y = "b" (the first numeric columns); skipped the id-like column "fid"' in err
+    doc = load(tmp_path / "a.geojson")
+    assert [f["properties"]["fid"] for f in doc["features"]] == [1, 2, 3]
+
+
+def test_semicolon_file_with_delimiter_option(capsys, tmp_path):
+    path = tmp_path / "p.txt"
+    path.write_text("x;y;zip\n0;0;01000\n1;0;02000\n0;1;03000\n")
+    status, _, err = run(capsys, "batch", path, "--delimiter", ";", "-o", tmp_path / "a.geojson")
+    assert (status, err) == (0, "")
+    doc = load(tmp_path / "a.geojson")
+    assert [f["properties"]["zip"] for f in doc["features"]] == ["01000", "02000", "03000"]
+
+
+def test_range_error_names_file_line_and_value_without_numpy_warnings(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("x,y\n1,1\n2,3\n1e60,2\n3,3\n")
+    proc = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
+                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(f"tvoronoi: error: {path}, line 2: coordinate 1.0 is over 1e51 times smaller")
+    assert "1e+60 (line 4)" in proc.stderr and "np.float64" not in proc.stderr
+    assert proc.stderr.count("\n") == 1
+
+
+def test_values_at_the_edge_of_the_double_range_leak_no_warning(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("x,y\n1e308,1e308\n-1.7e308,-1e308\n1e308,-1.5e308\n")
+    proc = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
+                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    assert "Warning" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stderr.count("\n") <= 1
+
+
+def test_unsupported_format_is_a_usage_error(capsys, tmp_path):
+    path = tmp_path / "points.gpkg"
+    path.write_bytes(b"SQLite format 3\x00" + bytes(200))
+    status, _, err = run(capsys, "batch", path, "-o", tmp_path / "a.geojson")
+    assert status == 2 and "GeoPackage" in err and "ogr2ogr" in err and err.count("\n") == 1

@@ -187,7 +187,7 @@ def test_csv_two_quoted_columns(tmp_path):
     np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
 
 
-def test_csv_extra_columns_are_converted(tmp_path):
+def test_csv_extra_columns_are_typed_per_column(tmp_path):
     content = (
         "x,y,i,f,mixed,s,e,big,nan\n"
         "0,0,1,1.5,1,abc,,123456789012345678901234567890,nan\n"
@@ -195,32 +195,33 @@ def test_csv_extra_columns_are_converted(tmp_path):
         "2,2,+3,-1e3,hello, ,,2,3\n"
     )
     points = read(tmp_path, "p.csv", content)
+    # a column with a word is text throughout; a number column with a non-integer is float throughout
     assert points.properties(0) == {
-        "i": 1, "f": 1.5, "mixed": 1, "s": "abc", "e": None,
+        "i": 1, "f": 1.5, "mixed": "1", "s": "abc", "e": None,
         "big": "123456789012345678901234567890", "nan": None,
     }
     row1 = points.properties(1)
     assert row1["i"] == -2 and type(row1["i"]) is int
-    assert row1["f"] == 2 and type(row1["f"]) is int
-    assert row1["mixed"] == 2.5 and row1["s"] == "x y" and row1["nan"] is None
+    assert row1["f"] == 2 and type(row1["f"]) is float
+    assert row1["mixed"] == "2.5" and row1["s"] == "x y" and row1["nan"] is None
     row2 = points.properties(2)
     # a blank (whitespace-only) field is empty too
-    assert row2 == {"i": 3, "f": -1000.0, "mixed": "hello", "s": None, "e": None, "big": 2, "nan": 3}
-    assert type(row2["f"]) is float
+    assert row2 == {"i": 3, "f": -1000.0, "mixed": "hello", "s": None, "e": None, "big": "2", "nan": 3.0}
+    assert type(row2["f"]) is float and type(row2["nan"]) is float
 
 
-def test_csv_int_column_stays_int_and_float_column_keeps_int_literals(tmp_path):
+def test_csv_int_column_stays_int_and_float_column_is_float(tmp_path):
     points = read(tmp_path, "p.csv", "x,y,a,b\n0,0,7,0.5\n1,1,8,2\n2,2,9,1e-3\n")
     a = [points.properties(i)["a"] for i in range(3)]
     b = [points.properties(i)["b"] for i in range(3)]
     assert a == [7, 8, 9] and all(type(v) is int for v in a)
-    assert b == [0.5, 2, 0.001] and [type(v) for v in b] == [float, int, float]
+    assert b == [0.5, 2.0, 0.001] and all(type(v) is float for v in b)
 
 
 def test_csv_properties_are_json_ready(tmp_path):
     points = read(tmp_path, "p.csv", "x,y,a,b,c\n0,0,nan,1e999,\n1,1,2,x,7\n")
     text = json.dumps([points.properties(i) for i in range(2)], allow_nan=False)
-    assert json.loads(text) == [{"a": None, "b": None, "c": None}, {"a": 2, "b": "x", "c": 7}]
+    assert json.loads(text) == [{"a": None, "b": "1e999", "c": None}, {"a": 2.0, "b": "x", "c": 7}]
 
 
 def test_csv_blank_lines_crlf_bom_and_spaces(tmp_path):
@@ -771,3 +772,149 @@ def test_unterminated_quote(tmp_path):
 def test_control_characters_are_shown_escaped(tmp_path):
     message = error(tmp_path, "p.csv", "x,y\n1,2\n3,4\x00\n")
     assert 'p.csv, line 3: "4\\u0000" in column "y" is not a number' in message
+
+
+# ---------------------------------------------------------------------------
+# columns typed per column
+
+
+def test_zip_codes_keep_their_leading_zeros(tmp_path):
+    points = read(tmp_path, "p.csv", "zip,x,y\n01000,0,0\n02134,1,0\n90210,0,1\n")
+    assert [points.properties(i)["zip"] for i in range(3)] == ["01000", "02134", "90210"]
+
+
+def test_a_column_is_integer_only_if_every_value_is(tmp_path):
+    points = read(tmp_path, "p.csv", "x,y,n,m,t\n0,0,1,1,7\n1,0,,2.5,7a\n0,1,3,,8\n")
+    assert [points.properties(i)["n"] for i in range(3)] == [1, None, 3]
+    assert [type(points.properties(i)["m"]) for i in range(3)] == [float, float, type(None)]
+    assert [points.properties(i)["t"] for i in range(3)] == ["7", "7a", "8"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.one_of(st.integers(-10**20, 10**20).map(str), st.from_regex(r"0[0-9]{1,5}", fullmatch=True),
+                          st.floats(allow_nan=False, allow_infinity=False).map(repr), st.just(""),
+                          st.text("abc ", min_size=1, max_size=4)),
+                min_size=1, max_size=12))
+def test_every_column_has_one_type(values):
+    from tvoronoi.readers.pointset import _convert_column
+
+    for plain in (True, False):
+        out = _convert_column(values, plain)
+        assert [v is None for v in out] == [not v.strip() for v in values]
+        kinds = {type(v) for v in out} - {type(None)}
+        assert len(kinds) <= 1
+        if kinds == {str}:
+            assert all(o == v for o, v in zip(out, values) if o is not None)
+        if any(v.strip().startswith("0") and v.strip()[1:2].isdigit() for v in values):
+            assert kinds <= {str}
+
+
+# ---------------------------------------------------------------------------
+# column choice: names, id-like columns, separators
+
+
+@pytest.mark.parametrize("header, expect", [
+    ("name,Easting,Northing", ("Easting", "Northing")),
+    ("name,E,N", ("E", "N")),
+    ("name,X,Y", ("X", "Y")),
+    ("name,Longitude,Latitude", ("Longitude", "Latitude")),
+    ("name,lng,lat", ("lng", "lat")),
+])
+def test_coordinate_columns_recognised_by_name(tmp_path, header, expect):
+    points = read(tmp_path, "p.csv", f"{header}\na,5,7\nb,6,8\n")
+    np.testing.assert_array_equal(points.xy, [[5, 7], [6, 8]])
+    assert points.property_names == ["name"]
+    assert points.choice is None or f'x = "{expect[0]}", y = "{expect[1]}" (by name)' in points.choice
+
+
+def test_n_alone_is_not_a_northing(tmp_path):
+    points = read(tmp_path, "p.csv", "a,n,x\n5,1,7\n6,2,8\n")
+    # "n" (a count) has no "e" beside it: y is the first free numeric column
+    np.testing.assert_array_equal(points.xy, [[7, 5], [8, 6]])
+    assert points.property_names == ["n"]
+
+
+@pytest.mark.parametrize("id_name", ["id", "FID", "index", "row", "OBJECTID", "station_id", "Unnamed: 0"])
+def test_id_like_columns_are_never_taken_by_position(tmp_path, id_name):
+    points = read(tmp_path, "p.csv", f"{id_name},a,b\n1,5,7\n2,6,8\n3,1,1\n")
+    np.testing.assert_array_equal(points.xy, [[5, 7], [6, 8], [1, 1]])
+    assert points.choice.startswith('x = "a", y = "b" (the first numeric columns); skipped the id-like column')
+    assert f'"{id_name}"' in points.choice
+
+
+def test_only_id_columns_left_is_an_error_naming_them(tmp_path):
+    message = error(tmp_path, "p.csv", "id,value,name\n1,5,a\n2,6,b\n")
+    assert "id-like columns are not taken: id" in message and "--x/--y" in message
+
+
+def test_semicolon_csv_with_decimal_commas(tmp_path):
+    points = read(tmp_path, "p.csv", "Name;X;Y;Pop\nA;1,5;2,25;1000\nB;3;4,75;2000\n")
+    np.testing.assert_array_equal(points.xy, [[1.5, 2.25], [3.0, 4.75]])
+    assert points.properties(1) == {"Name": "B", "Pop": 2000}
+
+
+def test_semicolon_csv_bad_value_is_named_as_written(tmp_path):
+    message = error(tmp_path, "p.csv", "x;y\n1,5;2\n1,5,3;4\n")
+    assert 'line 3: "1,5,3" in column "x" is not a number' in message
+
+
+def test_tsv_and_explicit_delimiter(tmp_path):
+    points = read(tmp_path, "p.tsv", "x\ty\tname\n1\t2\ta b\n3\t4\t\n")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+    assert points.properties(0) == {"name": "a b"} and points.properties(1) == {"name": None}
+    points = read(tmp_path, "p.txt", "x|y|name\n1|2|a\n3|4|b\n", delimiter="|")
+    np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
+
+
+@pytest.mark.parametrize("name, content, what", [
+    ("p.gpkg", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+    ("p.dat", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+    ("p.shp", b"\x00\x00\x27\x0a" + bytes(96), "shapefile"),
+    ("p.zip", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.csv", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.xlsx", b"PK\x03\x04" + bytes(40), "zip archive"),
+    ("p.kml", b"<?xml version='1.0'?><kml/>", "KML"),
+    ("p.csv.gz", b"\x1f\x8b\x08" + bytes(20), "gzip"),
+])
+def test_unsupported_formats_are_named_with_a_conversion(tmp_path, name, content, what):
+    message = error(tmp_path, name, content)
+    assert what in message and "does not read" in message
+    assert "ogr2ogr" in message or "gunzip" in message or "unzip" in message
+    assert "UTF-8" not in message
+
+
+def test_a_binary_file_is_named_as_such(tmp_path):
+    message = error(tmp_path, "points", b"\x7fELF\x02\x01\x01\x00" + bytes(64) + b"\xd0\x8f\xff" + bytes(64))
+    assert "a binary file" in message and "UTF-8" not in message
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.sampled_from([",", ";", "\t", "|"]),
+       st.lists(st.tuples(st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
+                          st.text("ab ,;|", max_size=5)), min_size=1, max_size=20))
+def test_any_separator_is_found_from_the_rows(tmp_path_factory, delimiter, rows):
+    out = io.StringIO()
+    writer = csv.writer(out, delimiter=delimiter, lineterminator="\n")
+    writer.writerow(["x", "y", "label"])
+    writer.writerows(rows)
+    path = write(tmp_path_factory.mktemp("sep"), "p.csv", out.getvalue())
+    points = read_points(path)
+    np.testing.assert_array_equal(points.xy, [[x, y] for x, y, _ in rows])
+    assert [points.properties(i)["label"] for i in range(len(rows))] == [
+        label if label.strip() else None for _, _, label in rows
+    ]
+
+
+@pytest.mark.parametrize("content, rows_lines", [
+    ("x,y\n1,2\n3,4\n5,6\n", [(0, 2), (2, 4)]),  # fast path, one line per row
+    ("\nx,y\n\n1,2\n\n3,4\n5,6", [(0, 4), (1, 6), (2, 7)]),  # blank lines
+    ('x,y,n\n1,2,"a\nb"\n3,4,c\n', [(0, 2), (1, 4)]),  # a field over two lines
+    ("x,y\n1,2\n3,abc\n", None),  # the slow path names the line itself
+])
+def test_each_site_knows_its_line(tmp_path, content, rows_lines):
+    if rows_lines is None:
+        assert "line 3" in error(tmp_path, "p.csv", content)
+        return
+    points = read(tmp_path, "p.csv", content)
+    for row, line in rows_lines:
+        assert points.place(row) == f"line {line}"

@@ -8,7 +8,7 @@ import numpy as np
 
 from tvoronoi.diagram import Diagram
 from tvoronoi.engines import scale_exponent
-from tvoronoi.errors import EngineError, TvoronoiError
+from tvoronoi.errors import CoordinateRangeError, EngineError, TvoronoiError
 
 ENGINES = ("incremental", "fortune")
 INSERTION_ORDERS = ("brio", "random")
@@ -23,16 +23,25 @@ RANGE_BITS = 170
 
 
 def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
-    """Refuse nonzero coordinates more than 2^170 from the scale 2^e (naming the first row at fault)."""
+    """Refuse nonzero coordinates more than 2^170 from the scale 2^e (naming the first row at fault).
+
+    Raises
+    ------
+    CoordinateRangeError
+        Naming the first row at fault and the row of the largest coordinate.
+    """
+    pts = np.asarray(pts, np.float64).reshape(len(pts), -1)
     mag = np.abs(pts)
-    bad = (pts != 0) & ((mag < math.ldexp(1.0, e - RANGE_BITS)) | (mag > math.ldexp(1.0, e + RANGE_BITS)))
+    # 2^(e+170) may exceed the double range: then nothing is too large
+    low = math.ldexp(1.0, e - RANGE_BITS)
+    high = math.ldexp(1.0, e + RANGE_BITS) if e + RANGE_BITS < 1024 else math.inf
+    bad = (pts != 0) & ((mag < low) | (mag > high))
     if bad.any():
-        row, col = (int(v) for v in np.argwhere(bad.reshape(len(pts), -1))[0])
-        value = float(np.asarray(pts).reshape(len(pts), -1)[row, col])
-        raise TvoronoiError(
-            f"{what} {row} has coordinate {value!r}, over 1e51 times {'smaller' if abs(value) < 2.0 ** e else 'larger'} "
-            f"than the diagram's scale (about {math.ldexp(1.0, e):.3g}): exact arithmetic covers a range of "
-            f"2^170 around it; round such values to 0 or split the data"
+        row, col = (int(v) for v in np.argwhere(bad)[0])
+        top_row, top_col = (int(v) for v in np.unravel_index(int(np.argmax(mag)), mag.shape))
+        raise CoordinateRangeError(
+            rows=(row, top_row), values=(float(pts[row, col]), float(pts[top_row, top_col])),
+            small=bool(mag[row, col] < low), locate=lambda i: f"{what} {i}",
         )
 
 
@@ -56,7 +65,7 @@ def as_points(points) -> np.ndarray:
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
         raise TvoronoiError(
-            f"point {row} is ({pts[row, 0]!r}, {pts[row, 1]!r}): coordinates must be finite "
+            f"point {row} is ({float(pts[row, 0])!r}, {float(pts[row, 1])!r}): coordinates must be finite "
             f"({int(bad.sum())} such point(s))"
         )
     check_range(pts, scale_exponent(pts))

@@ -5,13 +5,15 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import signal
 import sys
+import warnings
 from contextlib import contextmanager
 
 from tvoronoi import __version__
 from tvoronoi.api import ENGINES, INSERTION_ORDERS
-from tvoronoi.errors import TvoronoiError
+from tvoronoi.errors import CoordinateRangeError, TvoronoiError
 from tvoronoi.readers import FORMATS
 
 PROG = "tvoronoi"
@@ -23,25 +25,46 @@ EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 BATCH_EPILOG = """\
 output:
-  OUTPUT is an RFC 7946 FeatureCollection: one Polygon per distinct site, in
+  OUTPUT (by extension or --to) is an RFC 7946 FeatureCollection (.geojson),
+  an RFC 8142 GeoJSON sequence with a record separator before each feature
+  (.geojsons, as GDAL writes it), one feature per line (.geojsonl, .jsonl:
+  GDAL's GeoJSONSeq driver and jq read both), or GeoParquet 1.1 (.parquet,
+  needs pyarrow). Each holds one Polygon per distinct site, in
   input order, with properties {"site": ROW, ...the row's other columns} and
   "duplicates": [ROWS] where later rows repeat the site. A cell that misses
   a --bbox leaving its site outside has "geometry": null.
 
   An existing OUTPUT or --delaunay FILE is not replaced unless --force is
   given, and then only by renaming a complete new file over it: a failed run
-  leaves every existing file as it was, and no half-written file behind.
+  leaves every existing file as it was, and no half-written file behind. A
+  symbolic link keeps pointing where it pointed; the file it names is
+  replaced. Character devices (/dev/null), named pipes, /dev/stdout and "-"
+  are written directly, with or without --force, and never replaced.
 
   A progress display appears on stderr for inputs of 200,000 points or more
   when stderr is a terminal and -q is not given.
 
 exit status:
   0    success (warnings may have been printed)
-  1    an output could not be written (disk full, permission denied, ...)
+  1    an output could not be written (disk full, permission denied, ...),
+       or the reader of a pipe left early (| head), which is not reported
   2    bad input or options: unreadable or malformed point file, bad --bbox,
        unknown or unavailable engine, an existing output without --force
   130  interrupted
 """
+
+
+# output formats: --to names, and the extensions that choose them
+OUTPUT_FORMATS = ("geojson", "geojsonseq", "geojsonl", "parquet")
+OUTPUT_EXTENSIONS = {
+    ".geojson": "geojson", ".json": "geojson",
+    ".geojsons": "geojsonseq", ".geojsonseq": "geojsonseq",
+    ".geojsonl": "geojsonl", ".jsonl": "geojsonl", ".ndjson": "geojsonl",
+    ".parquet": "parquet", ".geoparquet": "parquet", ".pq": "parquet",
+}
+GEOJSON_LAYOUT = {"geojson": "collection", "geojsonseq": "seq", "geojsonl": "lines"}
+CRS84 = "OGC:CRS84"
+LONLAT_BOX = (-180.0, -90.0, 180.0, 90.0)
 
 
 class OutputError(Exception):
@@ -74,6 +97,19 @@ def parse_bbox(text: str) -> tuple[float, float, float, float]:
     return xmin, ymin, xmax, ymax
 
 
+def parse_delimiter(text: str) -> str:
+    """Parse ``--delimiter``: one character, or "tab" / "\\t" for a tab.
+
+    >>> parse_delimiter("tab"), parse_delimiter(";")
+    ('\\t', ';')
+    """
+    named = {"tab": "\t", "\\t": "\t", "comma": ",", "semicolon": ";", "pipe": "|", "space": " "}
+    value = named.get(text.lower(), text)
+    if len(value) != 1 or value in "\r\n\"":
+        raise argparse.ArgumentTypeError(f"{text!r}: give one character, e.g. ';' or 'tab'")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
@@ -83,14 +119,16 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     batch = commands.add_parser(
         "batch",
-        help="write the Voronoi cells of a point file as GeoJSON",
-        description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON.",
+        help="write the Voronoi cells of a point file as GeoJSON or GeoParquet",
+        description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON, "
+                    "a GeoJSON sequence or GeoParquet.",
         epilog=BATCH_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    batch.add_argument("input", metavar="INPUT", help='point file (CSV, text, GeoJSON or .npy), or "-" for stdin')
+    batch.add_argument("input", metavar="INPUT",
+                       help='point file (CSV, TSV, text, GeoJSON, .npy, (Geo)Parquet), or "-" for stdin')
     batch.add_argument("-o", "--output", required=True, metavar="OUTPUT",
-                       help='GeoJSON file of the cells, or "-" for stdout')
+                       help='file of the cells (.geojson, .geojsons, .geojsonl, .parquet), or "-" for stdout')
     batch.add_argument("--engine", choices=ENGINES, default="incremental", help="default: %(default)s")
     batch.add_argument("--bbox", metavar="XMIN,YMIN,XMAX,YMAX",
                        help="the box bounding the cells; default: the points' bounding box grown by 10%% "
@@ -100,9 +138,20 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
     batch.add_argument("--y", metavar="COL", help="y column of a table: a name, a 0-based index or colN")
     batch.add_argument("--format", choices=FORMATS, help="input format; default: from the extension, else the content")
+    batch.add_argument("--delimiter", metavar="CHAR", type=parse_delimiter,
+                       help='field separator of a CSV input: ",", ";", "tab", "|", ...; default: a tab for .tsv, '
+                            "else found from the first rows (a ;-separated file may use decimal commas)")
     batch.add_argument("--insertion", choices=INSERTION_ORDERS, default="brio",
                        help="incremental engine: insertion order (default: %(default)s)")
     batch.add_argument("--seed", type=int, default=0, help="seed of the insertion order (default: %(default)s)")
+    batch.add_argument("--to", choices=OUTPUT_FORMATS,
+                       help="output format of OUTPUT and --delaunay FILE; default: from the extension "
+                            "(.geojson, .geojsons, .geojsonl/.jsonl, .parquet), else geojson")
+    batch.add_argument("--precision", type=int, metavar="N",
+                       help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles)")
+    batch.add_argument("--crs", metavar="AUTH:CODE",
+                       help="the CRS of the input coordinates, e.g. EPSG:3857, recorded in GeoParquet "
+                            "(default: the input's own, else OGC:CRS84 for lon/lat columns, else unknown)")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress display and no warnings")
     batch.add_argument("--force", action="store_true", help="replace an existing OUTPUT or --delaunay FILE")
     return parser
@@ -171,16 +220,38 @@ def run_batch(args) -> int:
 def _batch(args, phases: Phases) -> int:
     import numpy as np
 
+    # a value at the edge of the double range overflows in the box arithmetic; the checks
+    # that follow report it in words, so numpy's own warnings are not printed
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _batch_run(args, phases)
+
+
+def _batch_run(args, phases: Phases) -> int:
+    import numpy as np
+
     from tvoronoi import geojson
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
+    from tvoronoi.writers.geoparquet import crs_name, projjson
+    from tvoronoi.writers.targets import descriptor_of, is_direct
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)
     names = [name for name in (args.output, args.delaunay) if name is not None]
     if names.count(STDIO) > 1:
         raise TvoronoiError('-o and --delaunay cannot both be "-": stdout takes one of them')
-    if len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1]):
+    if (len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1])
+            and not (is_direct(names[0]) and descriptor_of(names[0]) is None)):  # /dev/null takes both
         raise TvoronoiError(f"-o and --delaunay name the same file {names[0]}; choose two names")
+    if args.precision is not None and not 0 <= args.precision <= 17:
+        raise TvoronoiError(f"--precision {args.precision}: give a number of decimal digits from 0 to 17")
+    if args.crs is not None and not _CRS_CODE.fullmatch(args.crs):
+        raise TvoronoiError(f"--crs {args.crs!r}: give an authority and a code, e.g. EPSG:3857 or OGC:CRS84")
+    formats = {name: _output_format(name, args.to) for name in names}
+    if "parquet" in formats.values():
+        from tvoronoi.writers.geoparquet import require_pyarrow
+
+        require_pyarrow()
     options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
     # the engine and its options pass the API's own checks before a large file is read
     voronoi(np.empty((0, 2)), **options)
@@ -194,12 +265,30 @@ def _batch(args, phases: Phases) -> int:
         if args.input != STDIO and _size(args.input) >= PROGRESS_MIN_BYTES:
             phases.show()
         with phases.phase("read") as done:
-            points = read_points(args.input, x=args.x, y=args.y, fmt=args.format)
+            points = read_points(args.input, x=args.x, y=args.y, fmt=args.format, delimiter=args.delimiter)
             done(f"{len(points):,} points")
+        if points.choice is not None and not args.quiet:
+            phases.note(f"{points.source}: {points.choice}")
+        crs = args.crs or points.crs or (CRS84 if points.lonlat else None)
+        lonlat = crs is not None and crs_name(crs) in ("OGC:CRS84", "EPSG:4326")
+        if "parquet" in formats.values():
+            projjson(crs)  # a CRS pyproj does not know fails here, before the build
+        geojson_out = [name for name, fmt in formats.items() if fmt != "parquet"]
+        if crs is not None and not lonlat and geojson_out and not args.quiet:
+            phases.warn(
+                f"{', '.join(geojson_out)}: RFC 7946 GeoJSON has no CRS and is read as lon/lat, but the "
+                f"coordinates are {crs_name(crs)}; write GeoParquet (.parquet) to keep the CRS"
+            )
+        if bbox is None and lonlat:
+            # lon/lat: the default box stops at the antimeridian and the poles
+            options["bbox"] = _lonlat_box(points.xy)
         if len(points) >= PROGRESS_MIN_POINTS:
             phases.show()
         with phases.phase("build") as done:
-            diagram = voronoi(points.xy, **options)
+            try:
+                diagram = voronoi(points.xy, **options)
+            except CoordinateRangeError as e:
+                raise TvoronoiError(f"{points.source}, {e.explain(points.place)}") from None
             done(f"{len(diagram.triangles):,} triangles")
 
         repeats = diagram.n_sites - int(np.count_nonzero(diagram.site_of == np.arange(diagram.n_sites)))
@@ -214,10 +303,24 @@ def _batch(args, phases: Phases) -> int:
             phases.warn(f'{missing} {which} outside --bbox): written with "geometry": null')
 
         with phases.counter("write cells") as progress, _writing(args.output):
-            geojson.write_cells(diagram, points, outputs[args.output].file, progress=progress)
+            stream = outputs[args.output].file
+            if formats[args.output] == "parquet":
+                from tvoronoi.writers.geoparquet import write_cells_parquet
+
+                write_cells_parquet(diagram, points, stream, crs=crs)
+            else:
+                geojson.write_cells(diagram, points, stream, progress=progress, precision=args.precision,
+                                    layout=GEOJSON_LAYOUT[formats[args.output]])
         if args.delaunay is not None:
             with phases.counter("write triangles") as progress, _writing(args.delaunay):
-                geojson.write_delaunay(diagram, outputs[args.delaunay].file, progress=progress)
+                stream = outputs[args.delaunay].file
+                if formats[args.delaunay] == "parquet":
+                    from tvoronoi.writers.geoparquet import write_delaunay_parquet
+
+                    write_delaunay_parquet(diagram, stream, crs=crs)
+                else:
+                    geojson.write_delaunay(diagram, stream, progress=progress, precision=args.precision,
+                                           layout=GEOJSON_LAYOUT[formats[args.delaunay]])
         for name, output in outputs.items():
             with _writing(name):
                 output.commit()
@@ -226,6 +329,28 @@ def _batch(args, phases: Phases) -> int:
             output.discard()
         raise
     return EXIT_OK
+
+
+_CRS_CODE = re.compile(r"[A-Za-z]+:[A-Za-z0-9]+")
+
+
+def _output_format(name: str, to: str | None) -> str:
+    """The format of an output: --to, else its extension, else GeoJSON."""
+    if to is not None:
+        return to
+    return OUTPUT_EXTENSIONS.get(os.path.splitext(name)[1].lower(), "geojson")
+
+
+def _lonlat_box(xy) -> tuple[float, float, float, float] | None:
+    """The default box of lon/lat sites, kept within [-180, 180] x [-90, 90] (None: sites outside it)."""
+    from tvoronoi.api import default_bbox
+
+    xmin, ymin, xmax, ymax = default_bbox(xy)
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    if lo[0] < -180 or lo[1] < -90 or hi[0] > 180 or hi[1] > 90:
+        return None
+    box = (max(xmin, -180.0), max(ymin, -90.0), min(xmax, 180.0), min(ymax, 90.0))
+    return box if box[0] < box[2] and box[1] < box[3] else None
 
 
 def _size(path: str) -> int:
@@ -334,8 +459,14 @@ class Phases:
         yield progress
         self.progress.update(task, total=1, completed=1)
 
+    def note(self, message: str) -> None:
+        """Tell what was chosen for the user (e.g. the x and y columns)."""
+        self._print(f"{PROG}: {message}")
+
     def warn(self, message: str) -> None:
-        line = f"{PROG}: warning: {message}"
+        self._print(f"{PROG}: warning: {message}")
+
+    def _print(self, line: str) -> None:
         if self.progress is not None:
             self.progress.console.print(line, markup=False, highlight=False)
         else:

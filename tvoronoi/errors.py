@@ -11,3 +11,29 @@ class InputFileError(TvoronoiError):
 
 class EngineError(TvoronoiError):
     """An engine name or option that does not exist (or is not available yet)."""
+
+
+class CoordinateRangeError(TvoronoiError):
+    """Coordinates spread over more than exact arithmetic covers (2^170 around the largest).
+
+    ``rows`` are the first row at fault and the row of the largest coordinate, ``values``
+    their coordinates; :meth:`explain` words the message with the rows named by a caller
+    that knows where they are in a file.
+    """
+
+    def __init__(self, *, rows: tuple[int, int], values: tuple[float, float], small: bool, locate):
+        self.rows, self.values, self.small = rows, values, small
+        super().__init__(self.explain(locate))
+
+    def explain(self, locate) -> str:
+        """The message, with ``locate(row)`` naming a row ("point 3", "data.csv, line 5")."""
+        (row, top_row), (value, top) = self.rows, self.values
+        if self.small:
+            other = "the same point" if top_row == row else locate(top_row)
+            what = f"over 1e51 times smaller than the largest coordinate, {top!r} ({other})"
+        else:
+            what = "over 1e51 times larger than the diagram's scale"
+        return (
+            f"{locate(row)}: coordinate {value!r} is {what}: exact arithmetic covers a range of 2^170 "
+            f"(about 1e51) around the largest coordinate; round tiny values to 0, or remove the outlier"
+        )

@@ -2,23 +2,19 @@
 
 from __future__ import annotations
 
-import errno
-import os
-import secrets
-import stat
-import sys
-from contextlib import contextmanager
-from typing import BinaryIO, Callable, Iterator
+from typing import Callable
 
 import numpy as np
 import orjson
 
 from tvoronoi.bulk import gc_paused
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.writers.targets import STDOUT, TEMP_SUFFIX, AtomicFile, StdoutFile, open_output, output_file
 
-__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT"]
+# the output targets live in tvoronoi.writers.targets and stay importable from here
+__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT",
+           "AtomicFile", "StdoutFile", "TEMP_SUFFIX"]
 
-STDOUT = "-"
 # features serialized per orjson call: large enough to amortise numpy and orjson
 # calls, small enough that a chunk of text stays a few megabytes
 CHUNK_FEATURES = 10_000
@@ -26,9 +22,6 @@ CHUNK_FEATURES = 10_000
 MIN_RING_POINTS = 3
 # property names tvoronoi writes itself; a site property of the same name is renamed
 RESERVED = ("site", "duplicates")
-TEMP_SUFFIX = ".tmp"
-NEW_FILE_MODE = 0o666  # before the umask, as open() would create it
-WRITE_BUFFER = 1 << 20
 
 ProgressCallback = Callable[[int, int], None]
 
@@ -39,141 +32,42 @@ _POLYGON = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]
 _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
+# GeoJSON text sequences (RFC 8142): each feature opens with a record separator and ends a line
+RS = b"\x1e"
+# how features are framed: a FeatureCollection, an RFC 8142 sequence, or one feature per line
+LAYOUTS = ("collection", "seq", "lines")
 
 
-# ---------------------------------------------------------------------------
-# output files
+class _Framing:
+    """Writes features in chunks as a FeatureCollection or as a GeoJSON sequence."""
 
+    def __init__(self, stream, layout: str, bbox: bytes):
+        if layout not in LAYOUTS:
+            raise TvoronoiError(f"unknown GeoJSON layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
+        self.stream, self.layout, self.first = stream, layout, True
+        if layout == "collection":
+            stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
 
-class AtomicFile:
-    """A binary file written under a temporary name beside its target, renamed into place on commit.
-
-    The temporary file ``.NAME.tvoronoi-XXXXXXXX.tmp`` lives in the target's
-    directory, so that ``os.replace`` is a rename within one file system: the
-    target either keeps its old content or gets the complete new one.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The target. A symbolic link is followed: the file it points to is replaced.
-    overwrite : bool
-        Replace an existing target; if False, ``FileExistsError`` is raised when the
-        target exists, on opening and again just before the rename.
-
-    Raises
-    ------
-    FileExistsError
-        The target exists and ``overwrite`` is False.
-    OSError
-        The directory is missing or not writable, or the target is a directory.
-    """
-
-    def __init__(self, path: str | os.PathLike, *, overwrite: bool = True):
-        self.path = os.fspath(path)
-        self.target = os.path.realpath(self.path) if os.path.islink(self.path) else self.path
-        self.overwrite = overwrite
-        self.done = False
-        self._check_target()
-        directory, name = os.path.split(os.path.abspath(self.target))
-        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
-        while True:
-            self.temp = os.path.join(directory, f".{name}.tvoronoi-{secrets.token_hex(4)}{TEMP_SUFFIX}")
-            try:
-                fd = os.open(self.temp, flags, NEW_FILE_MODE)
-            except FileExistsError:  # a name another run holds: draw again
-                continue
-            break
-        self.file: BinaryIO = os.fdopen(fd, "wb", buffering=WRITE_BUFFER)
-
-    def _check_target(self) -> None:
-        if os.path.isdir(self.target):
-            raise IsADirectoryError(errno.EISDIR, "is a directory", self.path)
-        if not self.overwrite and os.path.lexists(self.path):
-            raise FileExistsError(errno.EEXIST, "file exists", self.path)
-
-    def commit(self) -> None:
-        """Flush the data to disk and rename the file into place (keeping an old target's mode)."""
-        try:
-            self.file.flush()
-            os.fsync(self.file.fileno())
-            self.file.close()
-            self._check_target()
-            try:
-                os.chmod(self.temp, stat.S_IMODE(os.stat(self.target).st_mode))
-            except FileNotFoundError:
-                pass
-            os.replace(self.temp, self.target)
-        except BaseException:
-            self.discard()
-            raise
-        self.done = True
-
-    def discard(self) -> None:
-        """Close and remove the temporary file; the target is left as it was. No-op after commit."""
-        if self.done:
+    def write(self, features: list[bytes]) -> None:
+        if not features:
             return
-        self.done = True
-        try:
-            self.file.close()
-        except OSError:
-            pass
-        try:
-            os.unlink(self.temp)
-        except FileNotFoundError:
-            pass
+        if self.layout == "collection":
+            if not self.first:
+                self.stream.write(_SEPARATOR)
+            self.stream.write(_SEPARATOR.join(features))
+        else:
+            prefix = RS if self.layout == "seq" else b""
+            self.stream.write(b"".join(b"%b%b\n" % (prefix, feature) for feature in features))
+        self.first = False
+
+    def close(self) -> None:
+        if self.layout == "collection":
+            self.stream.write(b"\n]}\n")
 
 
-class StdoutFile:
-    """Standard output with the interface of :class:`AtomicFile` (it cannot be atomic: commit flushes)."""
-
-    path = STDOUT
-
-    def __init__(self):
-        self.file: BinaryIO = sys.stdout.buffer
-
-    def commit(self) -> None:
-        self.file.flush()
-
-    def discard(self) -> None:
-        pass
-
-
-def output_file(out, *, overwrite: bool = True) -> AtomicFile | StdoutFile:
-    """An :class:`AtomicFile` for a path, a :class:`StdoutFile` for ``"-"``.
-
-    Write to ``.file``, then call ``.commit()`` on success or ``.discard()`` on failure.
-    """
-    if isinstance(out, str) and out == STDOUT:
-        return StdoutFile()
-    return AtomicFile(out, overwrite=overwrite)
-
-
-@contextmanager
-def open_output(out, *, overwrite: bool = True) -> Iterator[BinaryIO]:
-    """A binary stream for ``out``: a path (written atomically), ``"-"`` (stdout) or an open binary file.
-
-    A path is written through an :class:`AtomicFile`: it is renamed into place
-    when the block ends normally and removed when the block raises, so a
-    failure never leaves half a file and never touches an existing one.
-    Standard output is flushed at the end; an open file is used as it is.
-
-    Raises
-    ------
-    FileExistsError
-        If ``overwrite`` is False and the path exists.
-    OSError
-        If the file cannot be created or written.
-    """
-    if hasattr(out, "write"):
-        yield out
-        return
-    target = output_file(out, overwrite=overwrite)
-    try:
-        yield target.file
-    except BaseException:
-        target.discard()
-        raise
-    target.commit()
+def _rounded(xy: np.ndarray, precision: int | None) -> np.ndarray:
+    """Coordinates rounded to ``precision`` decimal digits (None: as computed)."""
+    return xy if precision is None else np.round(xy, precision)
 
 
 # ---------------------------------------------------------------------------
@@ -302,7 +196,7 @@ def _bbox_member(bbox) -> bytes:
 
 
 def write_cells(diagram, points, out, *, progress: ProgressCallback | None = None,
-                overwrite: bool = True) -> int:
+                overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
     """Write the Voronoi cells as an RFC 7946 GeoJSON FeatureCollection.
 
     One Polygon feature per distinct site, in input order, one feature per
@@ -331,6 +225,15 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
         Called with the number of features written so far and in all.
     overwrite : bool
         Replace an existing file at ``out``.
+    precision : int, optional
+        Round coordinates to this many decimal digits (smaller files; a cell
+        narrower than the rounding may then collapse or self-touch).
+    layout : {"collection", "seq", "lines"}
+        A FeatureCollection; or a GeoJSON text sequence (RFC 8142), each feature
+        after a record separator (0x1E) and ending a line, as GDAL writes
+        ``.geojsons``; or newline-delimited features, as GDAL writes
+        ``.geojsonl`` and jq reads without options. GDAL's GeoJSONSeq driver
+        reads both.
 
     Returns
     -------
@@ -352,15 +255,16 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     total = int(distinct.sum())
     done = 0
     with open_output(out, overwrite=overwrite) as stream, gc_paused():
-        bbox = _bbox_member(diagram.bbox) if has_ring.any() else b""
-        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+        bbox = _bbox_member(_rounded(np.asarray(diagram.bbox, np.float64), precision)) if has_ring.any() else b""
+        frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)
         for a in range(0, n_sites, CHUNK_FEATURES):
             b = min(a + CHUNK_FEATURES, n_sites)
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
-            text, starts, stops = _ring_texts(*_closed_rings(diagram, a, b, keep))
+            xy, first, last = _closed_rings(diagram, a, b, keep)
+            text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
             features = []
             for i, ring in zip(rows[a:b][distinct[a:b]].tolist(), keep[distinct[a:b]].tolist()):
@@ -371,23 +275,21 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
                     features.append(_NULL % properties(i))
             if not features:
                 continue
-            if done:
-                stream.write(_SEPARATOR)
-            stream.write(_SEPARATOR.join(features))
+            frame.write(features)
             done += len(features)
             if progress is not None:
                 progress(done, total)
-        stream.write(b"\n]}\n")
+        frame.close()
     return done
 
 
 def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
-                   overwrite: bool = True) -> int:
+                   overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
     """Write the Delaunay triangles as a GeoJSON FeatureCollection of Polygons.
 
     Each triangle is a closed counter-clockwise ring of its three sites, with
-    properties ``{"sites": [i, j, k]}`` (0-based input rows). Output, progress
-    and errors as in :func:`write_cells`.
+    properties ``{"sites": [i, j, k]}`` (0-based input rows). Output, progress,
+    precision, layout and errors as in :func:`write_cells`.
 
     Returns
     -------
@@ -402,8 +304,8 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
             used = np.zeros(diagram.n_sites, bool)
             used[triangles.ravel()] = True
             corners = diagram.sites[used]
-            bbox = _bbox_member([*corners.min(axis=0), *corners.max(axis=0)])
-        stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
+            bbox = _bbox_member(_rounded(np.array([*corners.min(axis=0), *corners.max(axis=0)]), precision))
+        frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)
         for a in range(0, total, CHUNK_FEATURES):
@@ -411,15 +313,13 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
             # ring i, j, k, i
             xy = np.take(diagram.sites, chunk[:, [0, 1, 2, 0]].ravel(), axis=0)
             first = np.arange(0, 4 * len(chunk), 4, dtype=np.int64)
-            text, starts, stops = _ring_texts(xy, first, first + 3)
+            text, starts, stops = _ring_texts(_rounded(xy, precision), first, first + 3)
             features = [
                 _TRIANGLE % (text[start:stop], i, j, k)
                 for start, stop, (i, j, k) in zip(starts, stops, chunk.tolist())
             ]
-            if a:
-                stream.write(_SEPARATOR)
-            stream.write(_SEPARATOR.join(features))
+            frame.write(features)
             if progress is not None:
                 progress(a + len(chunk), total)
-        stream.write(b"\n]}\n")
+        frame.close()
     return total

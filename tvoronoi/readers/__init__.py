@@ -11,6 +11,7 @@ from pathlib import Path
 from ..errors import InputFileError, TvoronoiError
 from .geojson import _read_geojson
 from .npy import NPY_MAGIC, _read_npy
+from .parquet import PARQUET_MAGIC, _read_parquet
 from .pointset import PointSet
 from .tabular import COMMENT, _read_table
 
@@ -21,9 +22,11 @@ from .tabular import _fast_table, _line_offset, _slow_table, _table_layout  # no
 
 __all__ = ["FORMATS", "PointSet", "read_points"]
 
-FORMATS = ("csv", "text", "geojson", "npy")
+FORMATS = ("csv", "text", "geojson", "npy", "parquet")
 EXTENSIONS = {
     ".csv": "csv",
+    ".tsv": "csv",
+    ".tab": "csv",
     ".txt": "text",
     ".xy": "text",
     ".dat": "text",
@@ -31,6 +34,38 @@ EXTENSIONS = {
     ".geojson": "geojson",
     ".json": "geojson",
     ".npy": "npy",
+    ".parquet": "parquet",
+    ".geoparquet": "parquet",
+    ".pq": "parquet",
+}
+# the separator of a CSV file with this extension (others are found from the first rows)
+DELIMITER_OF = {".tsv": "\t", ".tab": "\t"}
+_GDAL = "ogr2ogr -f GeoJSON points.geojson {source} (GDAL), or geopandas: read_file(...).to_parquet(...)"
+# formats that are not read, by their first bytes and by extension: (name, how to convert)
+UNSUPPORTED_MAGIC = (
+    (b"SQLite format 3\x00", "GeoPackage (SQLite database)", _GDAL),
+    (b"\x00\x00\x27\x0a", "shapefile", _GDAL),
+    (b"fgb\x03", "FlatGeobuf", _GDAL),
+    (b"\x1f\x8b", "gzip-compressed",
+     "gunzip -k {source}, or pipe it: gunzip -c {source} | tvoronoi batch - -o ..."),
+    (b"PK\x03\x04", "zip archive",
+     "unzip it and give the point file inside (a zipped shapefile converts directly: "
+     "ogr2ogr -f GeoJSON points.geojson /vsizip/{source})"),
+)
+UNSUPPORTED_EXTENSIONS = {
+    ".gpkg": ("GeoPackage", _GDAL),
+    ".shp": ("shapefile", _GDAL),
+    ".shx": ("shapefile index", "give the .shp file to " + _GDAL),
+    ".dbf": ("shapefile attribute table (dBASE)", "give the .shp file to " + _GDAL),
+    ".fgb": ("FlatGeobuf", _GDAL),
+    ".kml": ("KML", _GDAL),
+    ".kmz": ("KMZ (zipped KML)", _GDAL),
+    ".gml": ("GML", _GDAL),
+    ".zip": UNSUPPORTED_MAGIC[-1][1:],
+    ".gz": UNSUPPORTED_MAGIC[-2][1:],
+    ".xlsx": ("Excel workbook", "save the sheet as CSV (File > Save As > CSV)"),
+    ".xls": ("Excel workbook", "save the sheet as CSV (File > Save As > CSV)"),
+    ".ods": ("OpenDocument spreadsheet", "save the sheet as CSV (File > Save As > CSV)"),
 }
 STDIN = "-"
 STDIN_SOURCE = "<stdin>"
@@ -43,8 +78,12 @@ def read_points(
     x: str | int | None = None,
     y: str | int | None = None,
     fmt: str | None = None,
+    delimiter: str | None = None,
 ) -> PointSet:
-    """Read sites from a CSV, whitespace-text, GeoJSON or .npy file, or standard input.
+    """Read sites from a CSV, whitespace-text, GeoJSON, .npy or (Geo)Parquet file, or standard input.
+
+    A GeoParquet file gives the points of its primary geometry column and its CRS;
+    a plain Parquet file its x/y columns, chosen as a CSV file's are.
 
     Parameters
     ----------
@@ -55,8 +94,12 @@ def read_points(
         (int or digit string) or ``"colN"`` (1-based). By default the columns
         named x/lon/lng/long/longitude and y/lat/latitude, else the first two
         numeric columns.
-    fmt : {None, "csv", "text", "geojson", "npy"}
+    fmt : {None, "csv", "text", "geojson", "npy", "parquet"}
         The format; ``None`` detects it from the extension, else from the content.
+    delimiter : str, optional
+        The field separator of a CSV file (one character); by default a tab for
+        ``.tsv``, else the one of ",", ";", tab and "|" that splits the first rows
+        evenly. In a ";"-separated file, coordinates may have a decimal comma.
 
     Returns
     -------
@@ -67,21 +110,50 @@ def read_points(
     ------
     InputFileError
         If the file is missing or unreadable, has no points, or holds a value that
-        is not a finite coordinate; the message names the file, the line (or the
-        feature or row) and the fix.
+        is not a finite coordinate, or is in a format tvoronoi does not read
+        (GeoPackage, shapefile, zip, ...); the message names the file, the line
+        (or the feature or row) and the fix.
     TvoronoiError
         If ``fmt`` is unknown, or ``x``/``y`` are given for a GeoJSON file.
     """
     if fmt is not None and fmt not in FORMATS:
         raise TvoronoiError(f"unknown format {fmt!r}; choose one of: {', '.join(FORMATS)}")
+    if delimiter is not None and len(delimiter) != 1:
+        raise TvoronoiError(f"--delimiter {delimiter!r}: give one character, e.g. ';' or '\\t'")
     source, suffix, data = _read_bytes(path)
+    _refuse_unsupported(data, suffix if fmt is None else "", source)
     if fmt is None:
         fmt = EXTENSIONS.get(suffix) or _sniff_format(data)
+    if delimiter is not None and fmt not in ("csv", "text"):
+        raise TvoronoiError(f"{source}: --delimiter applies to CSV files, and this is read as {fmt}")
+    if delimiter is not None or suffix in DELIMITER_OF:
+        fmt = "csv"
+        delimiter = delimiter or DELIMITER_OF[suffix]
     if fmt == "npy":
         return _read_npy(data, source, x, y)
+    if fmt == "parquet":
+        return _read_parquet(data, source, x, y)
     if fmt == "geojson":
         return _read_geojson(data, source, x, y, _loads_json)
-    return _read_table(_decode(data, source), source, fmt, x, y)
+    return _read_table(_decode(data, source), source, fmt, x, y, delimiter)
+
+
+def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
+    """Name a format that is not read, and how to convert it, rather than fail on its bytes."""
+    found = next(((name, how) for magic, name, how in UNSUPPORTED_MAGIC if data.startswith(magic)), None)
+    if found is None:
+        found = UNSUPPORTED_EXTENSIONS.get(suffix)
+    if found is None and _is_binary(data):
+        raise InputFileError(
+            f"{source}: a binary file, not a point file; tvoronoi reads CSV, text, GeoJSON, .npy and "
+            f"(Geo)Parquet: give one of those"
+        )
+    if found is not None:
+        name, how = found
+        raise InputFileError(
+            f"{source}: this is a {name} file, which tvoronoi does not read; convert it to GeoJSON, "
+            f"GeoParquet or CSV first, e.g. {how.format(source=source)}"
+        )
 
 
 # ---------------------------------------------------------------------------
@@ -112,10 +184,27 @@ def _read_bytes(path) -> tuple[str, str, bytes]:
     return source, p.suffix.lower(), data
 
 
+def _is_binary(data: bytes) -> bool:
+    """Whether the first bytes hold a NUL and are not UTF-8 (nor UTF-16, .npy, Parquet): a binary file.
+
+    A text file with a stray NUL is still text: the reader names the line that holds it.
+    """
+    head = data[:SNIFF_BYTES]
+    if b"\x00" not in head or head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE, NPY_MAGIC, PARQUET_MAGIC)):
+        return False
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as e:
+        return e.start < len(head) - 4  # not a character cut at the end of the head
+    return False
+
+
 def _sniff_format(data: bytes) -> str:
     """Guess the format from the first bytes: npy magic, a JSON object, a comma, else text."""
     if data.startswith(NPY_MAGIC):
         return "npy"
+    if data.startswith(PARQUET_MAGIC):
+        return "parquet"
     head = _decode_lenient(data[:SNIFF_BYTES]).lstrip()
     if head.startswith("{"):
         return "geojson"

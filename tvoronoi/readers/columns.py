@@ -8,10 +8,33 @@ import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
 
-# column names recognised in any case, in order of preference
-X_NAMES = ("x", "lon", "lng", "long", "longitude")
-Y_NAMES = ("y", "lat", "latitude")
+# column names recognised in any case, in order of preference; "e" and "n" only as a pair
+X_NAMES = ("x", "lon", "lng", "long", "longitude", "easting", "e")
+Y_NAMES = ("y", "lat", "latitude", "northing", "n")
+PAIRED_ONLY = {"e": "n", "n": "e"}
+# names of longitude and latitude columns: their sites are lon/lat degrees
+LON_NAMES = ("lon", "lng", "long", "longitude")
+LAT_NAMES = ("lat", "latitude")
+# words that make a column an identifier, never a coordinate taken by position
+ID_WORDS = frozenset(
+    "id fid gid oid uid pk key idx index row rowid rownum no num number objectid code zip zipcode "
+    "postcode postal plz fips geoid unnamed".split()
+)
 _COL_NAME = re.compile(r"col([0-9]+)", re.IGNORECASE)
+_WORDS = re.compile(r"[A-Z]?[a-z]+|[A-Z]+(?![a-z])|[0-9]+")
+
+
+def is_id_like(name: str) -> bool:
+    """Whether a column name reads as an identifier: "id", "FID", "row", "station_id", "cityId", "Unnamed: 0".
+
+    >>> [is_id_like(n) for n in ("id", "OBJECTID", "site_no", "zip", "x", "height", "grid")]
+    [True, True, True, True, False, False, False]
+    """
+    lowered = name.strip().lower()
+    if lowered in ID_WORDS or lowered.endswith(("_id", "-id", " id", ".id")):
+        return True
+    words = [w.lower() for w in _WORDS.findall(name)]
+    return bool(words) and (words[-1] in ID_WORDS or words[0] in ("unnamed", "index"))
 
 
 def _col_name(j: int) -> str:
@@ -35,9 +58,12 @@ def _resolve_column(sel, role: str, names: list[str], by_name: bool, source: str
     if sel is None:
         if not by_name:
             return None
+        lowered = [name.lower() for name in names]
         for candidate in X_NAMES if role == "x" else Y_NAMES:
+            if candidate in PAIRED_ONLY and PAIRED_ONLY[candidate] not in lowered:
+                continue
             exact = [j for j, name in enumerate(names) if name == candidate]
-            loose = [j for j, name in enumerate(names) if name.lower() == candidate]
+            loose = [j for j, name in enumerate(lowered) if name == candidate]
             if exact or loose:
                 return (exact or loose)[0]
         return None
@@ -67,3 +93,16 @@ def _check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str =
     """Refuse x and y chosen as the same column (or field)."""
     if ix == iy:
         raise TvoronoiError(f'{source}: x and y are the same {noun} "{names[ix]}"; choose two {noun}s')
+
+
+def describe_choice(names: list[str], ix: int, iy: int, how: str, skipped: list[str] = ()) -> str | None:
+    """The line that tells which columns became x and y, e.g. 'x = "lon", y = "lat" (by name)';
+    None for columns named x and y, or a file of two columns, which leave nothing to tell."""
+    if how == "the two columns" or (how == "by name" and names[ix].lower() == "x" and names[iy].lower() == "y"):
+        return None
+    text = f'x = "{names[ix]}", y = "{names[iy]}" ({how})'
+    if skipped:
+        text += f"; skipped the id-like {'column' if len(skipped) == 1 else 'columns'} " + ", ".join(
+            f'"{name}"' for name in skipped
+        )
+    return text + "; choose others with --x/--y"

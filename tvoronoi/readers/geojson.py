@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -90,6 +91,9 @@ def _geojson_sites(doc, source: str):
 
 
 _NUMBER_TYPES = (int, float)
+CRS84 = "OGC:CRS84"
+# "urn:ogc:def:crs:EPSG::3857", "urn:ogc:def:crs:OGC:1.3:CRS84", "EPSG:3857"
+_CRS_NAME = re.compile(r"(?:urn:ogc:def:crs:)?(?P<authority>[A-Za-z]+):(?:[0-9.]*:)?(?P<code>[A-Za-z0-9]+)")
 
 
 def _position(position, source: str, where: str):
@@ -134,15 +138,18 @@ def _point_features(features: list):
 
 
 def _checked_sites(doc, source: str):
-    """(xs, ys, properties) of any GeoJSON document, each feature checked."""
+    """(xs, ys, properties, where) of any GeoJSON document, each feature checked; ``where`` names
+    the feature (and MultiPoint part) of each site."""
     xs: list = []
     ys: list = []
     records: list[dict] = []
-    for _, part, position, properties in _geojson_sites(doc, source):
+    wheres: list[str] = []
+    for where, part, position, properties in _geojson_sites(doc, source):
         xs.append(position[0])
         ys.append(position[1])
         records.append(properties if part is None else {**properties, "part": part})
-    return xs, ys, records
+        wheres.append(where if part is None else f"{where}, point {part}")
+    return xs, ys, records, wheres.__getitem__
 
 
 def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
@@ -162,7 +169,9 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
             sites = _point_features(doc["features"])
         if sites is None:
             sites = _checked_sites(doc, source)
-    xs, ys, records = sites
+        else:  # Point features only: site i is feature i
+            sites = (*sites, "features[{}]".format)
+    xs, ys, records, where = sites
     if not xs:
         raise InputFileError(f"{source}: no points found (no Point or MultiPoint features)")
     xy = np.empty((len(xs), 2), dtype=np.float64)
@@ -183,5 +192,32 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
         raise InputFileError(
             f"{source}, {where}: {role} is {position[0 if role == 'x' else 1]}; tvoronoi needs finite coordinates"
         )
-    return PointSet(xy, source, {}, records if any(records) else None)
+    crs = _crs_member(doc, source)
+    # the document is not kept: ``where`` holds one label per site at most
+    return PointSet(xy, source, {}, records if any(records) else None, crs=crs,
+                    lonlat=crs is None or crs == CRS84, where=where)
+
+
+def _crs_member(doc, source: str) -> str | None:
+    """The CRS a pre-RFC 7946 ``crs`` member names ("EPSG:3857"), None without one (RFC 7946: lon/lat).
+
+    ``{"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3857"}}``, as GDAL writes
+    it, gives "EPSG:3857"; OGC CRS84 and EPSG:4326 give "OGC:CRS84".
+    """
+    member = doc.get("crs") if isinstance(doc, dict) else None
+    if member is None:
+        return None
+    name = member.get("properties", {}).get("name") if isinstance(member, dict) else None
+    if not isinstance(name, str):
+        raise InputFileError(
+            f'{source}: the "crs" member names no CRS; expected {{"type": "name", "properties": '
+            f'{{"name": "urn:ogc:def:crs:EPSG::3857"}}}}, or drop it (RFC 7946 GeoJSON is lon/lat)'
+        )
+    match = _CRS_NAME.fullmatch(name.strip())
+    if match is None:
+        return name.strip()
+    authority, code = match["authority"].upper(), match["code"]
+    if (authority, code) in (("OGC", "CRS84"), ("EPSG", "4326")):
+        return CRS84
+    return f"{authority}:{code}"
 

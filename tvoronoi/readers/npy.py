@@ -7,7 +7,7 @@ import io
 import numpy as np
 
 from ..errors import InputFileError
-from .columns import _check_distinct, _col_name, _resolve_column
+from .columns import LAT_NAMES, LON_NAMES, _check_distinct, _col_name, _resolve_column, describe_choice, is_id_like
 from .pointset import PointSet, _json_column
 
 NPY_MAGIC = b"\x93NUMPY"
@@ -63,13 +63,18 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     names = list(array.dtype.names)
     ix = _resolve_column(x, "x", names, True, source)
     iy = _resolve_column(y, "y", names, True, source)
+    how, skipped = "by name", []
     if ix is None or iy is None:
-        free = [j for j, name in enumerate(names) if j not in (ix, iy) and array.dtype[name].kind in "iuf"]
+        numeric = [j for j, name in enumerate(names) if j not in (ix, iy) and array.dtype[name].kind in "iuf"]
+        skipped = [names[j] for j in numeric if is_id_like(names[j])]
+        free = [j for j in numeric if names[j] not in skipped]
         ix = free.pop(0) if ix is None and free else ix
         iy = free.pop(0) if iy is None and free else iy
+        how = "the first numeric fields"
     if ix is None or iy is None:
+        ids = f" (id-like fields are not taken: {', '.join(skipped)})" if skipped else ""
         raise InputFileError(
-            f"{source}: cannot find the x and y fields among {', '.join(names)}; choose them with --x/--y"
+            f"{source}: cannot find the x and y fields among {', '.join(names)}{ids}; choose them with --x/--y"
         )
     _check_distinct(ix, iy, names, source, noun="field")
     for j in (ix, iy):
@@ -85,7 +90,9 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     xy[:, 1] = array[names[iy]]
     _check_finite_rows(xy, source)
     columns = {names[j]: _json_column(array[names[j]]) for j in range(len(names)) if j not in (ix, iy)}
-    return PointSet(xy, source, columns)
+    lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
+    choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
+    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, where=lambda i: f"row {i} (0-based)")
 
 
 def _check_finite_rows(xy: np.ndarray, source: str) -> None:

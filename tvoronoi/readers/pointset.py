@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -31,12 +32,27 @@ class PointSet:
     records : list of dict or None
         Per-site properties (GeoJSON); ``None`` when the sites carry them in
         ``columns`` or have none.
+    crs : str or dict or None
+        The coordinate reference system the file declares ("EPSG:3857", a
+        PROJJSON dict), None when it declares none.
+    lonlat : bool
+        Whether the sites are longitude/latitude degrees: columns named so,
+        GeoJSON without a ``crs`` member (RFC 7946), or a geographic CRS.
+    choice : str or None
+        Which columns became x and y and why, for tables whose columns were not
+        all given by the caller; None otherwise.
+    where : callable(int) -> str, optional
+        Where site ``i`` is in the file ("line 7", "features[3]", "row 3").
     """
 
     xy: np.ndarray
     source: str
     columns: dict[str, list] = field(default_factory=dict)
     records: list[dict] | None = None
+    crs: str | dict | None = None
+    lonlat: bool = False
+    choice: str | None = None
+    where: Callable[[int], str] | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -73,17 +89,32 @@ class PointSet:
             return dict(self.records[i])
         return {name: values[i] for name, values in self.columns.items()}
 
+    def place(self, i: int) -> str:
+        """Where site ``i`` is in its file, for a message: "line 7", "features[3]", "row 3 (0-based)"."""
+        return self.where(i) if self.where is not None else f"row {i} (0-based)"
+
+    def locate(self, i: int) -> str:
+        """Where site ``i`` is, with the file: "data.csv, line 7"."""
+        return f"{self.source}, {self.place(i)}"
+
 
 # ---------------------------------------------------------------------------
 # JSON-ready values: from the text of a table field, from a numpy column
 
 
+_LEADING_ZERO = re.compile(r"^\s*[+-]?0[0-9]", re.MULTILINE)
+
+
 def _convert_value(s: str):
     """A property value: int for an int literal, float for a float literal, None for "" or a
-    non-finite number (JSON has none), else the string as written."""
+    non-finite number (JSON has none), else the string as written.
+
+    A number written with a leading zero ("01000", a zip code) stays a string."""
     t = s.strip()
     if not t:
         return None
+    if _LEADING_ZERO.match(t):
+        return s
     if _INT_LITERAL.fullmatch(t):
         value = int(t)
         # beyond 64 bits most JSON writers fail: keep the digits as text
@@ -95,30 +126,61 @@ def _convert_value(s: str):
 
 
 def _convert_column(values, plain: bool) -> list:
-    """``_convert_value`` over a column; ``plain`` (ASCII, no "_") lets int() and float() decide in bulk,
-    since on such text they accept exactly the literals the regexes describe."""
-    if plain:
+    """A table column as JSON-ready values of one type: the column is typed, not each value.
+
+    Empty values are None. The rest are ints if every one is an int literal (within 64 bits),
+    else floats if every one is a number (a non-finite one is None), else strings as written:
+    "01000" in a zip column stays "01000", and so does "7" in a column that also holds "7a".
+    ``plain`` (ASCII, no "_") lets int() and float() decide in bulk, since on such text they
+    accept exactly the literals the regexes describe.
+    """
+    if not values:
+        return []
+    if plain and not _LEADING_ZERO.search("\n".join(values)):
         try:
             ints = list(map(int, values))
         except ValueError:
-            pass
-        else:
-            if not ints or (INT64_MIN <= min(ints) and max(ints) <= INT64_MAX):
-                return ints
+            ints = None
+        if ints is not None and INT64_MIN <= min(ints) and max(ints) <= INT64_MAX:
+            return ints
         try:
+            if ints is not None:
+                raise ValueError("integers beyond 64 bits are kept as text")
             floats = np.fromiter(map(float, values), dtype=np.float64, count=len(values))
         except ValueError:
             pass
         else:
-            if np.isfinite(floats).all():
-                # float literals keep the parsed float, int literals go back through _convert_value
-                return [
-                    f if ("." in v or "e" in v or "E" in v) else _convert_value(v)
-                    for v, f in zip(values, floats.tolist())
-                ]
-    # mixed or text: convert each distinct value once
-    memo = {v: _convert_value(v) for v in set(values)}
+            out = floats.tolist()
+            for i in np.flatnonzero(~np.isfinite(floats)):
+                out[i] = None
+            return out
+    distinct = set(values)
+    if _is_text(distinct):
+        # a text column: as written, empty values null
+        blank = [v for v in distinct if not v.strip()]
+        if not blank:
+            return list(values)
+        return [None if not v.strip() else v for v in values]
+    # numbers and empty values: convert each distinct value once, then settle the column's type
+    memo = {v: _convert_value(v) for v in distinct}
+    kinds = {type(value) for value in memo.values()} - {type(None)}
+    if kinds <= {int}:
+        pass
+    elif kinds <= {int, float}:
+        memo = {v: None if value is None else float(value) for v, value in memo.items()}
+    else:
+        memo = {v: None if not v.strip() else v for v in memo}
     return list(map(memo.__getitem__, values))
+
+
+def _is_text(distinct) -> bool:
+    """Whether a column holds a value that is not a number, or a number with a leading zero
+    (stops at the first: a text column is told from its first values)."""
+    for v in distinct:
+        t = v.strip()
+        if t and (_LEADING_ZERO.match(t) or not _FLOAT_LITERAL.fullmatch(t)):
+            return True
+    return False
 
 
 def _json_column(values: np.ndarray) -> list:

@@ -13,14 +13,31 @@ from typing import Iterator
 import numpy as np
 
 from ..errors import InputFileError
-from .columns import X_NAMES, Y_NAMES, _as_index, _check_distinct, _col_name, _resolve_column
+from .columns import (
+    LAT_NAMES,
+    LON_NAMES,
+    X_NAMES,
+    Y_NAMES,
+    _as_index,
+    _check_distinct,
+    _col_name,
+    _resolve_column,
+    describe_choice,
+    is_id_like,
+)
 from tvoronoi.bulk import gc_paused
 
 from .pointset import PointSet, _convert_column
 
 LAYOUT_CHARS = 1 << 16
+# a table text up to this size is kept to name the line of a site in a later message
+KEEP_TEXT_CHARS = 8 << 20
 QUOTE = '"'
 COMMENT = "#"
+# field separators a CSV file may use, in order of preference when several fit
+DELIMITERS = (",", ";", "\t", "|")
+# rows the separator is guessed from
+SNIFF_ROWS = 20
 
 
 @dataclass(frozen=True)
@@ -33,21 +50,25 @@ class _Layout:
     first_line: int  # line of the first data row
     ix: int
     iy: int
+    delimiter: str = ","  # of a CSV file
+    choice: str | None = None  # which columns became x and y and why, when the caller chose neither
 
 
-def _read_table(text: str, source: str, kind: str, x, y) -> PointSet:
+def _read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = None) -> PointSet:
     # the header and the first data row are near the top: look there first, so that
     # a large file is not scanned for them
     head = text
     if len(text) > LAYOUT_CHARS:
         head = text[: text.find("\n", LAYOUT_CHARS) + 1] or text
+    if kind == "csv" and delimiter is None:
+        delimiter = sniff_delimiter(head)
     try:
-        layout = _table_layout(head, source, kind, x, y)
+        layout = _table_layout(head, source, kind, x, y, delimiter or ",")
     except InputFileError:
         if head is text:
             raise
         head = text
-        layout = _table_layout(text, source, kind, x, y)
+        layout = _table_layout(text, source, kind, x, y, delimiter or ",")
     body = text[_line_offset(head, layout.header_lines) :]
     try:
         fast = _fast_table(body, kind, layout)
@@ -56,16 +77,74 @@ def _read_table(text: str, source: str, kind: str, x, y) -> PointSet:
     if fast is None:
         # the fast path met something it does not handle or a bad value: walk the
         # file row by row, which either reads it or names the first bad line
-        return _slow_table(text, source, kind, layout)
-    xy, columns = fast
-    return PointSet(xy, source, columns)
+        points = _slow_table(text, source, kind, layout)
+    else:
+        points = PointSet(fast[0], source, fast[1])
+        points.where = _fast_lines(text, body, source, kind, layout, len(points))
+    if points.where is not None:
+        points.where = _line_label(points.where)
+    names = [name.strip().lower() for name in (layout.names[layout.ix], layout.names[layout.iy])]
+    points.lonlat = layout.has_header and names[0] in LON_NAMES and names[1] in LAT_NAMES
+    points.choice = layout.choice
+    return points
+
+
+def _fast_lines(text: str, body: str, source: str, kind: str, layout: _Layout, n_rows: int):
+    """The line of each row, as a function of the row, for messages about a site.
+
+    When every row is one line (no blank line, comment or field over lines) it is
+    arithmetic; else a walk of the rows, kept only for a text of up to KEEP_TEXT_CHARS
+    (a large text is not held for a message: None, and rows are named by index).
+    """
+    breaks = body.count("\n")
+    if "\r" not in body.replace("\r\n", "") and breaks - (0 if body.endswith("\n") else -1) == n_rows:
+        first = layout.first_line
+        return lambda i: first + i
+    if len(text) > KEEP_TEXT_CHARS:
+        return None
+
+    def line_of(i: int) -> int:
+        records = _records(text, kind, source, layout.delimiter)
+        if layout.has_header:
+            next(records, None)
+        for k, (line_no, _) in enumerate(records):
+            if k == i:
+                return line_no
+        raise IndexError(i)
+
+    return line_of
+
+
+def _line_label(line_of):
+    return lambda i: f"line {int(line_of(i))}"
+
+
+def sniff_delimiter(head: str) -> str:
+    """The separator of a CSV file from its first rows: the one that splits them all into the
+    same number of fields (at least two), the most fields first; "," when none does.
+
+    >>> sniff_delimiter("x;y\n1,5;2,25\n")
+    ';'
+    """
+    lines = [line for line in head.splitlines() if line.strip() and not line.startswith(COMMENT)][:SNIFF_ROWS]
+    if len(lines) > 1 and not head.endswith(("\n", "\r")) and len(head) >= LAYOUT_CHARS:
+        lines = lines[:-1]  # cut off mid-line
+    best, best_fields = ",", 1
+    for delimiter in DELIMITERS:
+        try:
+            counts = {len(row) for row in csv.reader(lines, delimiter=delimiter)}
+        except csv.Error:
+            continue
+        if len(counts) == 1 and (fields := counts.pop()) > best_fields:
+            best, best_fields = delimiter, fields
+    return best
 
 
 # ---------------------------------------------------------------------------
 # rows with their line numbers; the layout: header, column names, x and y
 
 
-def _records(text: str, kind: str, source: str) -> Iterator[tuple[int, list[str]]]:
+def _records(text: str, kind: str, source: str, delimiter: str = ",") -> Iterator[tuple[int, list[str]]]:
     """Yield (line number, fields) for each non-blank row of a table; line numbers are 1-based."""
     if kind == "text":
         for line_no, line in enumerate(io.StringIO(text, newline=""), 1):
@@ -73,7 +152,7 @@ def _records(text: str, kind: str, source: str) -> Iterator[tuple[int, list[str]
             if fields:
                 yield line_no, fields
         return
-    reader = csv.reader(io.StringIO(text, newline=""))
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)
     start = 1
     try:
         for fields in reader:
@@ -105,19 +184,32 @@ def _is_number(s: str) -> bool:
     return True
 
 
-def _table_layout(text: str, source: str, kind: str, x, y) -> _Layout:
+def _is_decimal_comma_number(s: str) -> bool:
+    """A number with a decimal point or (spreadsheets' semicolon CSV) a decimal comma."""
+    return _is_number(s) or (s.count(",") == 1 and _is_number(s.replace(",", ".")))
+
+
+def _decimal_points(values, delimiter: str):
+    """Coordinates of a semicolon-separated file may have a decimal comma ("1,5"): read it as a point."""
+    if delimiter != ";":
+        return values
+    return [v.replace(",", ".") for v in values]
+
+
+def _table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") -> _Layout:
     """Find the header (if any), the column names and the x and y columns from the first rows."""
-    records = _records(text, kind, source)
+    records = _records(text, kind, source, delimiter)
     first = next(records, None)
     if first is None:
         why = "the file is empty" if not text.strip() else "the file has no data rows"
         raise InputFileError(f"{source}: no points found ({why})")
     line_no, fields = first
-    has_header = _is_header(fields, x, y, records)
+    number = _is_decimal_comma_number if kind == "csv" and delimiter == ";" else _is_number
+    has_header = _is_header(fields, x, y, records, number)
     if has_header:
         names = _unique_names([f.strip() for f in fields])
-        header_lines = _header_end(text, kind, source)
-        records = _records(text, kind, source)
+        header_lines = _header_end(text, kind, source, delimiter)
+        records = _records(text, kind, source, delimiter)
         next(records)
         data = next(records, None)
         if data is None:
@@ -128,30 +220,35 @@ def _table_layout(text: str, source: str, kind: str, x, y) -> _Layout:
         header_lines, first_line, first_fields = 0, line_no, fields
     ix = _resolve_column(x, "x", names, has_header, source)
     iy = _resolve_column(y, "y", names, has_header, source)
+    how = "by name" if has_header else "the first two columns"
+    skipped: list[str] = []
     if ix is None or iy is None:
-        # the first numeric columns of the first data row that are not taken
-        free = [
-            j
-            for j, f in enumerate(first_fields[: len(names)])
-            if j not in (ix, iy) and _is_number(f)
-        ]
+        # the first numeric columns of the first data row that are not taken, and not ids
+        numeric = [j for j, f in enumerate(first_fields[: len(names)]) if j not in (ix, iy) and number(f)]
+        skipped = [names[j] for j in numeric if has_header and is_id_like(names[j])]
+        free = [j for j in numeric if names[j] not in skipped]
         if ix is None and free:
             ix = free.pop(0)
         if iy is None and free:
             iy = free.pop(0)
+        how = "the first numeric columns" if has_header or len(names) > 2 else "the two columns"
     if ix is None or iy is None:
         missing = " and ".join(role for role, i in (("x", ix), ("y", iy)) if i is None)
         noun = "columns" if ix is None and iy is None else "column"
+        ids = f" (id-like columns are not taken: {', '.join(skipped)})" if skipped else ""
         raise InputFileError(
             f"{source}, line {first_line}: cannot find the {missing} {noun}: no header names it "
-            f"and the row has too few numeric columns; columns: {', '.join(names)}; "
+            f"and the row has too few numeric columns{ids}; columns: {', '.join(names)}; "
             f"choose them with --x/--y"
         )
     _check_distinct(ix, iy, names, source)
-    return _Layout(names, has_header, header_lines, first_line, ix, iy)
+    choice = None
+    if x is None or y is None:
+        choice = describe_choice(names, ix, iy, how if x is None and y is None else "by option and " + how, skipped)
+    return _Layout(names, has_header, header_lines, first_line, ix, iy, delimiter, choice)
 
 
-def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]]) -> bool:
+def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]], number=_is_number) -> bool:
     """Whether the first row ``fields`` is a header: a row whose x/y candidates are not numbers.
 
     The candidates are the columns chosen by index, else the row's first two numeric fields
@@ -159,7 +256,7 @@ def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]]
     can hold such a name as a value ("1,2,lat"): then the row is a header only if the next
     row has a number where it has the name ("x,y,2019" over "1,2,7").
     """
-    numeric = [_is_number(f) for f in fields]
+    numeric = [number(f) for f in fields]
     lowered = [f.strip().lower() for f in fields]
     chosen = [s.strip().lower() for s in (x, y) if isinstance(s, str) and _as_index(s) is None]
     if any(name in lowered for name in chosen):
@@ -171,14 +268,14 @@ def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]]
     if not named:
         return False
     second = next(records, None)
-    return second is not None and any(j < len(second[1]) and _is_number(second[1][j]) for j in named)
+    return second is not None and any(j < len(second[1]) and number(second[1][j]) for j in named)
 
 
-def _header_end(text: str, kind: str, source: str) -> int:
+def _header_end(text: str, kind: str, source: str, delimiter: str = ",") -> int:
     """Number of physical lines up to the end of the first non-blank row (the header)."""
     if kind == "text":
         return next(_records(text, kind, source))[0]
-    reader = csv.reader(io.StringIO(text, newline=""))
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)
     for fields in reader:
         if not _is_blank(fields):
             return reader.line_num
@@ -207,13 +304,13 @@ def _fast_table(body: str, kind: str, layout: _Layout):
     """Read the rows after the header in bulk; None (or ValueError) when a row needs a closer look."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     n_cols = len(names)
-    if n_cols == 2:
+    if n_cols == 2 and layout.delimiter != ";":
         # only coordinates: numpy's C reader, which also checks every row has two fields
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             if kind == "csv":
                 table = np.loadtxt(
-                    io.StringIO(body), dtype=np.float64, delimiter=",", quotechar=QUOTE,
+                    io.StringIO(body), dtype=np.float64, delimiter=layout.delimiter, quotechar=QUOTE,
                     comments=None, ndmin=2,
                 )
             else:
@@ -224,7 +321,7 @@ def _fast_table(body: str, kind: str, layout: _Layout):
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
         if kind == "csv":
-            rows = list(csv.reader(io.StringIO(body, newline="")))
+            rows = list(csv.reader(io.StringIO(body, newline=""), delimiter=layout.delimiter))
         else:
             if "\r" in body and "\r" in body.replace("\r\n", ""):
                 return None  # a line ending in a lone CR (old Mac): the row walk splits there
@@ -240,18 +337,21 @@ def _fast_table(body: str, kind: str, layout: _Layout):
         columns = list(zip(*rows))
         del rows
     xy = np.empty((len(columns[0]), 2), dtype=np.float64)
-    xy[:, 0] = np.fromiter(map(float, columns[ix]), dtype=np.float64, count=len(xy))
-    xy[:, 1] = np.fromiter(map(float, columns[iy]), dtype=np.float64, count=len(xy))
+    for k, j in enumerate((ix, iy)):
+        values = _decimal_points(columns[j], layout.delimiter)
+        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
     if not np.isfinite(xy).all():
         return None
     return xy, _extras(columns, layout, body)
 
 
 def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
-    """Read a table row by row, keeping line numbers, and raise on the first row that is not a site."""
+    """Read a table row by row, keeping line numbers, and raise on the first row that is not a site.
+
+    The sites' ``where`` gives the line number of each row (not yet a label)."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     n_cols = len(names)
-    records = _records(text, kind, source)
+    records = _records(text, kind, source, layout.delimiter)
     if layout.has_header:
         next(records)
     line_nos: list[int] = []
@@ -271,15 +371,19 @@ def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
         columns = list(zip(*rows))
         del rows
     xy = np.empty((len(line_nos), 2), dtype=np.float64)
-    xy[:, 0] = _floats_or_nan(columns[ix])
-    xy[:, 1] = _floats_or_nan(columns[iy])
+    xy[:, 0] = _floats_or_nan(_decimal_points(columns[ix], layout.delimiter))
+    xy[:, 1] = _floats_or_nan(_decimal_points(columns[iy], layout.delimiter))
     bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
     if len(bad):
         # the first bad row: x is checked before y, as it reads
         r = bad[0]
         for j, role in ((ix, "x"), (iy, "y")):
-            _coordinate(columns[j][r], role, names[j], line_nos[r], source, layout.has_header)
-    return PointSet(xy, source, _extras(columns, layout, text))
+            text = columns[j][r]
+            _coordinate(_decimal_points([text], layout.delimiter)[0], role, names[j], line_nos[r], source,
+                        layout.has_header, text)
+    points = PointSet(xy, source, _extras(columns, layout, text))
+    points.where = np.asarray(line_nos, np.int64).__getitem__
+    return points
 
 
 def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
@@ -323,13 +427,14 @@ def _row_shape(layout: _Layout) -> str:
     return f"the first row (line {layout.first_line}) has {n_cols}"
 
 
-def _coordinate(text: str, role: str, name: str, line_no: int, source: str, named: bool) -> float:
+def _coordinate(text: str, role: str, name: str, line_no: int, source: str, named: bool,
+                written: str | None = None) -> float:
     column = f'column "{name}"' if name == role else f'column "{name}" ({role})'
     try:
         value = float(text)
     except ValueError:
         raise InputFileError(
-            f"{source}, line {line_no}: {_quoted(text)} in {column} is not a number; "
+            f"{source}, line {line_no}: {_quoted(text if written is None else written)} in {column} is not a number; "
             f"fix the value, or choose other columns with --x/--y"
         ) from None
     if not math.isfinite(value):

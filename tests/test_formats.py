@@ -1,0 +1,210 @@
+"""Batch output formats (GeoJSON, GeoJSONSeq, GeoParquet) and Parquet input, read back and checked."""
+
+from __future__ import annotations
+
+import io
+import json
+import sys
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+import pytest
+import shapely
+
+from conftest import DATASETS
+from tvoronoi import cli
+
+pa = pytest.importorskip("pyarrow")
+pq = pytest.importorskip("pyarrow.parquet")
+
+SITES = np.concatenate([DATASETS["uniform"][:50], DATASETS["uniform"][[3]]])  # row 50 repeats row 3
+
+
+@pytest.fixture
+def points_csv(tmp_path):
+    lines = ["zip,x,y,name,score"]
+    for i, (x, y) in enumerate(SITES.tolist()):
+        lines.append(f"{i:05d},{x!r},{y!r},p{i},{i * 0.5 if i % 7 else ''}")
+    path = tmp_path / "p.csv"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def run(*args) -> int:
+    return cli.main(["batch", *map(str, args), "-q"])
+
+
+def test_geoparquet_cells_read_back_valid_typed_and_tiling_the_box(tmp_path, points_csv):
+    out = tmp_path / "cells.parquet"
+    assert run(points_csv, "-o", out, "--bbox", "-1,-1,2,2") == 0
+    table = pq.read_table(out)
+    assert table.schema.field("site").type == pa.int64()
+    assert table.schema.field("zip").type == pa.string() and table.column("zip")[0].as_py() == "00000"
+    assert table.schema.field("score").type == pa.float64() and table.column("score")[0].as_py() is None
+    assert table.num_rows == 50  # row 50 repeats row 3: no row of its own
+    assert table.column("duplicates").to_pylist()[3] == [50]
+    cells = shapely.from_wkb(table.column("geometry").to_numpy(zero_copy_only=False))
+    assert shapely.is_valid(cells).all()
+    assert shapely.area(cells).sum() == pytest.approx(9.0, rel=1e-12)
+    bounds = shapely.bounds(cells)
+    bbox = table.column("bbox").combine_chunks().flatten()
+    np.testing.assert_array_equal(np.column_stack([b.to_numpy() for b in bbox]), bounds)
+    geo = json.loads(table.schema.metadata[b"geo"])
+    assert geo["version"] == "1.1.0" and geo["primary_column"] == "geometry"
+    column = geo["columns"]["geometry"]
+    assert column["encoding"] == "WKB" and column["geometry_types"] == ["Polygon"]
+    assert column["covering"]["bbox"]["xmin"] == ["bbox", "xmin"]
+    assert column["crs"] is None  # x/y of unknown meaning
+    assert column["bbox"] == [-1.0, -1.0, 2.0, 2.0]
+
+
+def test_geoparquet_delaunay_and_crs_option(tmp_path, points_csv):
+    assert run(points_csv, "-o", tmp_path / "c.geojson", "--delaunay", tmp_path / "t.parquet", "--crs", "EPSG:3857") == 0
+    table = pq.read_table(tmp_path / "t.parquet")
+    triangles = shapely.from_wkb(table.column("geometry").to_numpy(zero_copy_only=False))
+    assert shapely.is_valid(triangles).all() and len(triangles) > 50
+    assert all(len(set(s)) == 3 for s in table.column("sites").to_pylist())
+    crs = json.loads(table.schema.metadata[b"geo"])["columns"]["geometry"]["crs"]
+    assert crs["id"]["authority"] == "EPSG" and int(crs["id"]["code"]) == 3857
+
+
+def test_geoparquet_to_stdout(tmp_path, points_csv, capsysbinary):
+    assert run(points_csv, "-o", "-", "--to", "parquet") == 0
+    assert pq.read_table(io.BytesIO(capsysbinary.readouterr().out)).num_rows == 50
+
+
+def test_geojson_sequences(tmp_path, points_csv):
+    assert run(points_csv, "-o", tmp_path / "c.geojsons", "--delaunay", tmp_path / "t.geojsonl") == 0
+    records = (tmp_path / "c.geojsons").read_bytes().split(b"\x1e")
+    assert records[0] == b"" and len(records) == 51
+    features = [json.loads(r) for r in records[1:]]
+    assert all(r.endswith(b"\n") for r in records[1:]) and features[3]["properties"]["duplicates"] == [50]
+    lines = (tmp_path / "t.geojsonl").read_text().splitlines()
+    assert all(json.loads(line)["type"] == "Feature" for line in lines) and b"\x1e" not in (tmp_path / "t.geojsonl").read_bytes()
+
+
+def test_precision_rounds_coordinates(tmp_path, points_csv):
+    assert run(points_csv, "-o", tmp_path / "c.geojson", "--precision", "3") == 0
+    doc = json.loads((tmp_path / "c.geojson").read_text())
+    coords = np.array([p for f in doc["features"] for p in f["geometry"]["coordinates"][0]])
+    np.testing.assert_array_equal(coords, np.round(coords, 3))
+    assert len(doc["features"]) == 50
+
+
+def test_parquet_inputs_plain_and_geo(tmp_path):
+    plain = tmp_path / "plain.parquet"
+    pq.write_table(pa.table({"id": [1, 2, 3, 4], "Easting": [0.0, 10, 0, 7], "Northing": [0.0, 0, 10, 7],
+                             "zip": ["01000", "02000", None, "04000"]}), plain)
+    assert run(plain, "-o", tmp_path / "a.parquet", "--crs", "EPSG:27700") == 0
+    table = pq.read_table(tmp_path / "a.parquet")
+    assert table.column("zip").to_pylist() == ["01000", "02000", None, "04000"]
+    assert table.column("id").type == pa.int64()
+    points = shapely.points([[5e5, 0], [5e5 + 10, 0], [5e5, 10], [5e5 + 7, 7]])
+    geo = pa.table({"name": list("abcd"), "geometry": pa.array(shapely.to_wkb(points), pa.binary())})
+    crs = {"id": {"authority": "EPSG", "code": 32631}}
+    meta = {"version": "1.1.0", "primary_column": "geometry",
+            "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Point"], "crs": crs}}}
+    pq.write_table(geo.replace_schema_metadata({b"geo": json.dumps(meta)}), tmp_path / "geo.parquet")
+    assert run(tmp_path / "geo.parquet", "-o", tmp_path / "b.parquet") == 0
+    out = pq.read_table(tmp_path / "b.parquet")
+    assert out.column("name").to_pylist() == list("abcd")
+    assert json.loads(out.schema.metadata[b"geo"])["columns"]["geometry"]["crs"] == crs
+
+
+def test_lonlat_default_box_stays_on_the_globe(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("lon,lat\n170,80\n179.5,85\n175,60\n-179,-89\n")
+    assert run(path, "-o", tmp_path / "c.parquet") == 0
+    table = pq.read_table(tmp_path / "c.parquet")
+    geo = json.loads(table.schema.metadata[b"geo"])["columns"]["geometry"]
+    xmin, ymin, xmax, ymax = geo["bbox"]
+    assert (xmin, ymin, xmax, ymax) == (-180.0, -90.0, 180.0, 90.0)
+    assert geo["crs"]["id"] == {"authority": "OGC", "code": "CRS84"}
+
+
+def test_non_wgs84_geojson_input_warns_for_geojson_output(tmp_path, capsys):
+    doc = {"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3857"}},
+           "features": [{"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": c}}
+                        for c in ([0, 0], [10, 0], [0, 10])]}
+    path = tmp_path / "p.geojson"
+    path.write_text(json.dumps(doc))
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "c.geojson")]) == 0
+    assert "EPSG:3857" in capsys.readouterr().err
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "c.parquet")]) == 0
+    assert capsys.readouterr().err == ""
+    crs = json.loads(pq.read_table(tmp_path / "c.parquet").schema.metadata[b"geo"])["columns"]["geometry"]["crs"]
+    assert crs["id"]["code"] in (3857, "3857")
+
+
+def test_missing_pyarrow_names_the_extra(tmp_path, points_csv, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyarrow", None)
+    monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)
+    assert cli.main(["batch", str(points_csv), "-o", str(tmp_path / "c.parquet")]) == 2
+    err = capsys.readouterr().err
+    assert "tvoronoi[parquet]" in err and err.count("\n") == 1
+    assert not (tmp_path / "c.parquet").exists()
+
+
+def test_unknown_crs_fails_before_the_build(tmp_path, points_csv, capsys):
+    pytest.importorskip("pyproj")
+    assert cli.main(["batch", str(points_csv), "-o", str(tmp_path / "c.parquet"), "--crs", "EPSG:999999"]) == 2
+    assert "EPSG:999999" in capsys.readouterr().err and not (tmp_path / "c.parquet").exists()
+
+
+def test_crs_code_without_pyproj_names_the_extra(tmp_path, points_csv, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyproj", None)
+    assert cli.main(["batch", str(points_csv), "-o", str(tmp_path / "c.parquet"), "--crs", "EPSG:3857"]) == 2
+    assert "tvoronoi[parquet]" in capsys.readouterr().err
+
+
+def test_geopandas_reads_cells_with_crs_types_and_covering(tmp_path):
+    gpd = pytest.importorskip("geopandas")
+    path = tmp_path / "p.csv"
+    path.write_text("name,Easting,Northing,zip\na,500000,100,01000\nb,500100,120,02000\nc,500050,190,\nd,500020,40,04000\n")
+    assert run(path, "-o", tmp_path / "c.parquet", "--crs", "EPSG:27700") == 0
+    frame = gpd.read_parquet(tmp_path / "c.parquet")
+    assert frame.crs.to_epsg() == 27700
+    assert frame.geometry.is_valid.all() and len(frame) == 4
+    assert frame["zip"].tolist()[:2] == ["01000", "02000"] and frame["zip"].isna().tolist()[2]
+    # the default box: 10% of the larger side (150) on every side
+    assert frame.total_bounds.tolist() == pytest.approx([500000 - 15, 40 - 15, 500100 + 15, 190 + 15])
+
+
+@pytest.mark.parametrize("suffix", [".geojsons", ".geojsonl", ".geojson"])
+def test_gdal_reads_every_geojson_layout(tmp_path, points_csv, suffix):
+    pyogrio = pytest.importorskip("pyogrio")
+    out = tmp_path / f"cells{suffix}"
+    assert run(points_csv, "-o", out) == 0
+    info = pyogrio.read_info(out)
+    assert info["driver"] == ("GeoJSON" if suffix == ".geojson" else "GeoJSONSeq")
+    assert info["features"] == 50
+    frame = pyogrio.read_dataframe(out)
+    assert frame["zip"].tolist()[:3] == ["00000", "00001", "00002"]
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.integers(3, 9), min_size=1, max_size=30), st.integers(0, 2**32 - 1))
+def test_bulk_wkb_is_shapely_wkb(ring_sizes, seed):
+    from tvoronoi.writers.geoparquet import _wkb_polygons
+
+    rng = np.random.default_rng(seed)
+    rings = [np.vstack([pts, pts[:1]]) for pts in (rng.normal(size=(k, 2)) * 1e3 for k in ring_sizes)]
+    offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
+    xy = np.vstack(rings)
+    ours = _wkb_polygons(pa, xy, offsets).to_pylist()
+    polygons = shapely.from_ragged_array(shapely.GeometryType.POLYGON, xy,
+                                         (offsets, np.arange(len(rings) + 1, dtype=np.int64)))
+    assert ours == list(shapely.to_wkb(polygons, byte_order=1))
+
+
+def test_parquet_input_binary_and_decimal_columns(tmp_path):
+    import decimal
+
+    table = pa.table({"x": [0.0, 1, 0], "y": [0.0, 0, 1], "raw": [b"\x00", b"\x01", b"\x02"],
+                      "price": pa.array([decimal.Decimal("1.25"), None, decimal.Decimal("3")], pa.decimal128(5, 2))})
+    pq.write_table(table, tmp_path / "p.parquet")
+    assert run(tmp_path / "p.parquet", "-o", tmp_path / "c.geojson") == 0
+    doc = json.loads((tmp_path / "c.geojson").read_text())
+    assert [f["properties"] for f in doc["features"]] == [
+        {"site": 0, "price": 1.25}, {"site": 1, "price": None}, {"site": 2, "price": 3.0}]

@@ -1,0 +1,113 @@
+"""Output targets: regular files atomic, devices, pipes and stdout written directly, links kept."""
+
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tvoronoi import cli
+from tvoronoi.writers import targets
+
+ROOT = Path(__file__).resolve().parents[1]
+CSV = "x,y,name\n0,0,a\n1,0,b\n0,1,c\n1,1,d\n0.5,0.4,e\n"
+
+
+def batch(*args) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-m", "tvoronoi", "batch", *map(str, args)],
+                          capture_output=True, env=env, timeout=120)
+
+
+@pytest.fixture
+def points(tmp_path) -> Path:
+    path = tmp_path / "p.csv"
+    path.write_text(CSV)
+    return path
+
+
+def test_a_named_pipe_is_written_directly_with_or_without_force(tmp_path, points, capsys):
+    fifo = tmp_path / "cells.fifo"
+    os.mkfifo(fifo)
+    for force in ([], ["--force"]):
+        received = []
+        reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()))
+        reader.start()
+        status = cli.main(["batch", str(points), "-o", str(fifo), "-q", *force])
+        reader.join(timeout=60)
+        assert status == 0
+        assert received and received[0].startswith(b'{"type":"FeatureCollection"')
+        assert received[0].count(b'"type":"Feature"') == 5
+        assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert {p.name for p in tmp_path.iterdir()} == {"cells.fifo", "p.csv"}  # no temporary file
+
+
+def test_dev_null_stays_a_device(points, capsys):
+    before = os.stat("/dev/null")
+    assert cli.main(["batch", str(points), "-o", "/dev/null", "--force", "-q"]) == 0
+    after = os.stat("/dev/null")
+    assert stat.S_ISCHR(after.st_mode) and after.st_ino == before.st_ino and after.st_rdev == before.st_rdev
+
+
+def test_kind_of_output():
+    assert isinstance(targets.output_file("-"), targets.StdoutFile)
+    assert isinstance(targets.output_file("/dev/stdout"), targets.StdoutFile)
+    direct = targets.output_file("/dev/null")
+    assert isinstance(direct, targets.DirectFile)
+    direct.discard()
+    assert targets.descriptor_of("/dev/fd/3") == 3 and targets.descriptor_of("/proc/self/fd/1") == 1
+    assert targets.descriptor_of("/dev/stdoutx") is None
+
+
+def test_dev_stdout_redirected_to_a_file_is_written_through_the_descriptor(tmp_path, points):
+    """The shell's file behind /dev/stdout is neither replaced nor truncated: the output is appended."""
+    out = tmp_path / "out.geojson"
+    out.write_bytes(b"HEAD\n")
+    with open(out, "ab") as sink:
+        env = {**os.environ, "PYTHONPATH": str(ROOT)}
+        status = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(points), "-o", "/dev/stdout"],
+                                stdout=sink, env=env, timeout=120).returncode
+    assert status == 0
+    data = out.read_bytes()
+    assert data.startswith(b'HEAD\n{"type":"FeatureCollection"') and data.endswith(b"]}\n")
+
+
+def test_a_symbolic_link_keeps_pointing_to_its_replaced_target(tmp_path, points, capsys):
+    target = tmp_path / "real.geojson"
+    target.write_bytes(b"old")
+    link = tmp_path / "link.geojson"
+    link.symlink_to(target.name)
+    assert cli.main(["batch", str(points), "-o", str(link), "-q"]) == 2  # exists: needs --force
+    assert target.read_bytes() == b"old"
+    assert cli.main(["batch", str(points), "-o", str(link), "--force", "-q"]) == 0
+    assert link.is_symlink() and os.readlink(link) == "real.geojson"
+    assert target.read_bytes().count(b'"type":"Feature"') == 5
+
+
+def test_stdout_dash(points, capsysbinary):
+    assert cli.main(["batch", str(points), "-o", "-", "-q"]) == 0
+    assert capsysbinary.readouterr().out.count(b'"type":"Feature"') == 5
+
+
+def test_a_reader_leaving_early_ends_the_run_quietly(tmp_path):
+    rng = np.random.default_rng(5)
+    big = tmp_path / "big.csv"
+    np.savetxt(big, rng.random((60_000, 2)), delimiter=",", header="x,y", comments="")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "tvoronoi", "batch", str(big), "-o", "-"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc.stdout.read(100)
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 1
+    assert err == b""
+
+
+def test_dev_null_may_take_both_outputs(points, capsys):
+    assert cli.main(["batch", str(points), "-o", "/dev/null", "--delaunay", "/dev/null", "-q"]) == 0

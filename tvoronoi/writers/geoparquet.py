@@ -1,0 +1,266 @@
+"""GeoParquet 1.1 out: cells and triangles as WKB polygons, bbox covering columns, typed properties."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tvoronoi.errors import TvoronoiError
+
+from .targets import open_output
+
+__all__ = ["write_cells_parquet", "write_delaunay_parquet", "require_pyarrow", "projjson", "crs_name", "is_crs84",
+           "CRS84_PROJJSON"]
+
+GEOPARQUET_VERSION = "1.1.0"
+# bytes before the points of a one-ring polygon's WKB: byte order, type, ring count, point count
+WKB_HEADER = 13
+INSTALL_HINT = "pip install 'tvoronoi[parquet]' (or pip install pyarrow pyproj)"
+# OGC:CRS84, lon/lat on WGS 84, as the GeoParquet specification spells it
+CRS84_PROJJSON = {
+    "$schema": "https://proj.org/schemas/v0.7/projjson.schema.json",
+    "type": "GeographicCRS",
+    "name": "WGS 84 (CRS84)",
+    "datum_ensemble": {
+        "name": "World Geodetic System 1984 ensemble",
+        "members": [
+            {"name": "World Geodetic System 1984 (Transit)"},
+            {"name": "World Geodetic System 1984 (G730)"},
+            {"name": "World Geodetic System 1984 (G873)"},
+            {"name": "World Geodetic System 1984 (G1150)"},
+            {"name": "World Geodetic System 1984 (G1674)"},
+            {"name": "World Geodetic System 1984 (G1762)"},
+            {"name": "World Geodetic System 1984 (G2139)"},
+        ],
+        "ellipsoid": {"name": "WGS 84", "semi_major_axis": 6378137, "inverse_flattening": 298.257223563},
+        "accuracy": "2.0",
+        "id": {"authority": "EPSG", "code": 6326},
+    },
+    "coordinate_system": {
+        "subtype": "ellipsoidal",
+        "axis": [
+            {"name": "Geodetic longitude", "abbreviation": "Lon", "direction": "east", "unit": "degree"},
+            {"name": "Geodetic latitude", "abbreviation": "Lat", "direction": "north", "unit": "degree"},
+        ],
+    },
+    "scope": "Not known.",
+    "area": "World.",
+    "bbox": {"south_latitude": -90, "west_longitude": -180, "north_latitude": 90, "east_longitude": 180},
+    "id": {"authority": "OGC", "code": "CRS84"},
+}
+
+
+def require_pyarrow():
+    """Import pyarrow and pyarrow.parquet, or say how to install them."""
+    try:
+        import pyarrow
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        raise TvoronoiError(f"GeoParquet needs pyarrow, which is not installed: {INSTALL_HINT}") from None
+    return pyarrow
+
+
+def is_crs84(crs) -> bool:
+    """Whether a CRS (a name or PROJJSON) is WGS 84 longitude/latitude: OGC:CRS84 or EPSG:4326."""
+    return crs_name(crs) in ("OGC:CRS84", "EPSG:4326")
+
+
+def crs_name(crs) -> str | None:
+    """"EPSG:3857" for a name or a PROJJSON with that id; a PROJJSON's name without one; None if unknown."""
+    if crs is None:
+        return None
+    if isinstance(crs, dict):
+        ident = crs.get("id")
+        if isinstance(ident, dict):
+            return f"{ident.get('authority')}:{ident.get('code')}".upper()
+        return str(crs.get("name", "a CRS without an id"))
+    return crs.upper()
+
+
+def projjson(crs) -> dict | None:
+    """The PROJJSON of a CRS ("OGC:CRS84", "EPSG:3857" or a PROJJSON dict); None when unknown.
+
+    An authority code other than OGC:CRS84 is spelled out by pyproj (part of the
+    ``parquet`` extra): a PROJJSON with only an id is not readable by PROJ.
+
+    Raises
+    ------
+    TvoronoiError
+        pyproj is missing, or does not know the code.
+    """
+    if crs is None or isinstance(crs, dict):
+        return crs
+    if crs.upper() == "OGC:CRS84":
+        return CRS84_PROJJSON
+    try:
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+    except ImportError:
+        raise TvoronoiError(
+            f"recording {crs} in GeoParquet needs pyproj, which is not installed: {INSTALL_HINT}"
+        ) from None
+    try:
+        return CRS.from_user_input(crs).to_json_dict()
+    except CRSError as e:
+        raise TvoronoiError(f"{crs}: not a CRS pyproj knows ({e}); give one like EPSG:3857") from None
+
+
+def _typed_column(pa, values: list):
+    """An Arrow array of one property: its own type when the values share one, else JSON text."""
+    try:
+        return pa.array(values)
+    except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
+        import orjson
+
+        return pa.array([None if v is None else orjson.dumps(v).decode() for v in values], pa.string())
+
+
+def _geo_metadata(column_bbox, geometry_types: list[str], crs) -> bytes:
+    import orjson
+
+    meta = {
+        "encoding": "WKB",
+        "geometry_types": geometry_types,
+        "covering": {"bbox": {k: ["bbox", k] for k in ("xmin", "ymin", "xmax", "ymax")}},
+    }
+    if column_bbox is not None:
+        meta["bbox"] = [float(v) for v in column_bbox]
+    # without a crs member GeoParquet means OGC:CRS84; coordinates of unknown meaning say null
+    meta["crs"] = projjson(crs)
+    return orjson.dumps({"version": GEOPARQUET_VERSION, "primary_column": "geometry", "columns": {"geometry": meta}})
+
+
+def _wkb_polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray):
+    """Closed single-ring polygons as an Arrow binary array of little-endian WKB, built in bulk.
+
+    Each polygon is ``01 | 03000000 | 01000000 | n (uint32) | n points (2 float64)``, the
+    bytes shapely.to_wkb writes for it, laid out with numpy instead of one GEOS geometry and
+    one Python bytes object per cell (three times faster, and no per-cell objects in memory).
+    """
+    counts = np.diff(ring_offsets)
+    sizes = WKB_HEADER + 16 * counts
+    offsets = np.zeros(len(counts) + 1, np.int64)
+    np.cumsum(sizes, out=offsets[1:])
+    total = int(offsets[-1])
+    data = np.empty(total, np.uint8)
+    header = np.empty((len(counts), WKB_HEADER), np.uint8)
+    header[:, :9] = np.frombuffer(b"\x01\x03\x00\x00\x00\x01\x00\x00\x00", np.uint8)
+    header[:, 9:] = counts.astype("<u4").view(np.uint8).reshape(-1, 4)
+    positions = (offsets[:-1, None] + np.arange(WKB_HEADER)).ravel()
+    data[positions] = header.ravel()
+    del header
+    # every byte that is not a header's holds the points, in order
+    in_points = np.ones(total, bool)
+    in_points[positions] = False
+    del positions
+    data[in_points] = np.ascontiguousarray(xy, "<f8").view(np.uint8).ravel()
+    del in_points
+    kind, index = (pa.binary(), np.int32) if total < 2**31 else (pa.large_binary(), np.int64)
+    return pa.Array.from_buffers(kind, len(counts), [None, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)])
+
+
+def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray):
+    """WKB and bbox columns of closed single-ring polygons; rows where ``present`` is False are null."""
+    n_rings = len(ring_offsets) - 1
+    mins = np.full((len(present), 2), np.nan)
+    maxs = np.full((len(present), 2), np.nan)
+    wkb = _wkb_polygons(pa, xy, ring_offsets)
+    if not present.all():
+        # null rows between the polygons: take with a null index
+        index = np.full(len(present), -1, np.int64)
+        index[present] = np.arange(n_rings)
+        wkb = wkb.take(pa.array(index, mask=~present))
+    if n_rings:
+        starts = ring_offsets[:-1]
+        mins[present] = np.minimum.reduceat(xy, starts, axis=0)
+        maxs[present] = np.maximum.reduceat(xy, starts, axis=0)
+    mask = ~present
+    bbox = pa.StructArray.from_arrays(
+        [pa.array(v, pa.float64(), mask=mask) for v in (mins[:, 0], mins[:, 1], maxs[:, 0], maxs[:, 1])],
+        names=["xmin", "ymin", "xmax", "ymax"],
+    )
+    extent = None
+    if n_rings:
+        extent = [*mins[present].min(axis=0), *maxs[present].max(axis=0)]
+    return wkb, bbox, extent
+
+
+def _write(pa, table, out, overwrite: bool) -> None:
+    import pyarrow.parquet as pq
+
+    with open_output(out, overwrite=overwrite) as stream:
+        pq.write_table(table, pa.PythonFile(stream, mode="w"), compression="zstd")
+
+
+def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=None) -> int:
+    """Write the Voronoi cells as GeoParquet 1.1: one row per distinct site, in input order.
+
+    Columns: ``site`` (int64, the 0-based input row), the site's properties as
+    typed Arrow columns (a property whose values mix types is JSON text),
+    ``duplicates`` (list of later rows at the same place, null where none),
+    ``geometry`` (WKB Polygon, null for a cell that misses the box) and ``bbox``
+    (struct xmin, ymin, xmax, ymax: the covering columns of GeoParquet 1.1).
+    The ``geo`` metadata records the CRS: ``crs`` (a CRS name or PROJJSON,
+    see :func:`projjson`), or null when the coordinates have no known CRS.
+
+    Returns
+    -------
+    int
+        The number of rows written.
+
+    Raises
+    ------
+    TvoronoiError
+        pyarrow is not installed, or ``points`` does not match the diagram.
+    OSError
+        If writing fails (an existing file at ``out`` is then left untouched).
+    """
+    pa = require_pyarrow()
+    from tvoronoi.geojson import MIN_RING_POINTS, _closed_rings, _renames
+
+    n_sites = diagram.n_sites
+    rows = np.arange(n_sites)
+    distinct = diagram.site_of == rows
+    has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
+    xy, first, last = _closed_rings(diagram, 0, n_sites, has_ring)
+    ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
+    geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(xy), ring_offsets, has_ring[distinct])
+    kept = rows[distinct]
+    columns = {"site": pa.array(kept, pa.int64())}
+    if points is not None:
+        if len(points) != n_sites:
+            raise TvoronoiError(
+                f"the point set has {len(points)} rows but the diagram has {n_sites} sites; "
+                f"pass the points the diagram was built from"
+            )
+        renames = _renames(points.property_names)
+        for name in points.property_names:
+            if points.records is not None:
+                values = [points.records[i].get(name) for i in kept.tolist()]
+            else:
+                values = points.columns[name]
+                values = values if len(kept) == n_sites else [values[i] for i in kept.tolist()]
+            columns[renames.get(name, name)] = _typed_column(pa, values)
+    repeats = diagram.duplicates()
+    columns["duplicates"] = pa.array([repeats.get(i) for i in kept.tolist()], pa.list_(pa.int64()))
+    columns["geometry"] = geometry
+    columns["bbox"] = bbox
+    table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
+    _write(pa, table, out, overwrite)
+    return len(kept)
+
+
+def write_delaunay_parquet(diagram, out, *, overwrite: bool = True, crs=None) -> int:
+    """Write the Delaunay triangles as GeoParquet 1.1: ``sites`` (three 0-based rows), ``geometry``, ``bbox``.
+
+    Returns the number of triangles; raises as :func:`write_cells_parquet`.
+    """
+    pa = require_pyarrow()
+    triangles = np.asarray(diagram.triangles, dtype=np.int64).reshape(-1, 3)
+    xy = np.take(diagram.sites, triangles[:, [0, 1, 2, 0]].ravel(), axis=0)
+    ring_offsets = np.arange(0, 4 * len(triangles) + 1, 4, dtype=np.int64)
+    geometry, bbox, extent = _polygons(pa, xy, ring_offsets, np.ones(len(triangles), bool))
+    sites = pa.FixedSizeListArray.from_arrays(pa.array(triangles.ravel(), pa.int64()), 3)
+    table = pa.table({"sites": sites, "geometry": geometry, "bbox": bbox})
+    table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
+    _write(pa, table, out, overwrite)
+    return len(triangles)
