@@ -30,7 +30,10 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
     CoordinateRangeError
         Naming the first row at fault and the row of the largest coordinate.
     """
-    pts = np.asarray(pts, np.float64).reshape(len(pts), -1)
+    pts = np.asarray(pts, np.float64)
+    if pts.size == 0:
+        return
+    pts = pts.reshape(len(pts), -1)
     mag = np.abs(pts)
     # 2^(e+170) may exceed the double range: then nothing is too large
     low = math.ldexp(1.0, e - RANGE_BITS)
