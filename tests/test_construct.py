@@ -69,6 +69,30 @@ def test_perturbed_lattice_and_decimals():
     check_triangles(dec)
 
 
+def test_near_ties_of_noisy_lattices():
+    """Centres of a lattice with tiny noise sit within 1e-6 ulp of a rounding tie (about 40% of them):
+    the exact stage decides them, in coordinates relative to a site where the differences are exact."""
+    rng = np.random.default_rng(11)
+    for noise in (1e-12, 1e-15, 1e-17):
+        k = 30
+        g = np.stack(np.meshgrid(np.arange(k), np.arange(k)), -1).reshape(-1, 2) * 2.0 ** -6
+        g = g + noise * rng.standard_normal(g.shape)
+        i = rng.integers(0, k - 1, 600)
+        j = rng.integers(0, k - 1, 600)
+        at = lambda di, dj: g[(i + di) * k + j + dj]        # noqa: E731
+        check_triangles(np.stack([at(0, 0), at(1, 0), at(0, 1)], 1))
+        check_triangles(np.stack([at(1, 1), at(0, 1), at(1, 0)], 1))
+
+
+def test_relative_differences_not_exact_fall_back():
+    """Sites whose differences are not doubles (a site at 0 beside ones near 1, magnitudes far apart)."""
+    rng = np.random.default_rng(12)
+    a = np.zeros((300, 2)) + rng.normal(0, 1e-30, (300, 2))
+    b = 1 + rng.random((300, 2)) * 1e-3
+    c = np.column_stack((1 + rng.random(300) * 1e-3, 2 + rng.random(300)))
+    check_triangles(np.stack([a, b, c], 1))
+
+
 def test_scaled_output_is_rounded_once():
     # the kernel folds the scale 2^e into the rounding: a subnormal result is still the nearest double
     rng = np.random.default_rng(9)

@@ -26,7 +26,8 @@ from libc.string cimport memcpy
 from libc.stdint cimport uint64_t
 
 from tvoronoi.kernels.predicates cimport (
-    EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_square, expansion_sign, fast_expansion_sum_zeroelim,
+    EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_square, two_product, two_two_diff, expansion_sign,
+    fast_expansion_sum_zeroelim,
     scale_expansion_zeroelim, expansion_product, negate_expansion, difference_expansion,
 )
 
@@ -228,6 +229,77 @@ cdef inline void circumcentre_exact(double ax, double ay, double bx, double by, 
     uy[0] = round_quotient(n_num, num, n_den, den, e)
 
 
+cdef inline int lifted_difference(double bax, double bay, double cax, double cay, double* h) noexcept nogil:
+    # cay |b - a|^2 - bay |c - a|^2 from exact relative coordinates (h: 16 components): the x
+    # numerator; called with (cay, cax, bay, bax) it gives bax |c - a|^2 - cax |b - a|^2, the y one
+    cdef double sq_a[2]
+    cdef double sq_b[2]
+    cdef double bb[4]
+    cdef double cc[4]
+    cdef double t1[8]
+    cdef double t2[8]
+    cdef int n_bb, n_cc, n1, n2
+    sq_a[1], sq_a[0] = two_square(bax)
+    sq_b[1], sq_b[0] = two_square(bay)
+    n_bb = fast_expansion_sum_zeroelim(2, sq_a, 2, sq_b, bb)
+    sq_a[1], sq_a[0] = two_square(cax)
+    sq_b[1], sq_b[0] = two_square(cay)
+    n_cc = fast_expansion_sum_zeroelim(2, sq_a, 2, sq_b, cc)
+    n1 = scale_expansion_zeroelim(n_bb, bb, cay, t1)
+    n2 = scale_expansion_zeroelim(n_cc, cc, -bay, t2)
+    return fast_expansion_sum_zeroelim(n1, t1, n2, t2, h)
+
+
+cdef inline int offset_quotient(double a, int n_num, const double* num, const double* den2, double* p,
+                                double* q) noexcept nogil:
+    # a + num / den2 as p / q (p: a * den2 + num, up to 24 components; q: a copy of den2, 4)
+    cdef double t[8]
+    cdef int k, n_t = scale_expansion_zeroelim(4, den2, a, t)
+    for k in range(4):
+        q[k] = den2[k]
+    return fast_expansion_sum_zeroelim(n_t, t, n_num, num, p)
+
+
+cdef inline bint circumcentre_relative(double ax, double ay, double bx, double by, double cx, double cy,
+                                       int e, double* ux, double* uy) noexcept nogil:
+    """The exact path in coordinates relative to a, when b - a and c - a are exact doubles (nearby sites,
+    the usual case): the centre is a + N / (2 D) with expansions of 4 to 24 components, where the
+    general path forms 48 over 12. False (nothing written) when a difference is not exact."""
+    cdef double bax, bay, cax, cay, t, l1, l0, r1, r0
+    cdef double den2[4]
+    cdef double num[16]
+    cdef double p[P_MAX]
+    cdef double q[Q_MAX]
+    cdef int k, n_num, n_p
+    bax, t = two_diff(bx, ax)
+    if t != 0.0:
+        return False
+    bay, t = two_diff(by, ay)
+    if t != 0.0:
+        return False
+    cax, t = two_diff(cx, ax)
+    if t != 0.0:
+        return False
+    cay, t = two_diff(cy, ay)
+    if t != 0.0:
+        return False
+    # 2 D = 2 (bax cay - bay cax), exactly (doubling is exact)
+    l1, l0 = two_product(bax, cay)
+    r1, r0 = two_product(bay, cax)
+    two_two_diff(l1, l0, r1, r0, den2)
+    for k in range(4):
+        den2[k] *= 2.0
+    # x: a_x + (cay |b - a|^2 - bay |c - a|^2) / (2 D)
+    n_num = lifted_difference(bax, bay, cax, cay, num)
+    n_p = offset_quotient(ax, n_num, num, den2, p, q)
+    ux[0] = round_quotient(n_p, p, 4, q, e)
+    # y: a_y + (bax |c - a|^2 - cax |b - a|^2) / (2 D)
+    n_num = lifted_difference(cay, cax, bay, bax, num)
+    n_p = offset_quotient(ay, n_num, num, den2, p, q)
+    uy[0] = round_quotient(n_p, p, 4, q, e)
+    return True
+
+
 cdef inline bint settled(double a, double u, double err, int e, double* out) noexcept nogil:
     # a + u with |u - exact| <= err: is the rounding of a + exact known to be fl(a + u)? (then 2^e * it)
     cdef double s, t, g_hi, g_lo, r
@@ -316,6 +388,8 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
             return
         if circumcentre_long(ax, ay, bx, by, cx, cy, e, ux, uy):
             return
+    if circumcentre_relative(ax, ay, bx, by, cx, cy, e, ux, uy):
+        return
     circumcentre_exact(ax, ay, bx, by, cx, cy, e, ux, uy)
 
 
