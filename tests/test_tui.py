@@ -376,3 +376,107 @@ def test_snapshot_light_theme_zoomed_in(snap_compare):
         await pilot.press("plus", "plus", "plus")
 
     assert snap_compare(make_app(), run_before=light, terminal_size=SIZE)
+
+
+# -- focus, status and layout (issue 13's defects) ----------------------------
+
+
+def footer_keys(app) -> list[str]:
+    from textual.widgets._footer import FooterKey
+
+    return [key.key_display for key in app.screen.query(FooterKey)]
+
+
+def slow_builds(monkeypatch):
+    """Make builds in a worker wait until the returned event is set."""
+    import threading
+
+    from tvoronoi.tui import building
+
+    release = threading.Event()
+    real = building.build
+
+    def build(*args, **kwargs):
+        if threading.current_thread() is not threading.main_thread():
+            release.wait(10)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(building, "build", build)
+    return release
+
+
+@pilot_test
+async def test_a_large_start_keeps_the_focus_on_the_canvas():
+    """Starting on 100,000 points (built in a worker) leaves the keys to the canvas."""
+    app = make_app(points=generate("uniform", 100_000, seed=1))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert app.canvas.has_focus
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built.diagram.n_sites == 100_000
+        assert app.canvas.has_focus
+        fitted = app.canvas.view
+        await pilot.press("right", "plus")
+        assert app.canvas.view.cx > fitted.cx and app.canvas.view.scale < fitted.scale
+
+
+@pilot_test
+async def test_d_during_a_large_build_keeps_the_building_status(monkeypatch):
+    release = slow_builds(monkeypatch)
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#count", Input).value = "100000"
+        app.canvas.focus()
+        await pilot.press("g")
+        assert status_text(app).startswith("building 100,000 sites")
+        await pilot.press("d")
+        assert app.canvas.show_delaunay
+        assert status_text(app).startswith("building 100,000 sites")
+        assert app.canvas.has_focus
+        release.set()
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert status_text(app).startswith("100,000 sites")
+        assert "Delaunay shown" in status_text(app)
+
+
+@pilot_test
+async def test_the_panel_follows_the_terminal_width():
+    app = make_app()
+    async with app.run_test(size=(70, 20)) as pilot:
+        await pilot.pause()
+        panel = app.query_one("#panel")
+        assert not panel.display
+        await pilot.resize_terminal(120, 30)
+        await pilot.pause()
+        assert panel.display
+        await pilot.resize_terminal(60, 20)
+        await pilot.pause()
+        assert not panel.display
+        assert app.canvas.content_size.width == 60
+        # p shows it at this width; a resize to a wide terminal decides again
+        await pilot.press("p")
+        assert panel.display
+        await pilot.resize_terminal(120, 30)
+        await pilot.pause()
+        assert panel.display
+
+
+@pilot_test
+async def test_the_footer_shows_the_canvas_keys_after_a_file_is_opened(tmp_path):
+    path = tmp_path / "points.csv"
+    path.write_text("x,y\n0,0\n1,0\n0,1\n1,1\n0.5,0.4\n")
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert "←" in footer_keys(app)
+        await pilot.press("o")
+        app.screen.query_one(Input).value = str(path)
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built.source == "points.csv"
+        assert app.canvas.has_focus
+        assert "←" in footer_keys(app) and "+" in footer_keys(app)

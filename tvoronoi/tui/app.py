@@ -14,6 +14,7 @@ from textual import on
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
+from textual.message import Message
 from textual.widgets import Button, Footer, Input, Label, ProgressBar, Select, Static
 
 from tvoronoi.api import ENGINES
@@ -43,6 +44,16 @@ PARAMETERS = {
     "gaussian": (("sigma", float),),
     "clustered": (("clusters", int), ("spread", float)),
 }
+
+class Workspace(Horizontal):
+    """The canvas and the side panel, as wide as the terminal: its resizes are the terminal's."""
+
+    class Resized(Message):
+        """The terminal changed size (the App itself does not hear of it)."""
+
+    def on_resize(self) -> None:
+        self.post_message(self.Resized())
+
 
 class SidePanel(VerticalScroll, can_focus=False):
     """The controls beside the canvas; it scrolls when the terminal is short, but Tab skips it."""
@@ -91,11 +102,12 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         self.clock = clock
         self.built: Built | None = None
         self._panel_wanted: bool | None = None  # None: decided by the width
+        self._narrow: bool | None = None  # whether the panel was last laid out for a narrow terminal
 
     # -- layout --------------------------------------------------------------
 
     def compose(self) -> ComposeResult:
-        with Horizontal(id="main"):
+        with Workspace(id="main"):
             yield DiagramCanvas(id="canvas")
             with SidePanel(id="panel"):
                 yield Label("Points", classes="heading")
@@ -174,14 +186,26 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         else:
             self.action_generate()
 
-    def on_resize(self) -> None:
+    def on_workspace_resized(self) -> None:
         self._layout_panel()
 
     def _layout_panel(self) -> None:
+        """Show or hide the side panel: as the user chose with `p`, else by the terminal's width.
+
+        A resize across NARROW_WIDTH decides again by the width (the choice was
+        made for the other size).
+        """
+        narrow = self.size.width < NARROW_WIDTH
+        if narrow != self._narrow:
+            self._narrow = narrow
+            self._panel_wanted = None
         wanted = self._panel_wanted
         if wanted is None:
-            wanted = self.size.width >= NARROW_WIDTH
-        self.query_one("#panel").display = wanted
+            wanted = not narrow
+        panel = self.query_one("#panel")
+        panel.display = wanted
+        if not wanted and panel.has_focus_within:
+            self.canvas.focus()
 
     @property
     def canvas(self) -> DiagramCanvas:
@@ -272,6 +296,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         self.query_one("#status", Static).update(text, layout=False)
 
     def _update_status(self) -> None:
+        if self.building is not None:
+            self._set_status(self.building)  # the old diagram's status would hide the running build
+            return
         built = self.built
         if built is None:
             self._set_status("no diagram")

@@ -111,7 +111,8 @@ class FilesMixin:
 
     def on_save_finished(self, message: SaveFinished) -> None:
         self._saving = False
-        self.query_one("#progress").display = False
+        if self.building is None:  # the bar stays while a build runs
+            self.query_one("#progress").display = False
         if message.error is not None:
             self.notify(message.error, title="Not saved", severity="error", timeout=8, markup=False)
         else:
