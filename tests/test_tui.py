@@ -480,3 +480,67 @@ async def test_the_footer_shows_the_canvas_keys_after_a_file_is_opened(tmp_path)
         assert app.built.source == "points.csv"
         assert app.canvas.has_focus
         assert "←" in footer_keys(app) and "+" in footer_keys(app)
+
+
+@pilot_test
+async def test_enter_in_a_field_hands_the_keys_back_to_the_canvas():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        count = app.query_one("#count", Input)
+        count.focus()
+        count.value = ""
+        await pilot.press("4", "0", "0", "enter")
+        await pilot.pause()
+        assert app.built.diagram.n_sites == 400
+        assert app.canvas.has_focus
+        await pilot.press("d")
+        assert app.canvas.show_delaunay
+        # a bad value keeps the focus in the field, to be fixed
+        count.focus()
+        count.value = ""
+        await pilot.press("x", "enter")
+        await pilot.pause()
+        assert count.has_focus
+
+
+@pilot_test
+async def test_a_choice_in_a_select_hands_the_keys_back_to_the_canvas():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pick_fortune(app, pilot)
+        assert app.canvas.has_focus
+        await pilot.press("d")
+        assert app.canvas.show_delaunay
+        shape = app.query_one("#distribution", Select)
+        shape.focus()
+        await pilot.press("enter", "down", "enter")
+        await pilot.pause()
+        assert shape.value == "gaussian"
+        assert app.canvas.has_focus
+
+
+@pilot_test
+async def test_tab_shows_which_control_has_the_focus():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        shape = app.query_one("#distribution", Select)
+        engine = app.query_one("#engine", Select)
+        count = app.query_one("#count", Input)
+        seed = app.query_one("#seed", Input)
+        await pilot.press("tab")
+        assert shape.has_focus
+        await pilot.pause()
+
+        def looks(widget):
+            label = widget.parent.query_one("Label")
+            body = widget.query_one("SelectCurrent") if isinstance(widget, Select) else widget
+            return body.styles.background, label.styles.color, label.styles.text_style
+
+        assert looks(shape) != looks(engine)
+        await pilot.press("tab")
+        await pilot.pause()
+        assert count.has_focus
+        assert looks(count) != looks(seed)

@@ -220,9 +220,11 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
     @on(Select.Changed, "#distribution")
     def _distribution_changed(self, event: Select.Changed) -> None:
         self._show_parameters(str(event.value))
+        self._back_to_canvas(event.select)
 
     @on(Select.Changed, "#engine")
     def _engine_changed(self, event: Select.Changed) -> None:
+        self._back_to_canvas(event.select)
         built = self.built
         if built is None or event.value == built.diagram.engine:
             return
@@ -233,9 +235,15 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         points, point_set = built.points, built.point_set
         self._request_build(lambda: points, source=built.source, size=len(points), fit=False, point_set=point_set)
 
+    def _back_to_canvas(self, control) -> None:
+        """A control was used (a choice made, a field submitted): the keys go to the diagram again."""
+        if control.has_focus:
+            self.canvas.focus()
+
     @on(Button.Pressed, "#generate")
-    def _generate_pressed(self) -> None:
-        self.action_generate()
+    def _generate_pressed(self, event: Button.Pressed) -> None:
+        if self._generate():
+            self._back_to_canvas(event.button)
 
     @on(Button.Pressed, "#playback")
     def _playback_pressed(self) -> None:
@@ -244,8 +252,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
 
     @on(Input.Submitted)
     def _input_submitted(self, event: Input.Submitted) -> None:
-        if event.input.id in ("count", "seed", "sigma", "clusters", "spread"):
-            self.action_generate()
+        # a bad value keeps the focus in its field, for the user to fix it
+        if event.input.id in ("count", "seed", "sigma", "clusters", "spread") and self._generate():
+            self._back_to_canvas(event.input)
 
     def _read_int(self, input_id: str, name: str, minimum: int) -> int:
         text = self.query_one(f"#{input_id}", Input).value.strip()
@@ -280,14 +289,19 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
 
     def action_generate(self) -> None:
         """Make points from the panel's settings and build their diagram."""
+        self._generate()
+
+    def _generate(self) -> bool:
+        """Make points from the panel's settings and build their diagram; False if a setting is bad."""
         try:
             distribution, count, seed, params = self._panel_request()
         except TvoronoiError as exc:
             self._fail(str(exc))
-            return
+            return False
         shown = ", ".join([f"seed {seed}", *(f"{k} {v:g}" for k, v in params.items())])
         source = f"{distribution} ({shown})"
         self._request_build(lambda: generate(distribution, count, seed=seed, **params), source=source, size=count)
+        return True
 
     # -- status --------------------------------------------------------------
 
