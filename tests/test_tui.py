@@ -544,3 +544,42 @@ async def test_tab_shows_which_control_has_the_focus():
         await pilot.pause()
         assert count.has_focus
         assert looks(count) != looks(seed)
+
+
+@pilot_test
+async def test_a_file_error_names_the_open_dialogs_column_fields(tmp_path):
+    path = tmp_path / "words.csv"
+    path.write_text("name,kind\nLisbon,city\nMadrid,city\n")
+    app = make_app()
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await pilot.pause()
+        await pilot.press("o")
+        app.screen.query_one("#path", Input).value = str(path)
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        text = " ".join(error_toasts(app))
+        assert "words.csv" in text
+        assert "--x" not in text and "--y" not in text
+        assert "x and y column fields of the Open dialog" in text
+
+
+@pilot_test
+async def test_the_open_dialog_chooses_the_columns(tmp_path):
+    path = tmp_path / "table.csv"
+    path.write_text("a,b,c\n1,10,100\n2,20,200\n3,30,300\n4,40,250\n")
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("o")
+        app.screen.query_one("#path", Input).value = str(path)
+        app.screen.query_one("#x-column", Input).value = "c"
+        app.screen.query_one("#y-column", Input).value = "a"
+        await pilot.press("enter")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built.diagram.sites.tolist() == [[100, 1], [200, 2], [300, 3], [250, 4]]
+        # the dialog offers the same file and columns again
+        await pilot.press("o")
+        assert app.screen.query_one("#path", Input).value == str(path)
+        assert app.screen.query_one("#x-column", Input).value == "c"
