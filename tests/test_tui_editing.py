@@ -420,9 +420,10 @@ def test_edits_far_from_the_view_redraw_nothing(live_case):
 
 
 def test_snapshot_editing_with_the_keyboard_cursor(snap_compare):
-    """Zoomed in twice, two sites added with the keyboard cursor (the pink block) and the
-    second one moved one character left with m: their cells cut into their neighbours',
-    which keep their colours; the status line counts the edits."""
+    """Zoomed in twice, two sites added with the keyboard cursor (a pink cross over darker
+    cell colours, the site under it still yellow) and the second one moved one character
+    left with m: their cells cut into their neighbours', which keep their colours; the
+    status line counts the edits."""
     keys = ["plus", "plus", "c", "shift+right", "shift+right", "a", "shift+up", "shift+up", "a",
             "m", "left", "enter"]
     assert snap_compare(make_app(), press=keys, terminal_size=SIZE)

@@ -18,6 +18,12 @@ SCATTER = 0x9E3779B1
 MAX_COLOURS = 8
 
 
+# The characters under the keyboard cursor take their cell's colour shifted this many
+# tint steps: the other way from a tint (darker on the dark theme, lighter on the light
+# one), so that the light marks of the dark theme (and the dark ones of the light) keep
+# their contrast there.
+HIGHLIGHT_STEPS = -1
+
 # The six levels of each channel of the xterm 256-colour cube.
 CUBE_LEVELS = (0x00, 0x5F, 0x87, 0xAF, 0xD7, 0xFF)
 
@@ -38,9 +44,11 @@ class Palette:
     sweep line, beach line, pending circle events and growing edges,
     ``event`` for what the current step did (and the site being moved),
     ``conflict`` and ``conflict_fill`` for the triangles an insertion
-    destroyed, ``cursor`` and ``cursor_text`` for the keyboard cursor (a
-    block of colour under dots). ``tints`` are the fills
-    of the cells an insertion took area from.
+    destroyed, ``cursor`` for the keyboard cursor's cross. ``tints`` are the
+    fills of the cells an insertion took area from, ``highlights`` those of
+    the characters under the keyboard cursor (the cell's own colour, darker
+    on a dark theme and lighter on a light one, so that the site and edges
+    under the cursor keep showing).
     """
 
     fills: tuple[str, ...]
@@ -58,16 +66,19 @@ class Palette:
     conflict: str
     conflict_fill: str
     cursor: str
-    cursor_text: str
 
     @property
     def tints(self) -> tuple[str, ...]:
         return tuple(cube_shift(c, self.tint_steps) for c in self.fills)
 
     @property
+    def highlights(self) -> tuple[str, ...]:
+        return tuple(cube_shift(c, HIGHLIGHT_STEPS * self.tint_steps) for c in self.fills)
+
+    @property
     def backgrounds(self) -> tuple[str | None, ...]:
         """Every background a character can have, indexed by its fill + 1 (no fill first)."""
-        return (None, *self.fills, *self.tints, self.conflict_fill)
+        return (None, *self.fills, *self.tints, self.conflict_fill, *self.highlights)
 
 
 # All colours are exact entries of the xterm 256-colour cube, so a terminal (or a
@@ -99,7 +110,6 @@ DARK = Palette(
     conflict="#ff5f5f",
     conflict_fill="#870000",
     cursor="#ff87ff",
-    cursor_text="#000000",
 )
 
 # Pastel fills: dark edges and deep marks stay readable on each of them.
@@ -128,7 +138,6 @@ LIGHT = Palette(
     conflict="#d70000",
     conflict_fill="#ffafaf",
     cursor="#870087",
-    cursor_text="#ffffff",
 )
 
 
