@@ -583,3 +583,72 @@ async def test_the_open_dialog_chooses_the_columns(tmp_path):
         await pilot.press("o")
         assert app.screen.query_one("#path", Input).value == str(path)
         assert app.screen.query_one("#x-column", Input).value == "c"
+
+
+def footer_fits(app, width: int) -> bool:
+    from textual.widgets._footer import FooterKey
+
+    keys = list(app.screen.query(FooterKey))
+    return bool(keys) and max(key.region.right for key in keys) <= width
+
+
+@pilot_test
+async def test_the_footer_fits_80_columns_in_every_mode():
+    app = make_app()
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        assert footer_fits(app, 80)
+        assert {"←", "+", "?", "d", "g", "t"} <= set(footer_keys(app))
+        await pilot.press("t")
+        await pilot.pause()
+        assert footer_fits(app, 80)
+        assert {"?", "t", "space", ",", "."} <= set(footer_keys(app))
+
+
+@pilot_test
+async def test_no_color_draws_no_fills_and_sites_stand_out(monkeypatch):
+    """With NO_COLOR the cells are not filled (their greys would look alike) and every
+    site is a bold block of dots in the brightest colour."""
+    from tvoronoi.tui.colours import PLAIN_DARK
+    from tvoronoi.tui.raster import SITE
+
+    monkeypatch.setenv("NO_COLOR", "1")
+    app = make_app(points=generate("uniform", 300, seed=0))
+    async with app.run_test(size=(80, 24)) as pilot:
+        await pilot.pause()
+        canvas = app.canvas
+        assert canvas.palette() is PLAIN_DARK
+        canvas.render_line(0)
+        frame = canvas._frame
+        styles = {seg.style for line in canvas._lines for seg in line}
+        assert all(style.bgcolor is None for style in styles)
+        sites = frame.mark == SITE
+        assert sites.sum() > 100
+        # a block: at least 4 of the 8 dots of a site's character are set
+        assert (np.unpackbits(frame.codes[sites][:, None], axis=1).sum(axis=1) >= 4).mean() > 0.9
+        assert footer_fits(app, 80)
+
+
+def test_sixteen_colours_draw_no_fills():
+    from types import SimpleNamespace
+
+    from tvoronoi.tui.canvas import plain_terminal
+
+    def app(no_color=False, system="truecolor", headless=False):
+        return SimpleNamespace(no_color=no_color, is_headless=headless,
+                               console=SimpleNamespace(color_system=system))
+
+    assert plain_terminal(app(system="standard"))
+    assert plain_terminal(app(system="windows"))
+    assert plain_terminal(app(no_color=True))
+    assert not plain_terminal(app(system="256"))
+    assert not plain_terminal(app(system="truecolor"))
+    # tests and snapshots draw in full colour whatever TERM says
+    assert not plain_terminal(app(system="standard", headless=True))
+
+
+def test_snapshot_no_color_80x24(snap_compare, monkeypatch):
+    """NO_COLOR at 80 x 24 (greys only): no cell fills, grey edges, the sites as bright bold
+    blocks, the panel beside them, and the footer's keys all within the 80 columns."""
+    monkeypatch.setenv("NO_COLOR", "1")
+    assert snap_compare(make_app(), terminal_size=(80, 24))

@@ -82,7 +82,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
     TITLE = "tvoronoi"
 
     BINDINGS = [
-        Binding("q", "quit", "Quit"),
+        Binding("q", "quit", "Quit", show=False),  # in the help: the footer keeps 80 columns for the rest
         Binding("question_mark", "help", "Help", key_display="?"),
         Binding("d", "toggle_delaunay", "Delaunay"),
         Binding("v", "toggle_vertices", "Vertices", show=False),
@@ -174,7 +174,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
                 yield ProgressBar(id="progress", show_eta=False)
         yield Timeline(id="timeline")
         yield Static(id="status")
-        yield Footer()
+        yield Footer(show_command_palette=False)
 
     def on_mount(self) -> None:
         self._show_parameters(DEFAULT_DISTRIBUTION)

@@ -13,7 +13,7 @@ from textual.reactive import reactive
 from textual.strip import Strip
 from textual.widget import Widget
 
-from tvoronoi.tui.colours import palette_for
+from tvoronoi.tui.colours import Palette, palette_for
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.raster import (
     CURSOR_ARM,
@@ -37,6 +37,19 @@ PARTIAL_MAX_FRACTION = 0.5
 # Zoom limits, as a factor of the view that fits the box.
 MAX_ZOOM_IN = 1e6
 MAX_ZOOM_OUT = 50.0
+
+# The colour systems (rich's names) of terminals with 16 colours or fewer: cells are not filled.
+PLAIN_COLOR_SYSTEMS = ("standard", "windows")
+
+
+
+def plain_terminal(app) -> bool:
+    """Whether the app's terminal shows no colours (NO_COLOR) or only 16: cells are not filled then."""
+    if app.no_color:
+        return True
+    # a headless app (tests, snapshots) draws in full colour, whatever TERM says
+    return not app.is_headless and app.console.color_system in PLAIN_COLOR_SYSTEMS
+
 
 PAN = Binding.Group("Pan", compact=True)
 ZOOM = Binding.Group("Zoom", compact=True)
@@ -304,10 +317,10 @@ class DiagramCanvas(Widget, can_focus=True):
             # again, quietly, since this is the drawing itself
             self._fit_size = size
             self.set_reactive(DiagramCanvas.view, View.fit(self.scene.bbox, size.width, size.height))
-        dark = self.app.current_theme.dark
+        palette = self.palette()
         scene = self.scene
         version = getattr(scene, "version", 0)
-        base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, dark)
+        base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, palette)
         key = (base, version, self.cursor)
         if key == self._frame_key:
             return self._lines
@@ -315,20 +328,26 @@ class DiagramCanvas(Widget, can_focus=True):
         if scene is None:
             self._frame = None
             self._lines = [[] for _ in range(size.height)]
-        elif base != self._base_key or not self._redraw_changes(scene, size, dark):
+        elif base != self._base_key or not self._redraw_changes(scene, size, palette):
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
-                overlay=self.overlay, cursor=self.cursor,
+                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled,
             )
-            self._lines = frame_lines(self._frame, palette_for(dark))
+            self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
         self._frame_version, self._frame_cursor = version, self.cursor
         self.drawn_at = time.perf_counter()
         self.last_draw_ms = (self.drawn_at - start) * 1000
         return self._lines
 
-    def _redraw_changes(self, scene, size: Size, dark: bool) -> bool:
+    def palette(self) -> Palette:
+        """The colours for the theme, without cell fills where the terminal cannot show them
+        (NO_COLOR, or 16 colours)."""
+        app = self.app
+        return palette_for(app.current_theme.dark, plain_terminal(app))
+
+    def _redraw_changes(self, scene, size: Size, palette: Palette) -> bool:
         """Draw again only the characters that an edit of a live scene or a cursor move touched.
 
         Returns False when that is not possible (the scene cannot say what
@@ -363,9 +382,9 @@ class DiagramCanvas(Widget, can_focus=True):
             owner = scene.update_owner(frame.owner[r0:r1, c0:c1], ids, part_view, c1 - c0, r1 - r0)
         redraw_part(frame, scene, self.view, cols, rows, (c0, r0, c1, r1), owner=owner,
                     delaunay=self.show_delaunay, vertices=self.show_vertices,
-                    overlay=self.overlay, cursor=self.cursor)
+                    overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled)
         part = Frame(frame.codes[r0:r1], frame.mark[r0:r1], frame.fill[r0:r1], frame.owner[r0:r1])
-        self._lines[r0:r1] = frame_lines(part, palette_for(dark))
+        self._lines[r0:r1] = frame_lines(part, palette)
         return True
 
     def render_line(self, y: int) -> Strip:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -66,6 +66,10 @@ class Palette:
     conflict: str
     conflict_fill: str
     cursor: str
+    # False: no cell fills (a terminal without colours, or with only 16)
+    filled: bool = True
+    # the background of the characters under the keyboard cursor when cells are not filled
+    plain_highlight: str = "#808080"
 
     @property
     def tints(self) -> tuple[str, ...]:
@@ -78,6 +82,9 @@ class Palette:
     @property
     def backgrounds(self) -> tuple[str | None, ...]:
         """Every background a character can have, indexed by its fill + 1 (no fill first)."""
+        if not self.filled:
+            n = len(self.fills)
+            return (None, *(None,) * (2 * n), self.conflict_fill, *(self.plain_highlight,) * n)
         return (None, *self.fills, *self.tints, self.conflict_fill, *self.highlights)
 
 
@@ -141,8 +148,24 @@ LIGHT = Palette(
 )
 
 
-def palette_for(dark: bool) -> Palette:
-    """The palette that reads on a dark (True) or light (False) theme."""
+# Without colours (NO_COLOR: Textual turns colours into greys) or with only 16 (each
+# colour becomes the nearest of the 16), eight muted fills collapse into a few and the
+# marks drawn over them get lost. These palettes draw no fills: grey edges, and sites
+# in the brightest (darkest) colour there is, which stays the brightest (darkest) grey.
+PLAIN_DARK = replace(
+    DARK, filled=False, edge="#808080", site="#ffff00", vertex="#ff0000", delaunay="#008080",
+    cursor="#ff00ff", plain_highlight="#000080",
+)
+PLAIN_LIGHT = replace(
+    LIGHT, filled=False, edge="#808080", site="#000000", vertex="#800000", delaunay="#008080",
+    cursor="#800080", plain_highlight="#c0c0c0",
+)
+
+
+def palette_for(dark: bool, plain: bool = False) -> Palette:
+    """The palette that reads on a dark (True) or light (False) theme; ``plain``: without fills."""
+    if plain:
+        return PLAIN_DARK if dark else PLAIN_LIGHT
     return DARK if dark else LIGHT
 
 

@@ -410,13 +410,16 @@ def rasterize(
     overlay=None,
     cursor: tuple[float, float] | None = None,
     owner: np.ndarray | None = None,
+    site_blocks: bool = False,
 ) -> Frame:
     """Draw a scene into a frame of ``cols x rows`` characters.
 
     ``overlay``, if given, draws more layers (``overlay.draw(painter)``) and
     may change the fills (``overlay.refill(fill, owner, view, cols, rows)``);
     ``cursor`` is a world point marked with a cross; ``owner`` is the
-    ``cell_owner`` of this scene and view when the caller already has it.
+    ``cell_owner`` of this scene and view when the caller already has it;
+    ``site_blocks`` draws every site as a block of dots (else only where
+    sites are sparse), for a picture without fills.
     """
     paint = Painter(view, cols, rows)
     if delaunay and len(scene.delaunay):
@@ -425,7 +428,7 @@ def rasterize(
     if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
         paint.points(VERTEX, scene.vertices)
     if scene.n_sites:
-        sparse = per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
+        sparse = site_blocks or per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
         paint.points(SITE, scene.sites, block=sparse)
     if overlay is not None:
         overlay.draw(paint)
