@@ -363,7 +363,8 @@ def test_snapshot_help_screen(snap_compare):
 
 
 def test_snapshot_narrow_terminal(snap_compare):
-    """A 60 x 20 terminal: the panel is hidden and the diagram fills the width."""
+    """A 60 x 20 terminal: the panel is hidden and the diagram fills the width; the
+    inspector's line above the status line says how to inspect a cell."""
     assert snap_compare(make_app(), terminal_size=(60, 20))
 
 
@@ -649,6 +650,7 @@ def test_sixteen_colours_draw_no_fills():
 
 def test_snapshot_no_color_80x24(snap_compare, monkeypatch):
     """NO_COLOR at 80 x 24 (greys only): no cell fills, grey edges, the sites as bright bold
-    blocks, the panel beside them, and the footer's keys all within the 80 columns."""
+    blocks, the panel beside them (too short for the inspector, whose line sits above the
+    status line), and the footer's keys all within the 80 columns."""
     monkeypatch.setenv("NO_COLOR", "1")
     assert snap_compare(make_app(), terminal_size=(80, 24))

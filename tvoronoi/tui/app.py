@@ -25,6 +25,7 @@ from tvoronoi.tui.building import THREAD_MIN_SITES, Built, BuildingMixin, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
+from tvoronoi.tui.inspector import InspectorMixin
 from tvoronoi.tui.playback import PlaybackMixin
 from tvoronoi.tui.screens import HelpScreen
 from tvoronoi.tui.timeline import Timeline
@@ -64,7 +65,7 @@ def _tip(widget, text: str):
     return widget
 
 
-class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int]):
+class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, InspectorMixin, App[int]):
     """Explore Voronoi diagrams in the terminal.
 
     Parameters
@@ -172,7 +173,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
                     "Watch the engine build this diagram step by step (t)",
                 )
                 yield ProgressBar(id="progress", show_eta=False)
+                yield Label("Cell", classes="heading inspector")
+                yield Static(id="inspector", classes="inspector")
         yield Timeline(id="timeline")
+        yield Static(id="inspect-line")
         yield Static(id="status")
         yield Footer(show_command_palette=False)
 
@@ -188,6 +192,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
 
     def on_workspace_resized(self) -> None:
         self._layout_panel()
+        self.inspect()
+
+    def on_diagram_canvas_target_changed(self) -> None:
+        self.inspect()
 
     def _layout_panel(self) -> None:
         """Show or hide the side panel: as the user chose with `p`, else by the terminal's width.
@@ -310,6 +318,8 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         self.query_one("#status", Static).update(text, layout=False)
 
     def _update_status(self) -> None:
+        """Say what is shown: in the status line, and the inspected cell (which may have changed)."""
+        self.inspect()
         if self.building is not None:
             self._set_status(self.building)  # the old diagram's status would hide the running build
             return
@@ -357,6 +367,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         panel = self.query_one("#panel")
         self._panel_wanted = not panel.display
         self._layout_panel()
+        self.inspect()
         if not panel.display:
             self.canvas.focus()
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
 from rich.segment import Segment
 from textual.binding import Binding
 from textual.events import MouseDown, MouseMove, MouseScrollDown, MouseScrollUp, MouseUp, Resize
@@ -98,6 +99,9 @@ class DiagramCanvas(Widget, can_focus=True):
             self.x = x
             self.y = y
 
+    class TargetChanged(Message):
+        """The keyboard cursor or the mouse pointer moved, or left: what they point at may differ."""
+
     class SiteDragged(Message):
         """The user dragged site ``site`` to (x, y); ``done`` when the button was released.
 
@@ -169,6 +173,17 @@ class DiagramCanvas(Widget, can_focus=True):
     def set_cursor(self, cursor: tuple[float, float] | None) -> None:
         self.cursor = cursor
         self.refresh()
+        self.post_message(self.TargetChanged())
+
+    def cell_at(self, x: float, y: float) -> int | None:
+        """The id of the site whose cell holds the world point (x, y); None outside the box."""
+        scene = self.scene
+        if scene is None or scene.n_sites == 0:
+            return None
+        xmin, ymin, xmax, ymax = scene.bbox
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return None
+        return int(scene.nearest(np.array([[x, y]]))[0])
 
     def world_at(self, col: float, row: float) -> tuple[float, float]:
         """The world point at the centre of character (col, row)."""
@@ -273,6 +288,7 @@ class DiagramCanvas(Widget, can_focus=True):
         if self._press is None or not event.button:
             offset = event.get_content_offset(self)
             self.pointer = None if offset is None else self.world_at(offset.x, offset.y)
+            self.post_message(self.TargetChanged())
             return
         x0, y0 = self._drag_from
         dx, dy = event.screen_x - x0, event.screen_y - y0
@@ -303,6 +319,7 @@ class DiagramCanvas(Widget, can_focus=True):
 
     def on_leave(self) -> None:
         self.pointer = None
+        self.post_message(self.TargetChanged())
 
     def on_resize(self, event: Resize) -> None:
         self._keep_fitted()
