@@ -2,6 +2,7 @@
 
 import asyncio
 import functools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from tvoronoi.tui.raster import View
 from tvoronoi.tui.screens import HelpScreen, PathDialog
 
 SIZE = (100, 40)
+CITIES = Path(__file__).resolve().parent.parent / "data" / "cities.csv"
 
 
 def pilot_test(test):
@@ -43,7 +45,18 @@ def error_toasts(app) -> list[str]:
 
 
 def status_text(app) -> str:
-    return str(app.query_one("#status").render())
+    """What the status line says is shown, without where the view is (at its right end)."""
+    text = str(app.query_one("#status").render()).rstrip()
+    view = app.canvas.describe_view()
+    for suffix in (view, view.rsplit(" ", 1)[-1]):
+        if text.endswith(suffix):
+            return text[: -len(suffix)].rstrip()
+    return text
+
+
+def view_text(app) -> str:
+    """Where the status line says the view is."""
+    return str(app.query_one("#status").render()).rstrip()[len(status_text(app)):].strip()
 
 
 @pilot_test
@@ -654,3 +667,52 @@ def test_snapshot_no_color_80x24(snap_compare, monkeypatch):
     status line), and the footer's keys all within the 80 columns."""
     monkeypatch.setenv("NO_COLOR", "1")
     assert snap_compare(make_app(), terminal_size=(80, 24))
+
+
+@pilot_test
+async def test_the_status_line_shows_where_the_view_is_and_its_zoom():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+
+        def shown() -> str:
+            return view_text(app)
+
+        view = app.canvas.view
+        assert shown() == f"({view.cx:.3f}, {view.cy:.3f}) ×1"
+        await pilot.press("plus")
+        assert shown().endswith("×1.25")
+        await pilot.press("right")
+        assert shown().startswith(f"({app.canvas.view.cx:.3f}, ")
+        assert app.canvas.view.cx > view.cx
+        # zoomed far in, the coordinates get the digits a character needs
+        for _ in range(12):
+            await pilot.press("plus")
+        assert shown().endswith(f"×{1.25 ** 13:.3g}")
+        assert len(shown().split(",")[0]) > len("(0.500")
+        await pilot.press("0")
+        assert shown() == f"({view.cx:.3f}, {view.cy:.3f}) ×1"
+
+
+@pilot_test
+async def test_a_point_file_given_at_start_is_opened():
+    app = make_app(path=CITIES)
+    async with app.run_test(size=SIZE) as pilot:
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.built.source == "cities.csv"
+        assert app.built.diagram.n_sites == len(app.built.point_set)
+        assert app.canvas.has_focus
+        # the Open dialog offers it again
+        await pilot.press("o")
+        assert app.screen.query_one("#path", Input).value == str(CITIES)
+
+
+@pilot_test
+async def test_an_unreadable_file_at_start_is_an_error_and_the_default_points_show(tmp_path):
+    app = make_app(path=tmp_path / "nowhere.csv")
+    async with app.run_test(size=SIZE, notifications=True) as pilot:
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert any("nowhere.csv" in text for text in error_toasts(app))
+        assert app.built.diagram.n_sites == 300

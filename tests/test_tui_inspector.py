@@ -1,16 +1,12 @@
 """The inspector of the terminal UI: the cell under the keyboard cursor or the mouse pointer."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from shapely.geometry import Polygon
 from textual.widgets import Input
 
-from test_tui import SIZE, make_app, pilot_test
+from test_tui import CITIES, SIZE, make_app, pilot_test
 from tvoronoi.tui.inspector import diagram_neighbours, ring_area
-
-CITIES = Path(__file__).resolve().parent.parent / "data" / "cities.csv"
 
 
 async def open_cities(app, pilot):
@@ -137,3 +133,4 @@ def test_snapshot_inspector_line_at_80x24(snap_compare):
         await pilot.pause()
 
     assert snap_compare(make_app(), run_before=rome, terminal_size=(80, 24))
+

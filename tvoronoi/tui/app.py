@@ -7,9 +7,12 @@ diagrams (``building``), opening and saving (``files``), algorithm playback
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+from rich.text import Text
 from textual import on
 from textual.app import App, ComposeResult
 from textual.binding import Binding
@@ -27,7 +30,7 @@ from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
 from tvoronoi.tui.inspector import InspectorMixin
 from tvoronoi.tui.playback import PlaybackMixin
-from tvoronoi.tui.screens import HelpScreen
+from tvoronoi.tui.screens import HelpScreen, OpenRequest
 from tvoronoi.tui.timeline import Timeline
 
 DEFAULT_DISTRIBUTION = "uniform"
@@ -72,6 +75,11 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
     ----------
     points : (n, 2) array, optional
         Sites to show first; by default 300 uniform points (seed 0).
+    path : str or os.PathLike, optional
+        A point file to open at start instead (read as the Open dialog reads
+        it; if it cannot be read, the default points are shown after the error).
+    x, y : str, optional
+        The x and y columns of that file (default: found from the file).
     engine : str
         The engine selected at start.
     clock : callable
@@ -96,14 +104,18 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         *editing.BINDINGS,
     ]
 
-    def __init__(self, points=None, *, engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
+    def __init__(self, points=None, *, path=None, x: str | None = None, y: str | None = None,
+                 engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
         super().__init__()
         self.initial_points = None if points is None else np.asarray(points, np.float64)
+        self.initial_file = None if path is None else OpenRequest(Path(path), x, y)
         self.initial_engine = engine if engine in ENGINES else ENGINES[0]
         self.clock = clock
         self.built: Built | None = None
         self._panel_wanted: bool | None = None  # None: decided by the width
         self._narrow: bool | None = None  # whether the panel was last laid out for a narrow terminal
+        self._status_text = ""  # the left part of the status line
+        self._view_text = ""  # its right part: where the view is
 
     # -- layout --------------------------------------------------------------
 
@@ -177,7 +189,11 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                 yield Static(id="inspector", classes="inspector")
         yield Timeline(id="timeline")
         yield Static(id="inspect-line")
-        yield Static(id="status")
+        yield _tip(
+            Static(id="status"),
+            "What is shown; on the right, the world point at the centre of the view and the zoom "
+            "against the view that fits the box (0 fits it again)",
+        )
         yield Footer(show_command_palette=False)
 
     def on_mount(self) -> None:
@@ -185,14 +201,23 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self.query_one("#progress").display = False
         self.timeline.display = False
         self.canvas.focus()
+        self.watch(self.canvas, "view", self._show_view, init=False)
         if self.initial_points is not None:
             self._request_build(lambda: self.initial_points, source="points given", size=len(self.initial_points))
+        elif self.initial_file is not None:
+            self._open_path(self.initial_file)
         else:
             self.action_generate()
 
     def on_workspace_resized(self) -> None:
         self._layout_panel()
         self.inspect()
+        self._show_view()
+
+    def _show_view(self) -> None:
+        """Say where the view is (its centre and zoom) at the right of the status line."""
+        self._view_text = self.canvas.describe_view() if self.built is not None else ""
+        self._render_status()
 
     def on_diagram_canvas_target_changed(self) -> None:
         self.inspect()
@@ -314,12 +339,33 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
     # -- status --------------------------------------------------------------
 
     def _set_status(self, text: str) -> None:
-        # the status line has a fixed size: no layout pass (it would delay the canvas's frame)
-        self.query_one("#status", Static).update(text, layout=False)
+        self._status_text = text
+        self._render_status()
+
+    def _render_status(self) -> None:
+        """The status line: what is shown on the left, where the view is on the right.
+
+        What is shown comes first: the view's text shrinks to its zoom, then
+        goes, when both do not fit. The line has a fixed size: no layout pass
+        (it would delay the canvas's frame).
+        """
+        status = self.query_one("#status", Static)
+        left, right = self._status_text, self._view_text
+        room = status.content_size.width or max(self.size.width - 2, 0)
+        if len(left) + 2 + len(right) > room:
+            right = right[right.rindex(" ") + 1:] if right else ""  # the zoom alone
+            if len(left) + 2 + len(right) > room:
+                right = ""
+        line = Text(left, no_wrap=True, overflow="ellipsis")
+        if right:
+            line.append(" " * (room - len(left) - len(right)))
+            line.append(right, style="dim")
+        status.update(line, layout=False)
 
     def _update_status(self) -> None:
         """Say what is shown: in the status line, and the inspected cell (which may have changed)."""
         self.inspect()
+        self._show_view()
         if self.building is not None:
             self._set_status(self.building)  # the old diagram's status would hide the running build
             return
@@ -433,11 +479,12 @@ HELP_TEXT = {
 }
 
 
-def main() -> int:
-    """Run the terminal UI; the exit status of the app."""
-    status = VoronoiApp().run()
+def main(path=None) -> int:
+    """Run the terminal UI, on the point file ``path`` if given; the exit status of the app."""
+    status = VoronoiApp(path=path).run()
     return status if isinstance(status, int) else 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    # python -m tvoronoi.tui.app [FILE]
+    raise SystemExit(main(*sys.argv[1:2]))

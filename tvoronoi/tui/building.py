@@ -150,6 +150,9 @@ class BuildingMixin:
             self._show_building(None)
         self._fail(message.error)
         self._update_status()
+        if self.built is None and self.building is None:
+            # nothing to keep (a file given at start could not be read): show the panel's points
+            self.action_generate()
 
     def _accept(self, request: int, built: Built, fit: bool) -> None:
         if request != self._request:

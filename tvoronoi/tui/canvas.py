@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -217,6 +218,23 @@ class DiagramCanvas(Widget, can_focus=True):
             return
         self._fit_size = size
         self.view = View.fit(self.scene.bbox, size.width, size.height)
+
+    def zoom(self) -> float:
+        """How much the view is magnified against the one that fits the box (1: fitted)."""
+        if self.scene is None:
+            return 1.0
+        width, height = self._canvas_size()
+        return View.fit(self.scene.bbox, width, height).scale / self.view.scale
+
+    def describe_view(self) -> str:
+        """The world point at the centre of the view and the zoom, as "(x, y) ×zoom", with as
+        many digits as a character's width needs."""
+        view = self.view
+        char_width = view.scale * DOT_COLS
+        digits = min(max(1 - math.floor(math.log10(char_width)), 0), 12) if char_width > 0 else 3
+        zoom = self.zoom()
+        shown = f"{zoom:.3g}" if zoom < 1000 else f"{zoom:,.0f}"
+        return f"({view.cx:.{digits}f}, {view.cy:.{digits}f}) ×{shown}"
 
     def _canvas_size(self) -> tuple[int, int]:
         size = self.content_size
