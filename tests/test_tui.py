@@ -716,3 +716,23 @@ async def test_an_unreadable_file_at_start_is_an_error_and_the_default_points_sh
         await pilot.pause()
         assert any("nowhere.csv" in text for text in error_toasts(app))
         assert app.built.diagram.n_sites == 300
+
+
+@pytest.mark.parametrize("name, text, columns", [
+    ("words.csv", "name,kind\nLisbon,city\n", {}),
+    ("bad.csv", "x,y\n0,0\nabc,1\n", {}),
+    ("points.geojson", '{"type": "FeatureCollection", "features": []}', {"x": "a", "y": "b"}),
+])
+def test_reader_advice_names_the_open_dialogs_fields(tmp_path, name, text, columns):
+    from tvoronoi.errors import TvoronoiError
+    from tvoronoi.readers import read_points
+    from tvoronoi.tui.files import ui_advice
+
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(TvoronoiError) as caught:
+        read_points(path, **columns)
+    assert "--x" in str(caught.value)  # the readers speak to the command line
+    message = ui_advice(str(caught.value))
+    assert "--x" not in message and "--y" not in message
+    assert "column fields" in message
