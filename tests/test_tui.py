@@ -736,3 +736,21 @@ def test_reader_advice_names_the_open_dialogs_fields(tmp_path, name, text, colum
     message = ui_advice(str(caught.value))
     assert "--x" not in message and "--y" not in message
     assert "column fields" in message
+
+
+@pilot_test
+async def test_choosing_the_option_already_chosen_also_hands_the_keys_back():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        engine = app.query_one("#engine", Select)
+        engine.focus()
+        await pilot.press("enter", "enter")  # open the list, choose incremental again
+        await pilot.pause()
+        assert engine.value == "incremental"
+        assert app.canvas.has_focus
+        # Escape closes the list without a choice: the focus stays in the Select
+        engine.focus()
+        await pilot.press("enter", "escape")
+        await pilot.pause()
+        assert engine.has_focus

@@ -19,6 +19,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
 from textual.message import Message
 from textual.widgets import Button, Footer, Input, Label, ProgressBar, Select, Static
+from textual.widgets._select import SelectOverlay
 
 from tvoronoi.api import ENGINES
 from tvoronoi.errors import TvoronoiError
@@ -57,6 +58,23 @@ class Workspace(Horizontal):
 
     def on_resize(self) -> None:
         self.post_message(self.Resized())
+
+
+class PanelSelect(Select):
+    """A Select that reports every choice made in its list, the one already chosen included
+    (``Select.Changed`` comes only for a new value)."""
+
+    class Chosen(Message):
+        """The user chose an option in the list."""
+
+        def __init__(self, select: "PanelSelect") -> None:
+            super().__init__()
+            self.select = select
+
+    @on(SelectOverlay.UpdateSelection)
+    def _chosen(self) -> None:
+        # Select's own handler (run after this one) sets the value and closes the list
+        self.post_message(self.Chosen(self))
 
 
 class SidePanel(VerticalScroll, can_focus=False):
@@ -127,7 +145,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                 with Horizontal(classes="row"):
                     yield Label("shape")
                     yield _tip(
-                        Select(
+                        PanelSelect(
                             [(name, name) for name in DISTRIBUTIONS],
                             value=DEFAULT_DISTRIBUTION, allow_blank=False, compact=True, id="distribution",
                         ),
@@ -173,7 +191,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                 with Horizontal(classes="row"):
                     yield Label("engine")
                     yield _tip(
-                        Select(
+                        PanelSelect(
                             [(name, name) for name in ENGINES],
                             value=self.initial_engine, allow_blank=False, compact=True, id="engine",
                         ),
@@ -253,11 +271,12 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
     @on(Select.Changed, "#distribution")
     def _distribution_changed(self, event: Select.Changed) -> None:
         self._show_parameters(str(event.value))
-        self._back_to_canvas(event.select)
+
+    def on_panel_select_chosen(self, message: PanelSelect.Chosen) -> None:
+        self.canvas.focus()  # after Select's own focus on itself
 
     @on(Select.Changed, "#engine")
     def _engine_changed(self, event: Select.Changed) -> None:
-        self._back_to_canvas(event.select)
         built = self.built
         if built is None or event.value == built.diagram.engine:
             return
