@@ -211,6 +211,26 @@ async def test_m_and_arrows_move_a_site_enter_drops_it():
 
 
 @pilot_test
+async def test_after_a_large_start_m_and_arrows_move_a_site():
+    """Started on 100,000 points (built in a worker), the keys still reach the canvas."""
+    app = make_app(points=generate("uniform", 100_000, seed=4))
+    async with app.run_test(size=SIZE) as pilot:
+        await ready(app, pilot)
+        canvas = app.canvas
+        assert canvas.has_focus
+        for _ in range(6):  # zoom in until sites have room around them
+            await pilot.press("plus")
+        inside = canvas.scene.nearest(np.array([[canvas.view.cx, canvas.view.cy]]))
+        near = np.argsort(((canvas.scene.sites - canvas.scene.sites[inside[0]]) ** 2).sum(axis=1))[:200]
+        i = site_with_room(canvas, near)
+        x0, y0 = canvas.scene.sites[i]
+        canvas.set_cursor((x0, y0))
+        await pilot.press("m", "right", "enter")
+        await pilot.pause()
+        assert np.allclose(app.live.sites[i], (x0 + DOT_COLS * canvas.view.scale, y0))
+
+
+@pilot_test
 async def test_escape_puts_a_moved_site_back():
     app = make_app()
     async with app.run_test(size=SIZE) as pilot:
@@ -420,9 +440,10 @@ def test_edits_far_from_the_view_redraw_nothing(live_case):
 
 
 def test_snapshot_editing_with_the_keyboard_cursor(snap_compare):
-    """Zoomed in twice, two sites added with the keyboard cursor (the pink block) and the
-    second one moved one character left with m: their cells cut into their neighbours',
-    which keep their colours; the status line counts the edits."""
+    """Zoomed in twice, two sites added with the keyboard cursor (a pink cross over darker
+    cell colours, the site under it still yellow) and the second one moved one character
+    left with m: their cells cut into their neighbours', which keep their colours; the
+    status line counts the edits."""
     keys = ["plus", "plus", "c", "shift+right", "shift+right", "a", "shift+up", "shift+up", "a",
             "m", "left", "enter"]
     assert snap_compare(make_app(), press=keys, terminal_size=SIZE)

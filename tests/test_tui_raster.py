@@ -204,3 +204,41 @@ def test_colouring_has_no_clash_on_random_diagrams(n, seed, distribution):
     a, b = cell_adjacency(diagram)
     assert not (colours[a] == colours[b]).any()
     assert colours.max() < len(DARK.fills)
+
+
+def test_the_keyboard_cursor_lights_up_its_cell_and_keeps_the_site_under_it():
+    """The cursor on a site: the site's character keeps its mark and the cell's own colour,
+    lit up, not a block of the cursor's colour."""
+    from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+    from tvoronoi.tui.raster import CURSOR, HIGHLIGHTED, N_FILLS
+
+    diagram = tvoronoi.voronoi(generate("uniform", 30, seed=3))
+    scene = Scene.from_diagram(diagram)
+    cols, rows = 60, 20
+    view = View.fit(scene.bbox, cols, rows)
+    x, y = scene.sites[7]
+    plain = rasterize(scene, view, cols, rows)
+    frame = rasterize(scene, view, cols, rows, cursor=(x, y))
+    u, v = view.to_dots(x, y, cols, rows)
+    col, row = int(u // DOT_COLS), int(v // DOT_ROWS)
+    assert frame.mark[row, col] == SITE
+    assert frame.fill[row, col] == HIGHLIGHTED + scene.colours[7]
+    # the cross changed a few characters only, and each keeps its cell's colour, lit up
+    changed = (frame.fill != plain.fill) | (frame.mark != plain.mark)
+    assert 1 <= changed.sum() <= 6
+    assert (frame.fill[changed] - HIGHLIGHTED == plain.fill[changed]).all()
+    assert (plain.fill[changed] < N_FILLS).all()
+    assert ((frame.mark[changed] == CURSOR) | (frame.mark[changed] == plain.mark[changed])).all()
+    for palette in (DARK, LIGHT):
+        line = frame_lines(frame, palette)[row]
+        style = next(seg.style for seg, start in _with_starts(line) if start <= col < start + len(seg.text))
+        assert style.bgcolor.name != palette.cursor
+        assert style.color.name == palette.site
+        assert style.bgcolor.name == palette.highlights[scene.colours[7]]
+
+
+def _with_starts(line):
+    start = 0
+    for seg in line:
+        yield seg, start
+        start += len(seg.text)

@@ -7,14 +7,19 @@ diagrams (``building``), opening and saving (``files``), algorithm playback
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+from rich.text import Text
 from textual import on
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, VerticalScroll
+from textual.message import Message
 from textual.widgets import Button, Footer, Input, Label, ProgressBar, Select, Static
+from textual.widgets._select import SelectOverlay
 
 from tvoronoi.api import ENGINES
 from tvoronoi.errors import TvoronoiError
@@ -24,8 +29,9 @@ from tvoronoi.tui.building import THREAD_MIN_SITES, Built, BuildingMixin, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
+from tvoronoi.tui.inspector import InspectorMixin
 from tvoronoi.tui.playback import PlaybackMixin
-from tvoronoi.tui.screens import HelpScreen
+from tvoronoi.tui.screens import HelpScreen, OpenRequest
 from tvoronoi.tui.timeline import Timeline
 
 DEFAULT_DISTRIBUTION = "uniform"
@@ -44,6 +50,33 @@ PARAMETERS = {
     "clustered": (("clusters", int), ("spread", float)),
 }
 
+class Workspace(Horizontal):
+    """The canvas and the side panel, as wide as the terminal: its resizes are the terminal's."""
+
+    class Resized(Message):
+        """The terminal changed size (the App itself does not hear of it)."""
+
+    def on_resize(self) -> None:
+        self.post_message(self.Resized())
+
+
+class PanelSelect(Select):
+    """A Select that reports every choice made in its list, the one already chosen included
+    (``Select.Changed`` comes only for a new value)."""
+
+    class Chosen(Message):
+        """The user chose an option in the list."""
+
+        def __init__(self, select: "PanelSelect") -> None:
+            super().__init__()
+            self.select = select
+
+    @on(SelectOverlay.UpdateSelection)
+    def _chosen(self) -> None:
+        # Select's own handler (run after this one) sets the value and closes the list
+        self.post_message(self.Chosen(self))
+
+
 class SidePanel(VerticalScroll, can_focus=False):
     """The controls beside the canvas; it scrolls when the terminal is short, but Tab skips it."""
 
@@ -53,13 +86,18 @@ def _tip(widget, text: str):
     return widget
 
 
-class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int]):
+class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, InspectorMixin, App[int]):
     """Explore Voronoi diagrams in the terminal.
 
     Parameters
     ----------
     points : (n, 2) array, optional
         Sites to show first; by default 300 uniform points (seed 0).
+    path : str or os.PathLike, optional
+        A point file to open at start instead (read as the Open dialog reads
+        it; if it cannot be read, the default points are shown after the error).
+    x, y : str, optional
+        The x and y columns of that file (default: found from the file).
     engine : str
         The engine selected at start.
     clock : callable
@@ -71,7 +109,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
     TITLE = "tvoronoi"
 
     BINDINGS = [
-        Binding("q", "quit", "Quit"),
+        Binding("q", "quit", "Quit", show=False),  # in the help: the footer keeps 80 columns for the rest
         Binding("question_mark", "help", "Help", key_display="?"),
         Binding("d", "toggle_delaunay", "Delaunay"),
         Binding("v", "toggle_vertices", "Vertices", show=False),
@@ -84,25 +122,30 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         *editing.BINDINGS,
     ]
 
-    def __init__(self, points=None, *, engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
+    def __init__(self, points=None, *, path=None, x: str | None = None, y: str | None = None,
+                 engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
         super().__init__()
         self.initial_points = None if points is None else np.asarray(points, np.float64)
+        self.initial_file = None if path is None else OpenRequest(Path(path), x, y)
         self.initial_engine = engine if engine in ENGINES else ENGINES[0]
         self.clock = clock
         self.built: Built | None = None
         self._panel_wanted: bool | None = None  # None: decided by the width
+        self._narrow: bool | None = None  # whether the panel was last laid out for a narrow terminal
+        self._status_text = ""  # the left part of the status line
+        self._view_text = ""  # its right part: where the view is
 
     # -- layout --------------------------------------------------------------
 
     def compose(self) -> ComposeResult:
-        with Horizontal(id="main"):
+        with Workspace(id="main"):
             yield DiagramCanvas(id="canvas")
             with SidePanel(id="panel"):
                 yield Label("Points", classes="heading")
                 with Horizontal(classes="row"):
                     yield Label("shape")
                     yield _tip(
-                        Select(
+                        PanelSelect(
                             [(name, name) for name in DISTRIBUTIONS],
                             value=DEFAULT_DISTRIBUTION, allow_blank=False, compact=True, id="distribution",
                         ),
@@ -148,7 +191,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
                 with Horizontal(classes="row"):
                     yield Label("engine")
                     yield _tip(
-                        Select(
+                        PanelSelect(
                             [(name, name) for name in ENGINES],
                             value=self.initial_engine, allow_blank=False, compact=True, id="engine",
                         ),
@@ -160,28 +203,60 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
                     "Watch the engine build this diagram step by step (t)",
                 )
                 yield ProgressBar(id="progress", show_eta=False)
+                yield Label("Cell", classes="heading inspector")
+                yield Static(id="inspector", classes="inspector")
         yield Timeline(id="timeline")
-        yield Static(id="status")
-        yield Footer()
+        yield Static(id="inspect-line")
+        yield _tip(
+            Static(id="status"),
+            "What is shown; on the right, the world point at the centre of the view and the zoom "
+            "against the view that fits the box (0 fits it again)",
+        )
+        yield Footer(show_command_palette=False)
 
     def on_mount(self) -> None:
         self._show_parameters(DEFAULT_DISTRIBUTION)
         self.query_one("#progress").display = False
         self.timeline.display = False
         self.canvas.focus()
+        self.watch(self.canvas, "view", self._show_view, init=False)
         if self.initial_points is not None:
             self._request_build(lambda: self.initial_points, source="points given", size=len(self.initial_points))
+        elif self.initial_file is not None:
+            self._open_path(self.initial_file)
         else:
             self.action_generate()
 
-    def on_resize(self) -> None:
+    def on_workspace_resized(self) -> None:
         self._layout_panel()
+        self.inspect()
+        self._show_view()
+
+    def _show_view(self) -> None:
+        """Say where the view is (its centre and zoom) at the right of the status line."""
+        self._view_text = self.canvas.describe_view() if self.built is not None else ""
+        self._render_status()
+
+    def on_diagram_canvas_target_changed(self) -> None:
+        self.inspect()
 
     def _layout_panel(self) -> None:
+        """Show or hide the side panel: as the user chose with `p`, else by the terminal's width.
+
+        A resize across NARROW_WIDTH decides again by the width (the choice was
+        made for the other size).
+        """
+        narrow = self.size.width < NARROW_WIDTH
+        if narrow != self._narrow:
+            self._narrow = narrow
+            self._panel_wanted = None
         wanted = self._panel_wanted
         if wanted is None:
-            wanted = self.size.width >= NARROW_WIDTH
-        self.query_one("#panel").display = wanted
+            wanted = not narrow
+        panel = self.query_one("#panel")
+        panel.display = wanted
+        if not wanted and panel.has_focus_within:
+            self.canvas.focus()
 
     @property
     def canvas(self) -> DiagramCanvas:
@@ -197,6 +272,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
     def _distribution_changed(self, event: Select.Changed) -> None:
         self._show_parameters(str(event.value))
 
+    def on_panel_select_chosen(self, message: PanelSelect.Chosen) -> None:
+        self.canvas.focus()  # after Select's own focus on itself
+
     @on(Select.Changed, "#engine")
     def _engine_changed(self, event: Select.Changed) -> None:
         built = self.built
@@ -209,9 +287,15 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         points, point_set = built.points, built.point_set
         self._request_build(lambda: points, source=built.source, size=len(points), fit=False, point_set=point_set)
 
+    def _back_to_canvas(self, control) -> None:
+        """A control was used (a choice made, a field submitted): the keys go to the diagram again."""
+        if control.has_focus:
+            self.canvas.focus()
+
     @on(Button.Pressed, "#generate")
-    def _generate_pressed(self) -> None:
-        self.action_generate()
+    def _generate_pressed(self, event: Button.Pressed) -> None:
+        if self._generate():
+            self._back_to_canvas(event.button)
 
     @on(Button.Pressed, "#playback")
     def _playback_pressed(self) -> None:
@@ -220,8 +304,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
 
     @on(Input.Submitted)
     def _input_submitted(self, event: Input.Submitted) -> None:
-        if event.input.id in ("count", "seed", "sigma", "clusters", "spread"):
-            self.action_generate()
+        # a bad value keeps the focus in its field, for the user to fix it
+        if event.input.id in ("count", "seed", "sigma", "clusters", "spread") and self._generate():
+            self._back_to_canvas(event.input)
 
     def _read_int(self, input_id: str, name: str, minimum: int) -> int:
         text = self.query_one(f"#{input_id}", Input).value.strip()
@@ -256,22 +341,53 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
 
     def action_generate(self) -> None:
         """Make points from the panel's settings and build their diagram."""
+        self._generate()
+
+    def _generate(self) -> bool:
+        """Make points from the panel's settings and build their diagram; False if a setting is bad."""
         try:
             distribution, count, seed, params = self._panel_request()
         except TvoronoiError as exc:
             self._fail(str(exc))
-            return
+            return False
         shown = ", ".join([f"seed {seed}", *(f"{k} {v:g}" for k, v in params.items())])
         source = f"{distribution} ({shown})"
         self._request_build(lambda: generate(distribution, count, seed=seed, **params), source=source, size=count)
+        return True
 
     # -- status --------------------------------------------------------------
 
     def _set_status(self, text: str) -> None:
-        # the status line has a fixed size: no layout pass (it would delay the canvas's frame)
-        self.query_one("#status", Static).update(text, layout=False)
+        self._status_text = text
+        self._render_status()
+
+    def _render_status(self) -> None:
+        """The status line: what is shown on the left, where the view is on the right.
+
+        What is shown comes first: the view's text shrinks to its zoom, then
+        goes, when both do not fit. The line has a fixed size: no layout pass
+        (it would delay the canvas's frame).
+        """
+        status = self.query_one("#status", Static)
+        left, right = self._status_text, self._view_text
+        room = status.content_size.width or max(self.size.width - 2, 0)
+        if len(left) + 2 + len(right) > room:
+            right = right[right.rindex(" ") + 1:] if right else ""  # the zoom alone
+            if len(left) + 2 + len(right) > room:
+                right = ""
+        line = Text(left, no_wrap=True, overflow="ellipsis")
+        if right:
+            line.append(" " * (room - len(left) - len(right)))
+            line.append(right, style="dim")
+        status.update(line, layout=False)
 
     def _update_status(self) -> None:
+        """Say what is shown: in the status line, and the inspected cell (which may have changed)."""
+        self.inspect()
+        self._show_view()
+        if self.building is not None:
+            self._set_status(self.building)  # the old diagram's status would hide the running build
+            return
         built = self.built
         if built is None:
             self._set_status("no diagram")
@@ -316,6 +432,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, App[int
         panel = self.query_one("#panel")
         self._panel_wanted = not panel.display
         self._layout_panel()
+        self.inspect()
         if not panel.display:
             self.canvas.focus()
 
@@ -381,11 +498,12 @@ HELP_TEXT = {
 }
 
 
-def main() -> int:
-    """Run the terminal UI; the exit status of the app."""
-    status = VoronoiApp().run()
+def main(path=None) -> int:
+    """Run the terminal UI, on the point file ``path`` if given; the exit status of the app."""
+    status = VoronoiApp(path=path).run()
     return status if isinstance(status, int) else 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    # python -m tvoronoi.tui.app [FILE]
+    raise SystemExit(main(*sys.argv[1:2]))

@@ -14,7 +14,8 @@ import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.raster import Scene
 
-# Work on this many sites or more runs in a worker thread behind a loading indicator.
+# Work on this many sites or more runs in a worker thread; the status line and the panel's
+# progress bar say so, and the canvas keeps the focus (and the last diagram) meanwhile.
 THREAD_MIN_SITES = 100_000
 
 Clock = Callable[[], float]
@@ -69,6 +70,8 @@ class BuildingMixin:
     """
 
     _request = 0
+    # what the status line says while a build runs in a worker (None: no build running)
+    building: str | None = None
 
     def _engine(self) -> str:
         from textual.widgets import Select
@@ -105,9 +108,25 @@ class BuildingMixin:
             self._accept(request, built, fit)
         else:
             what = f"{size:,} sites" if size is not None else source
-            self._set_status(f"building {what} with {engine}…")
-            self.canvas.loading = True
+            self._show_building(f"building {what} with {engine}…")
             self._build_in_thread(request, job, fit)
+
+    def _show_building(self, text: str | None) -> None:
+        """Say that a build runs (text) or that none does (None).
+
+        Not the canvas's loading indicator: a widget that is loading cannot
+        hold the focus, which would pass to the panel and take the keys.
+        """
+        from textual.widgets import ProgressBar
+
+        self.building = text
+        bar = self.query_one("#progress", ProgressBar)
+        if text is not None:
+            bar.update(total=None, progress=0)
+            bar.display = True
+            self._set_status(text)
+        elif not self._saving:
+            bar.display = False
 
     @work(thread=True, exclusive=True, group="build", exit_on_error=False)
     def _build_in_thread(self, request: int, job: Callable[[], Built], fit: bool) -> None:
@@ -128,14 +147,17 @@ class BuildingMixin:
 
     def on_build_failed(self, message: BuildFailed) -> None:
         if message.request == self._request:
-            self.canvas.loading = False
+            self._show_building(None)
         self._fail(message.error)
         self._update_status()
+        if self.built is None and self.building is None:
+            # nothing to keep (a file given at start could not be read): show the panel's points
+            self.action_generate()
 
     def _accept(self, request: int, built: Built, fit: bool) -> None:
         if request != self._request:
             return  # a later request replaced this one
-        self.canvas.loading = False
+        self._show_building(None)
         self._diagram_replaced()
         self.built = built
         self.canvas.show_scene(built.scene, fit=fit)

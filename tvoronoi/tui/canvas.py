@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import math
 import time
 
+import numpy as np
 from rich.segment import Segment
 from textual.binding import Binding
 from textual.events import MouseDown, MouseMove, MouseScrollDown, MouseScrollUp, MouseUp, Resize
@@ -13,7 +15,7 @@ from textual.reactive import reactive
 from textual.strip import Strip
 from textual.widget import Widget
 
-from tvoronoi.tui.colours import palette_for
+from tvoronoi.tui.colours import Palette, palette_for
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.raster import (
     CURSOR_ARM,
@@ -37,6 +39,19 @@ PARTIAL_MAX_FRACTION = 0.5
 # Zoom limits, as a factor of the view that fits the box.
 MAX_ZOOM_IN = 1e6
 MAX_ZOOM_OUT = 50.0
+
+# The colour systems (rich's names) of terminals with 16 colours or fewer: cells are not filled.
+PLAIN_COLOR_SYSTEMS = ("standard", "windows")
+
+
+
+def plain_terminal(app) -> bool:
+    """Whether the app's terminal shows no colours (NO_COLOR) or only 16: cells are not filled then."""
+    if app.no_color:
+        return True
+    # a headless app (tests, snapshots) draws in full colour, whatever TERM says
+    return not app.is_headless and app.console.color_system in PLAIN_COLOR_SYSTEMS
+
 
 PAN = Binding.Group("Pan", compact=True)
 ZOOM = Binding.Group("Zoom", compact=True)
@@ -84,6 +99,9 @@ class DiagramCanvas(Widget, can_focus=True):
             super().__init__()
             self.x = x
             self.y = y
+
+    class TargetChanged(Message):
+        """The keyboard cursor or the mouse pointer moved, or left: what they point at may differ."""
 
     class SiteDragged(Message):
         """The user dragged site ``site`` to (x, y); ``done`` when the button was released.
@@ -156,6 +174,17 @@ class DiagramCanvas(Widget, can_focus=True):
     def set_cursor(self, cursor: tuple[float, float] | None) -> None:
         self.cursor = cursor
         self.refresh()
+        self.post_message(self.TargetChanged())
+
+    def cell_at(self, x: float, y: float) -> int | None:
+        """The id of the site whose cell holds the world point (x, y); None outside the box."""
+        scene = self.scene
+        if scene is None or scene.n_sites == 0:
+            return None
+        xmin, ymin, xmax, ymax = scene.bbox
+        if not (xmin <= x <= xmax and ymin <= y <= ymax):
+            return None
+        return int(scene.nearest(np.array([[x, y]]))[0])
 
     def world_at(self, col: float, row: float) -> tuple[float, float]:
         """The world point at the centre of character (col, row)."""
@@ -189,6 +218,23 @@ class DiagramCanvas(Widget, can_focus=True):
             return
         self._fit_size = size
         self.view = View.fit(self.scene.bbox, size.width, size.height)
+
+    def zoom(self) -> float:
+        """How much the view is magnified against the one that fits the box (1: fitted)."""
+        if self.scene is None:
+            return 1.0
+        width, height = self._canvas_size()
+        return View.fit(self.scene.bbox, width, height).scale / self.view.scale
+
+    def describe_view(self) -> str:
+        """The world point at the centre of the view and the zoom, as "(x, y) ×zoom", with as
+        many digits as a character's width needs."""
+        view = self.view
+        char_width = view.scale * DOT_COLS
+        digits = min(max(1 - math.floor(math.log10(char_width)), 0), 12) if char_width > 0 else 3
+        zoom = self.zoom()
+        shown = f"{zoom:.3g}" if zoom < 1000 else f"{zoom:,.0f}"
+        return f"({view.cx:.{digits}f}, {view.cy:.{digits}f}) ×{shown}"
 
     def _canvas_size(self) -> tuple[int, int]:
         size = self.content_size
@@ -260,6 +306,7 @@ class DiagramCanvas(Widget, can_focus=True):
         if self._press is None or not event.button:
             offset = event.get_content_offset(self)
             self.pointer = None if offset is None else self.world_at(offset.x, offset.y)
+            self.post_message(self.TargetChanged())
             return
         x0, y0 = self._drag_from
         dx, dy = event.screen_x - x0, event.screen_y - y0
@@ -290,6 +337,7 @@ class DiagramCanvas(Widget, can_focus=True):
 
     def on_leave(self) -> None:
         self.pointer = None
+        self.post_message(self.TargetChanged())
 
     def on_resize(self, event: Resize) -> None:
         self._keep_fitted()
@@ -304,10 +352,10 @@ class DiagramCanvas(Widget, can_focus=True):
             # again, quietly, since this is the drawing itself
             self._fit_size = size
             self.set_reactive(DiagramCanvas.view, View.fit(self.scene.bbox, size.width, size.height))
-        dark = self.app.current_theme.dark
+        palette = self.palette()
         scene = self.scene
         version = getattr(scene, "version", 0)
-        base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, dark)
+        base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, palette)
         key = (base, version, self.cursor)
         if key == self._frame_key:
             return self._lines
@@ -315,20 +363,26 @@ class DiagramCanvas(Widget, can_focus=True):
         if scene is None:
             self._frame = None
             self._lines = [[] for _ in range(size.height)]
-        elif base != self._base_key or not self._redraw_changes(scene, size, dark):
+        elif base != self._base_key or not self._redraw_changes(scene, size, palette):
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
-                overlay=self.overlay, cursor=self.cursor,
+                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled,
             )
-            self._lines = frame_lines(self._frame, palette_for(dark))
+            self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
         self._frame_version, self._frame_cursor = version, self.cursor
         self.drawn_at = time.perf_counter()
         self.last_draw_ms = (self.drawn_at - start) * 1000
         return self._lines
 
-    def _redraw_changes(self, scene, size: Size, dark: bool) -> bool:
+    def palette(self) -> Palette:
+        """The colours for the theme, without cell fills where the terminal cannot show them
+        (NO_COLOR, or 16 colours)."""
+        app = self.app
+        return palette_for(app.current_theme.dark, plain_terminal(app))
+
+    def _redraw_changes(self, scene, size: Size, palette: Palette) -> bool:
         """Draw again only the characters that an edit of a live scene or a cursor move touched.
 
         Returns False when that is not possible (the scene cannot say what
@@ -363,9 +417,9 @@ class DiagramCanvas(Widget, can_focus=True):
             owner = scene.update_owner(frame.owner[r0:r1, c0:c1], ids, part_view, c1 - c0, r1 - r0)
         redraw_part(frame, scene, self.view, cols, rows, (c0, r0, c1, r1), owner=owner,
                     delaunay=self.show_delaunay, vertices=self.show_vertices,
-                    overlay=self.overlay, cursor=self.cursor)
+                    overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled)
         part = Frame(frame.codes[r0:r1], frame.mark[r0:r1], frame.fill[r0:r1], frame.owner[r0:r1])
-        self._lines[r0:r1] = frame_lines(part, palette_for(dark))
+        self._lines[r0:r1] = frame_lines(part, palette)
         return True
 
     def render_line(self, y: int) -> Strip:

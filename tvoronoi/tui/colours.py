@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -17,6 +17,12 @@ SCATTER = 0x9E3779B1
 # Colour masks are one byte: at most 8 colours.
 MAX_COLOURS = 8
 
+
+# The characters under the keyboard cursor take their cell's colour shifted this many
+# tint steps: the other way from a tint (darker on the dark theme, lighter on the light
+# one), so that the light marks of the dark theme (and the dark ones of the light) keep
+# their contrast there.
+HIGHLIGHT_STEPS = -1
 
 # The six levels of each channel of the xterm 256-colour cube.
 CUBE_LEVELS = (0x00, 0x5F, 0x87, 0xAF, 0xD7, 0xFF)
@@ -38,9 +44,11 @@ class Palette:
     sweep line, beach line, pending circle events and growing edges,
     ``event`` for what the current step did (and the site being moved),
     ``conflict`` and ``conflict_fill`` for the triangles an insertion
-    destroyed, ``cursor`` and ``cursor_text`` for the keyboard cursor (a
-    block of colour under dots). ``tints`` are the fills
-    of the cells an insertion took area from.
+    destroyed, ``cursor`` for the keyboard cursor's cross. ``tints`` are the
+    fills of the cells an insertion took area from, ``highlights`` those of
+    the characters under the keyboard cursor (the cell's own colour, darker
+    on a dark theme and lighter on a light one, so that the site and edges
+    under the cursor keep showing).
     """
 
     fills: tuple[str, ...]
@@ -58,16 +66,26 @@ class Palette:
     conflict: str
     conflict_fill: str
     cursor: str
-    cursor_text: str
+    # False: no cell fills (a terminal without colours, or with only 16)
+    filled: bool = True
+    # the background of the characters under the keyboard cursor when cells are not filled
+    plain_highlight: str = "#808080"
 
     @property
     def tints(self) -> tuple[str, ...]:
         return tuple(cube_shift(c, self.tint_steps) for c in self.fills)
 
     @property
+    def highlights(self) -> tuple[str, ...]:
+        return tuple(cube_shift(c, HIGHLIGHT_STEPS * self.tint_steps) for c in self.fills)
+
+    @property
     def backgrounds(self) -> tuple[str | None, ...]:
         """Every background a character can have, indexed by its fill + 1 (no fill first)."""
-        return (None, *self.fills, *self.tints, self.conflict_fill)
+        if not self.filled:
+            n = len(self.fills)
+            return (None, *(None,) * (2 * n), self.conflict_fill, *(self.plain_highlight,) * n)
+        return (None, *self.fills, *self.tints, self.conflict_fill, *self.highlights)
 
 
 # All colours are exact entries of the xterm 256-colour cube, so a terminal (or a
@@ -99,7 +117,6 @@ DARK = Palette(
     conflict="#ff5f5f",
     conflict_fill="#870000",
     cursor="#ff87ff",
-    cursor_text="#000000",
 )
 
 # Pastel fills: dark edges and deep marks stay readable on each of them.
@@ -128,12 +145,27 @@ LIGHT = Palette(
     conflict="#d70000",
     conflict_fill="#ffafaf",
     cursor="#870087",
-    cursor_text="#ffffff",
 )
 
 
-def palette_for(dark: bool) -> Palette:
-    """The palette that reads on a dark (True) or light (False) theme."""
+# Without colours (NO_COLOR: Textual turns colours into greys) or with only 16 (each
+# colour becomes the nearest of the 16), eight muted fills collapse into a few and the
+# marks drawn over them get lost. These palettes draw no fills: grey edges, and sites
+# in the brightest (darkest) colour there is, which stays the brightest (darkest) grey.
+PLAIN_DARK = replace(
+    DARK, filled=False, edge="#808080", site="#ffff00", vertex="#ff0000", delaunay="#008080",
+    cursor="#ff00ff", plain_highlight="#000080",
+)
+PLAIN_LIGHT = replace(
+    LIGHT, filled=False, edge="#808080", site="#000000", vertex="#800000", delaunay="#008080",
+    cursor="#800080", plain_highlight="#c0c0c0",
+)
+
+
+def palette_for(dark: bool, plain: bool = False) -> Palette:
+    """The palette that reads on a dark (True) or light (False) theme; ``plain``: without fills."""
+    if plain:
+        return PLAIN_DARK if dark else PLAIN_LIGHT
     return DARK if dark else LIGHT
 
 

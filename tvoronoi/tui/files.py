@@ -10,9 +10,27 @@ from textual.widgets import ProgressBar
 
 import tvoronoi
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.tui.screens import PathDialog
+from tvoronoi.tui.screens import OpenDialog, OpenRequest, PathDialog
 
 DEFAULT_SAVE_NAME = "cells.geojson"
+# The readers' messages advise the command line's --x/--y; in the UI the Open
+# dialog's column fields do that job. Replaced in this order (the longer phrases first).
+CLI_ADVICE = (
+    ("drop --x/--y", "leave the x and y column fields of the Open dialog empty"),
+    ("--x/--y choose table columns", "the x and y column fields choose table columns"),
+    ("--x/--y", "the x and y column fields of the Open dialog (o)"),
+)
+
+
+def ui_advice(message: str) -> str:
+    """A reader's error message with its command-line advice turned into the UI's controls."""
+    for cli, ui in CLI_ADVICE:
+        message = message.replace(cli, ui)
+    return message
+
+
+class ReadFailed(TvoronoiError):
+    """A point file could not be read; the message names the UI's controls, not the CLI's flags."""
 
 
 class SaveProgress(Message):
@@ -38,23 +56,36 @@ class FilesMixin:
     """The App's part that opens point files and saves the cells as GeoJSON."""
 
     _saving = False
+    # the last file asked for, to offer it again
+    _last_open: OpenRequest | None = None
 
     def action_open(self) -> None:
         """Ask for a point file and show its diagram."""
+        last = self._last_open
         self.push_screen(
-            PathDialog("Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv"),
+            OpenDialog(
+                "Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv",
+                value="" if last is None else str(last.path),
+                x=None if last is None else last.x, y=None if last is None else last.y,
+            ),
             self._open_path,
         )
 
-    def _open_path(self, path: Path | None) -> None:
+    def _open_path(self, request: OpenRequest | None) -> None:
         self.canvas.focus()
-        if path is None:
+        if request is None:
             return
-        from tvoronoi.readers import read_points
+        self._last_open = request
 
-        self._request_build(
-            lambda: None, source=path.name, size=None, read=lambda: read_points(str(path)),
-        )
+        def read():
+            from tvoronoi.readers import read_points
+
+            try:
+                return read_points(str(request.path), x=request.x, y=request.y)
+            except TvoronoiError as exc:
+                raise ReadFailed(ui_advice(str(exc))) from exc
+
+        self._request_build(lambda: None, source=request.path.name, size=None, read=read)
 
     def action_save(self) -> None:
         """Ask for a path and write the cells there as GeoJSON."""
@@ -111,7 +142,8 @@ class FilesMixin:
 
     def on_save_finished(self, message: SaveFinished) -> None:
         self._saving = False
-        self.query_one("#progress").display = False
+        if self.building is None:  # the bar stays while a build runs
+            self.query_one("#progress").display = False
         if message.error is not None:
             self.notify(message.error, title="Not saved", severity="error", timeout=8, markup=False)
         else:

@@ -156,6 +156,7 @@ class PlaybackMixin:
         self.canvas.editable = False
         self._play_timer = self.set_interval(1 / TICK_HZ, self._playback_tick)
         self.refresh_bindings()
+        self.inspect()  # hidden during playback
         self._goto(0)
 
     def stop_playback(self) -> None:

@@ -20,15 +20,18 @@ from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, braille_text, pack_braille, po
 # The layers, in rising precedence: a character has one foreground colour,
 # that of the highest layer with a dot in it. FUTURE (sites not reached yet),
 # GROWING, CONFLICT, CIRCLE, BEACH, SWEEP and EVENT belong to algorithm playback,
-# CURSOR to editing.
-(NO_MARK, FUTURE, DELAUNAY, EDGE, GROWING, CONFLICT, CIRCLE, BEACH, SWEEP,
- VERTEX, SITE, EVENT, CURSOR) = range(13)
+# CURSOR to editing: the lowest, so that a site or edge under the keyboard cursor
+# keeps its colour (the cursor's characters are lit up by their fill instead).
+(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, CONFLICT, CIRCLE, BEACH, SWEEP,
+ VERTEX, SITE, EVENT) = range(13)
 N_MARKS = 13
 # Fills: -1 none, 0 .. N_FILLS - 1 the cell colours, TINTED + c the tinted
-# colour c, CONFLICT_FILL the inside of a conflict region.
+# colour c, CONFLICT_FILL the inside of a conflict region, HIGHLIGHTED + c the
+# colour c under the keyboard cursor.
 N_FILLS = MAX_COLOURS
 TINTED = N_FILLS
 CONFLICT_FILL = 2 * N_FILLS
+HIGHLIGHTED = 2 * N_FILLS + 1
 # The keyboard cursor's cross reaches this many dots each way (about a character).
 CURSOR_ARM = 2
 # Below this many sites per character a site is drawn as a 2 x 2 block of dots.
@@ -265,7 +268,7 @@ class Frame:
     codes : (rows, cols) uint8
         Braille bit patterns (all layers OR-ed).
     mark : (rows, cols) uint8
-        The highest layer with a dot in the character (NO_MARK .. CURSOR).
+        The highest layer with a dot in the character (NO_MARK .. EVENT).
     fill : (rows, cols) int16
         Fill of the character (see N_FILLS): usually the palette index of the
         cell that owns the character's centre, -1 outside the box.
@@ -385,14 +388,15 @@ class Painter:
         point_dots(dots, u, v, block=block)
         self.lay(layer, dots)
 
-    def cross(self, layer: int, x: float, y: float) -> None:
-        """A small cross centred on the world point (x, y)."""
+    def cross(self, layer: int, x: float, y: float) -> np.ndarray:
+        """A small cross centred on the world point (x, y); the (rows, cols) mask of its characters."""
         dots = self.new_dots()
         u, v = self.to_dots(x, y)
         u, v = float(u), float(v)
         segment_dots(dots, [u - CURSOR_ARM, u], [v, v - CURSOR_ARM - 1], [u + CURSOR_ARM, u],
                      [v, v + CURSOR_ARM + 1])
         self.lay(layer, dots)
+        return pack_braille(dots) != 0
 
 
 def rasterize(
@@ -406,13 +410,16 @@ def rasterize(
     overlay=None,
     cursor: tuple[float, float] | None = None,
     owner: np.ndarray | None = None,
+    site_blocks: bool = False,
 ) -> Frame:
     """Draw a scene into a frame of ``cols x rows`` characters.
 
     ``overlay``, if given, draws more layers (``overlay.draw(painter)``) and
     may change the fills (``overlay.refill(fill, owner, view, cols, rows)``);
     ``cursor`` is a world point marked with a cross; ``owner`` is the
-    ``cell_owner`` of this scene and view when the caller already has it.
+    ``cell_owner`` of this scene and view when the caller already has it;
+    ``site_blocks`` draws every site as a block of dots (else only where
+    sites are sparse), for a picture without fills.
     """
     paint = Painter(view, cols, rows)
     if delaunay and len(scene.delaunay):
@@ -421,17 +428,20 @@ def rasterize(
     if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
         paint.points(VERTEX, scene.vertices)
     if scene.n_sites:
-        sparse = per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
+        sparse = site_blocks or per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
         paint.points(SITE, scene.sites, block=sparse)
     if overlay is not None:
         overlay.draw(paint)
-    if cursor is not None:
-        paint.cross(CURSOR, *cursor)
+    under_cursor = None if cursor is None else paint.cross(CURSOR, *cursor)
     if owner is None:
         owner = cell_owner(scene, view, cols, rows)
     fill = fill_of(scene, owner)
     if overlay is not None:
         fill = overlay.refill(fill, owner, view, cols, rows)
+    if under_cursor is not None:
+        # light up the cell colours under the cross (not a block hiding what lies there)
+        lit = under_cursor & (fill >= 0) & (fill < N_FILLS)
+        fill[lit] += HIGHLIGHTED
     return Frame(paint.codes, paint.mark, fill, owner)
 
 
@@ -483,8 +493,6 @@ def style_table(palette: Palette) -> tuple[Style, ...]:
     for m in range(N_MARKS):
         colour, bold = marks[m]
         for bg in palette.backgrounds:
-            if m == CURSOR:  # a block of its own colour, whatever lies under it
-                colour, bg = palette.cursor_text, palette.cursor
             table.append(Style(color=colour, bgcolor=bg, bold=bold or None))
     return tuple(table)
 

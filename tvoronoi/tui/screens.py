@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Vertical, VerticalScroll
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Input, Label, Static
 
@@ -79,7 +80,7 @@ class PathDialog(ModalScreen[Path | None]):
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         event.stop()
-        text = event.value.strip()
+        text = self.query_one("#path", Input).value.strip()
         hint = self.query_one("#dialog-hint", Label)
         if not text:
             hint.update("[b $error]Give a path[/] · Esc to cancel")
@@ -89,11 +90,55 @@ class PathDialog(ModalScreen[Path | None]):
             self._confirmed = text
             hint.update(f"[b $warning]{path.name} exists:[/] Enter again to replace it · Esc to cancel")
             return
-        self.dismiss(path)
+        self.dismiss(self.result(path))
+
+    def result(self, path: Path):
+        """What the dialog is dismissed with once a path is accepted."""
+        return path
 
     def on_input_changed(self, event: Input.Changed) -> None:
         # a changed path needs its own confirmation
-        self._confirmed = None
+        if event.input.id == "path":
+            self._confirmed = None
 
     def action_cancel(self) -> None:
         self.dismiss(None)
+
+
+@dataclass(frozen=True)
+class OpenRequest:
+    """A point file to open, and its x and y columns (None: found from the file)."""
+
+    path: Path
+    x: str | None = None
+    y: str | None = None
+
+
+class OpenDialog(PathDialog):
+    """Ask for a point file and, optionally, which columns of a table hold x and y.
+
+    Dismissed with an ``OpenRequest``, or None when cancelled.
+    """
+
+    def __init__(self, title: str, *, value: str = "", placeholder: str = "",
+                 x: str | None = None, y: str | None = None) -> None:
+        super().__init__(title, value=value, placeholder=placeholder)
+        self.x = x
+        self.y = y
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="dialog") as box:
+            box.border_title = self.title_text
+            yield Input(self.value, placeholder=self.placeholder, id="path")
+            with Horizontal(id="columns"):
+                yield Label("x column")
+                yield Input(self.x or "", placeholder="auto", compact=True, id="x-column")
+                yield Label("y column")
+                yield Input(self.y or "", placeholder="auto", compact=True, id="y-column")
+            yield Label("Enter to open · Tab: columns (a name, an index or colN) · Esc to cancel",
+                        id="dialog-hint")
+
+    def result(self, path: Path) -> OpenRequest:
+        x = self.query_one("#x-column", Input).value.strip() or None
+        y = self.query_one("#y-column", Input).value.strip() or None
+        return OpenRequest(path, x, y)
