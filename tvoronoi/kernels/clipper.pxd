@@ -17,7 +17,7 @@
 # boundary of the cell leaves the box (an exit) and comes back (the next entry), the ring follows the
 # box boundary from the one to the other, through the corners between them.
 
-from libc.math cimport frexp, ldexp
+from libc.math cimport fabs, frexp, ldexp, INFINITY
 from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.exact_integers cimport tvb_orient
@@ -407,6 +407,15 @@ cdef inline int sgn(double v) noexcept nogil:
 DEF TURN_TOP = 450
 DEF TURN_BOTTOM = -340
 
+cdef extern from *:
+    """
+    /* 2^(TURN_BOTTOM - 1) and 2^TURN_TOP: the band of turn() as magnitudes */
+    #define TVORONOI_TURN_BAND_LOW 0x1p-341
+    #define TVORONOI_TURN_BAND_HIGH 0x1p450
+    """
+    const double TURN_BAND_LOW "TVORONOI_TURN_BAND_LOW"
+    const double TURN_BAND_HIGH "TVORONOI_TURN_BAND_HIGH"
+
 
 cdef inline int turn(const double* pts, int a, int b, int c) noexcept nogil:
     """Exact orientation of three output points (+1 left turn, -1 right, 0 collinear) at any magnitudes.
@@ -415,9 +424,22 @@ cdef inline int turn(const double* pts, int a, int b, int c) noexcept nogil:
     magnitudes span more than that band (a ring on a box 2^1000 times its sites' scale) are settled in
     exact integers (exact_integers.pxd)."""
     cdef double p[6]
+    cdef double v, small = INFINITY, large = 0.0
     cdef int i, k, lo = 100000, hi = -100000, s, r
     p[0] = pts[2 * a]; p[1] = pts[2 * a + 1]; p[2] = pts[2 * b]
     p[3] = pts[2 * b + 1]; p[4] = pts[2 * c]; p[5] = pts[2 * c + 1]
+    # the usual case, by comparisons alone: every nonzero magnitude inside the band (frexp's exponent k
+    # of |v| lies in [TURN_BOTTOM, TURN_TOP] exactly when 2^(TURN_BOTTOM - 1) <= |v| < 2^TURN_TOP)
+    for i in range(6):
+        v = fabs(p[i])
+        if v > large:
+            large = v
+        if v != 0.0 and v < small:
+            small = v
+    if large == 0.0:
+        return 0                                   # three times the origin
+    if small >= TURN_BAND_LOW and large < TURN_BAND_HIGH:
+        return orient2d(p[0], p[1], p[2], p[3], p[4], p[5])
     for i in range(6):
         if p[i] != 0.0:
             frexp(p[i], &k)
