@@ -170,9 +170,9 @@ def test_version_and_help(capsys):
 
 def test_without_a_command_the_tui_starts(capsys, monkeypatch):
     calls = []
-    monkeypatch.setitem(sys.modules, "tvoronoi.tui.app", types.SimpleNamespace(main=lambda: calls.append(1)))
+    monkeypatch.setitem(sys.modules, "tvoronoi.tui.app", types.SimpleNamespace(main=lambda path=None: calls.append(path)))
     assert run(capsys) == (0, "", "")
-    assert calls == [1]
+    assert calls == [None]
 
 
 def test_without_a_tui_one_line_error(capsys, monkeypatch):
@@ -397,3 +397,19 @@ def test_unsupported_format_is_a_usage_error(capsys, tmp_path):
     path.write_bytes(b"SQLite format 3\x00" + bytes(200))
     status, _, err = run(capsys, "batch", path, "-o", tmp_path / "a.geojson")
     assert status == 2 and "GeoPackage" in err and "ogr2ogr" in err and err.count("\n") == 1
+
+
+def test_tvoronoi_file_opens_the_ui_on_that_file(monkeypatch, tmp_path, capsys):
+    """`tvoronoi FILE` starts the terminal UI on FILE; a missing FILE is a usage error naming it."""
+    import tvoronoi.tui.app as app
+
+    seen = []
+    monkeypatch.setattr(app, "main", lambda path=None: seen.append(path) or 0)
+    src = tmp_path / "pts.csv"
+    src.write_text("x,y\n0,0\n1,0\n0,1\n")
+    assert cli.main([str(src)]) == 0
+    assert seen == [str(src)]
+    assert cli.main([]) == 0 and seen[-1] is None
+    code = cli.main([str(tmp_path / "nope.csv")])
+    assert code != 0 and seen == [str(src), None]
+    assert "nope.csv: no such file" in capsys.readouterr().err

@@ -110,10 +110,15 @@ def parse_delimiter(text: str) -> str:
     return value
 
 
+COMMANDS = ("batch",)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description="Exact, fast 2D Voronoi diagrams. Without a command, tvoronoi starts the terminal UI.",
+        description="Exact, fast 2D Voronoi diagrams. Without a command, tvoronoi starts the terminal UI "
+                    "(on a generated point set, or on FILE: tvoronoi FILE).",
+        usage=f"{PROG} [-h] [--version] [FILE | batch ...]",
     )
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -177,6 +182,14 @@ def _join_bbox(argv: list[str]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     """Run the console script with ``argv`` (default: ``sys.argv[1:]``) and return the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    if len(argv) == 1 and argv[0] not in COMMANDS and not argv[0].startswith("-"):
+        # tvoronoi FILE: the terminal UI on a point file
+        path = argv[0]
+        if not os.path.isfile(path):
+            print(f"{PROG}: error: {path}: no such file (to compute cells without the UI: "
+                  f"{PROG} batch INPUT -o OUTPUT)", file=sys.stderr)
+            return EXIT_USAGE
+        return run_tui(path)
     try:
         args = build_parser().parse_args(_join_bbox(argv))
     except SystemExit as e:  # --help, --version, usage errors
@@ -186,13 +199,14 @@ def main(argv: list[str] | None = None) -> int:
     return run_batch(args)
 
 
-def run_tui() -> int:
+def run_tui(path: str | None = None) -> int:
+    """The terminal UI, on the point file ``path`` if given."""
     try:
         from tvoronoi.tui.app import main as tui_main
     except ImportError as e:
         print(f"{PROG}: error: the terminal UI cannot start: {e}", file=sys.stderr)
         return EXIT_FAILURE
-    status = tui_main()
+    status = tui_main(path)
     return status if isinstance(status, int) else EXIT_OK
 
 
