@@ -118,6 +118,91 @@ def pythagorean_grid(side: int = 30, *, seed: int = SEED) -> Case:
     return Case(_pts(g[rng.permutation(len(g))]), note="integer grid rotated by atan(3/4)")
 
 
+def hexagonal_rotated(side: int = 30, *, degrees: float = 17.0, noise: float = 0.0, seed: int = SEED) -> Case:
+    """A triangular (hexagonal) lattice rotated by an angle and rounded: sextuples near-cocircular."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(i + 0.5 * (j % 2), j * math.sqrt(3) / 2) for i in range(side) for j in range(side)], float)
+    t = math.radians(degrees)
+    g = np.column_stack([math.cos(t) * g[:, 0] - math.sin(t) * g[:, 1],
+                         math.sin(t) * g[:, 0] + math.cos(t) * g[:, 1]])
+    if noise:
+        g = g + rng.normal(0.0, noise, g.shape)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"hexagonal lattice rotated {degrees} deg, noise {noise:g}")
+
+
+def sheared_lattice(side: int = 30, *, shear: float = 1.0 / 3.0, seed: int = SEED) -> Case:
+    """A lattice (i + shear * j, j / 7) in decimal-unfriendly steps: rows of exactly equal y, rounded x."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(i + shear * j, j / 7.0) for i in range(side) for j in range(side)], float)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"lattice sheared by {shear:.4g}")
+
+
+# ---------------------------------------------------------------------------------------------
+# curves
+
+
+def spiral(n: int = 1500, *, turns: float = 6.0, seed: int = SEED) -> Case:
+    """An Archimedean spiral sampled evenly in angle, rounded: long chains of near-cocircular neighbours."""
+    t = np.linspace(0.0, 2.0 * math.pi * turns, n)
+    return Case(_pts(np.column_stack([t * np.cos(t), t * np.sin(t)])), note=f"spiral, {turns} turns")
+
+
+def parabola_decimal(n: int = 1000, *, seed: int = SEED) -> Case:
+    """Points on y = x^2 at x given to 3 decimals, plus the same with y rounded to 3 decimals."""
+    x = np.round(np.linspace(-1.0, 1.0, n // 2), 3)
+    a = np.column_stack([x, x * x])
+    b = np.column_stack([x + 0.0005, np.round((x + 0.0005) ** 2, 3)])
+    return Case(_pts(np.concatenate([a, b])), note="parabola, decimal abscissae")
+
+
+def sine_wave(n: int = 2000, *, seed: int = SEED) -> Case:
+    """A densely sampled sine wave (step 1e-3): nearly collinear triples along its flat stretches."""
+    x = np.arange(n) * 1e-3
+    return Case(_pts(np.column_stack([x, np.sin(20.0 * x)])), note="sine wave, step 1e-3")
+
+
+def ellipse_rounded(n: int = 800, *, seed: int = SEED) -> Case:
+    """Points on a thin ellipse (axes 1 and 1e-4) and its two foci: sites on both sides very close."""
+    rng = np.random.default_rng(seed)
+    t = rng.uniform(0.0, 2.0 * math.pi, n)
+    pts = np.column_stack([np.cos(t), 1e-4 * np.sin(t)])
+    f = math.sqrt(1.0 - 1e-8)
+    return Case(_pts(np.concatenate([pts, [(-f, 0.0), (f, 0.0)]])), note="thin ellipse and its foci")
+
+
+# ---------------------------------------------------------------------------------------------
+# real coordinates rounded by their instruments
+
+
+def gps_degrees(n: int = 2000, *, decimals: int = 6, seed: int = SEED) -> Case:
+    """Lon/lat around Paris to 6 decimals (a GPS fix, ~0.1 m): a lattice of 1e-6 on an offset of 48."""
+    rng = np.random.default_rng(seed)
+    pts = np.column_stack([2.35 + rng.normal(0.0, 1e-3, n), 48.85 + rng.normal(0.0, 1e-3, n)])
+    return Case(_pts(np.round(pts, decimals)), note=f"lon/lat, {decimals} decimals")
+
+
+def utm_millimetres(n: int = 2000, *, seed: int = SEED) -> Case:
+    """UTM eastings/northings to the millimetre (500 km, 5400 km): a 1e-3 lattice on offsets of 5e6."""
+    rng = np.random.default_rng(seed)
+    pts = np.column_stack([500000.0 + rng.uniform(0.0, 50.0, n), 5400000.0 + rng.uniform(0.0, 50.0, n)])
+    return Case(_pts(np.round(pts, 3)), note="UTM, millimetres")
+
+
+def float32_sensor(n: int = 2000, *, seed: int = SEED) -> Case:
+    """Readings stored as float32 then widened (a sensor or a GPU): 24-bit lattices near 1e3."""
+    rng = np.random.default_rng(seed)
+    pts = (1000.0 + rng.normal(0.0, 0.05, (n, 2))).astype(np.float32).astype(np.float64)
+    return Case(_pts(pts), note="float32 values near 1000")
+
+
+def survey_rows(rows: int = 40, per_row: int = 40, *, seed: int = SEED) -> Case:
+    """A survey along rows: y to the centimetre per row, x to the centimetre with jitter; repeats kept."""
+    rng = np.random.default_rng(seed)
+    y = np.repeat(np.round(np.arange(rows) * 2.5 + rng.normal(0.0, 0.004, rows), 2), per_row)
+    x = np.round(np.tile(np.arange(per_row) * 2.0, rows) + rng.normal(0.0, 0.01, rows * per_row), 2)
+    return Case(_pts(np.column_stack([x, y])), note="survey rows, centimetres")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -348,6 +433,23 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "rotated_grid_45deg": partial(rotated_grid, 30, degrees=45.0),
     "rotated_grid_1deg_noise1e-9": partial(rotated_grid, 30, degrees=1.0, noise=1e-9),
     "pythagorean_grid": partial(pythagorean_grid, 30),
+    "rotated_grid_7deg": partial(rotated_grid, 30, degrees=7.0),
+    "rotated_grid_60deg_noise1e-13": partial(rotated_grid, 30, degrees=60.0, noise=1e-13),
+    "rotated_grid_89_9deg": partial(rotated_grid, 30, degrees=89.9),
+    "hexagonal_17deg": partial(hexagonal_rotated, 30, degrees=17.0),
+    "hexagonal_90deg_noise1e-16": partial(hexagonal_rotated, 30, degrees=90.0, noise=1e-16),
+    "sheared_lattice_third": partial(sheared_lattice, 30),
+    # curves
+    "spiral": spiral,
+    "parabola_decimal": parabola_decimal,
+    "sine_wave": sine_wave,
+    "ellipse_thin_with_foci": ellipse_rounded,
+    # instruments
+    "gps_6dec": gps_degrees,
+    "gps_4dec": partial(gps_degrees, decimals=4),
+    "utm_mm": utm_millimetres,
+    "float32_sensor": float32_sensor,
+    "survey_rows_cm": survey_rows,
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
