@@ -8,13 +8,14 @@ from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
-    finish_ring, first_right_turn, turn,
+    finish_ring, first_right_turn, turn, convex_ring,
 )
 
 cdef enum:
     HAS = 1
     ENTRY = 2
     EXIT = 4
+    WHOLE = 8       # the whole edge, both ends vertices in the closed box (the interior walk reads only flags)
 
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
@@ -118,6 +119,15 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             d = he_origin[tw]
             has_o = o >= 0
             has_d = d >= 0
+            if has_o and has_d and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
+                # both ends in the box: the whole edge (clip_edge's first case, without reading the sites)
+                seg_start[h] = o
+                seg_end[h] = d
+                seg_start[tw] = d
+                seg_end[tw] = o
+                flags[h] = HAS | WHOLE
+                flags[tw] = HAS | WHOLE
+                continue
             a = he_face[h]
             b = he_face[tw]
             clip_edge(&box, xs[a], ys[a], xs[b], ys[b],
@@ -172,16 +182,18 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             # an interior cell: its vertices, already in order
             h = face_edge[i]
             cnt = 0
-            while h >= 0 and flags[h] == HAS and seg_start[h] == he_origin[h]:
-                ring[n_ring + cnt] = seg_start[h]
+            while h >= 0 and ((flags[h] & WHOLE) or (flags[h] == HAS and seg_start[h] == he_origin[h])):
+                ring[n_ring + cnt] = he_origin[h]
                 cnt += 1
                 h = he_next[h]
                 if h == face_edge[i]:
                     break
             if h == face_edge[i] and cnt > 0:
-                k = finish_ring(&ring[n_ring], cnt, &pts[0, 0])
-                if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
-                    n_bent += 1
+                k = convex_ring(&ring[n_ring], cnt, &pts[0, 0])
+                if k < 0:
+                    k = finish_ring(&ring[n_ring], cnt, &pts[0, 0])
+                    if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
+                        n_bent += 1
                 n_ring += k
                 continue
             # a cell that meets the box boundary

@@ -522,6 +522,51 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
     return j
 
 
+cdef enum:
+    CONVEX_FAST_MAX = 64      # rings up to this many points try convex_ring first (a stack buffer)
+
+
+cdef inline int convex_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
+    """The usual case of finish_ring and first_right_turn together, on one read of the ring's points:
+    when every turn is strictly to the left (then no point repeats and none folds back) and the
+    magnitudes lie in turn()'s band, rotate the ring to its canonical start and return n. Otherwise
+    return -1, changing nothing: the caller runs finish_ring and first_right_turn."""
+    cdef double lx[CONVEX_FAST_MAX]
+    cdef double ly[CONVEX_FAST_MAX]
+    cdef double v, small = INFINITY, large = 0.0
+    cdef int k, prev, nxt_k, start = 0
+    if n < 3 or n > CONVEX_FAST_MAX:
+        return -1
+    for k in range(n):
+        lx[k] = pts[2 * ring[k]]
+        ly[k] = pts[2 * ring[k] + 1]
+        v = fabs(lx[k])
+        if v > large:
+            large = v
+        if v != 0.0 and v < small:
+            small = v
+        v = fabs(ly[k])
+        if v > large:
+            large = v
+        if v != 0.0 and v < small:
+            small = v
+    if not (small >= TURN_BAND_LOW and large < TURN_BAND_HIGH):
+        return -1
+    prev = n - 1
+    for k in range(n):
+        nxt_k = k + 1 if k + 1 < n else 0
+        if orient2d(lx[prev], ly[prev], lx[k], ly[k], lx[nxt_k], ly[nxt_k]) <= 0:
+            return -1
+        prev = k
+        # the canonical start: the lowest point (smallest y, then x)
+        if ly[k] < ly[start] or (ly[k] == ly[start] and lx[k] < lx[start]):
+            start = k
+    reverse(ring, 0, start)
+    reverse(ring, start, n)
+    reverse(ring, 0, n)
+    return n
+
+
 cdef inline int first_right_turn(const int32_t* ring, int n, const double* pts) noexcept nogil:
     """The position in a finished ring of its first right turn (a vertex that rounding moved across the
     line of its neighbours: the cell around it is thinner than the rounding there), or -1: every turn
