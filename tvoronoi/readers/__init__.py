@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import codecs
-import json
 import os
 import sys
 from pathlib import Path
+
+import orjson
 
 from ..errors import InputFileError, TvoronoiError
 from .geojson import _read_geojson
@@ -244,14 +245,8 @@ def _loads_json(data: bytes, source: str):
     if data.startswith(codecs.BOM_UTF8):
         data = data[len(codecs.BOM_UTF8) :]
     try:
-        import orjson
-    except ImportError:  # orjson is a dependency; json is the stand-in
-        loads = json.loads
-    else:
-        loads = orjson.loads
-    try:
-        return loads(data)
-    except json.JSONDecodeError as e:  # orjson's error derives from it
+        return orjson.loads(data)
+    except orjson.JSONDecodeError as e:
         raise InputFileError(
             f"{source}, line {e.lineno}, column {e.colno}: broken JSON: {e.msg}; fix the file there"
         ) from None
