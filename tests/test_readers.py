@@ -524,16 +524,16 @@ def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
         text = out.getvalue()
     else:
         text = "\n".join(" ".join(r) for r in ([names] if header else []) + rows) + "\n"
-    layout = readers._table_layout(text, "t", kind, None, None)
-    slow = readers._slow_table(text, "t", kind, layout)
+    layout = readers.table_layout(text, "t", kind, None, None)
+    slow = readers.slow_table(text, "t", kind, layout)
     np.testing.assert_array_equal(slow.xy, np.array(xy, dtype=np.float64).reshape(-1, 2))
-    body = text[readers._line_offset(text, layout.header_lines):]
-    fast = readers._fast_table(body, kind, layout)
+    body = text[readers.line_offset(text, layout.header_lines):]
+    fast = readers.fast_table(body, kind, layout)
     assert fast is not None
     np.testing.assert_array_equal(fast[0], slow.xy)
     assert fast[1] == slow.columns
     # the public entry gives the same
-    points = readers._read_table(text, "t", kind, None, None)
+    points = readers.read_table(text, "t", kind, None, None)
     np.testing.assert_array_equal(points.xy, slow.xy)
     assert points.columns == slow.columns
     for column in slow.columns.values():
@@ -795,10 +795,10 @@ def test_a_column_is_integer_only_if_every_value_is(tmp_path):
                           st.text("abc ", min_size=1, max_size=4)),
                 min_size=1, max_size=12))
 def test_every_column_has_one_type(values):
-    from tvoronoi.readers.pointset import _convert_column
+    from tvoronoi.readers.pointset import convert_column
 
     for plain in (True, False):
-        out = _convert_column(values, plain)
+        out = convert_column(values, plain)
         assert [v is None for v in out] == [not v.strip() for v in values]
         kinds = {type(v) for v in out} - {type(None)}
         assert len(kinds) <= 1

@@ -8,7 +8,7 @@ import re
 import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
-from tvoronoi.bulk import gc_paused
+from tvoronoi.fileio import gc_paused
 
 from .pointset import PointSet
 
@@ -152,7 +152,7 @@ def _checked_sites(doc, source: str):
     return xs, ys, records, wheres.__getitem__
 
 
-def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
+def read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
     """The sites of a GeoJSON file; ``loads(data, source)`` parses it (the package's JSON decoder)."""
     if x is not None or y is not None:
         raise TvoronoiError(
