@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 
@@ -183,9 +184,8 @@ def read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
         xy[:, 1] = [float(v) if abs(v) < 1e308 else math.inf for v in ys]
     bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
     if len(bad):
-        for i, (where, part, position, _) in enumerate(_geojson_sites(doc, source)):
-            if i == bad[0]:
-                break
+        # the first bad site, found again with where it came from
+        where, part, position, _ = next(itertools.islice(_geojson_sites(doc, source), int(bad[0]), None))
         if part is not None:
             where = f"{where}, point {part}"
         role = "x" if not math.isfinite(xy[bad[0], 0]) else "y"
