@@ -119,8 +119,6 @@ def incremental_panel(ax, pts, step, box) -> None:
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.patches import Circle
 
-    import tools
-
     d = step.diagram
     inserted = step.inserted.tolist()
     stolen = set(step.stolen_from.tolist())

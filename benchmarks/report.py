@@ -139,9 +139,6 @@ def update_series(med: dict) -> list[tuple[str, str]]:
 
 def update_section(updates: list[dict], status: dict, stats: dict) -> list[str]:
     lines = ["## Update cost", ""]
-    if status.get("dynamic") != "measured":
-        lines += ["tvoronoi's rows are **pending**: `tvoronoi.DynamicVoronoi` does not exist yet. Only Qhull's "
-                  "incremental mode is measured.", ""]
     if not updates:
         return lines + ["No update-cost results in this run.", ""]
     med = update_medians(updates)
@@ -347,7 +344,7 @@ def plot_relative(stats: dict, path: Path) -> bool:
     return True
 
 
-def plot_updates(updates: list[dict], status: dict, stats: dict, path: Path) -> bool:
+def plot_updates(updates: list[dict], stats: dict, path: Path) -> bool:
     plt = _plt()
     if not updates:
         return False
@@ -370,10 +367,7 @@ def plot_updates(updates: list[dict], status: dict, stats: dict, path: Path) -> 
     ax.grid(True, alpha=0.3)
     ax.set_xlabel("n (sites)")
     ax.set_ylabel("median seconds per operation")
-    title = "One update on uniform points (tvoronoi: until the changed cell is read back)"
-    if status.get("dynamic") != "measured":
-        title += "\n(tvoronoi.DynamicVoronoi pending: Qhull only)"
-    ax.set_title(title, fontsize=10)
+    ax.set_title("One update on uniform points (tvoronoi: until the changed cell is read back)", fontsize=10)
     ax.legend(fontsize=7.5, ncol=2)
     _save(fig, path)
     return True
@@ -396,7 +390,7 @@ def write_report(out: Path = RESULTS) -> Path:
     if plot_lines(stats, "peak", out / "memory_vs_n.png", "peak MiB above the baseline",
                   f"Peak memory of one build against n (readings under {MEMORY_FLOOR} MiB drawn at it)"):
         made.append("memory_vs_n.png")
-    if plot_updates(updates, status, stats, out / "update_cost.png"):
+    if plot_updates(updates, stats, out / "update_cost.png"):
         made.append("update_cost.png")
     made += [f for f in ("fortune_steps.png", "incremental_steps.png") if (out / f).exists()]
     path = out / "build.md"

@@ -1,8 +1,7 @@
 """Dynamic update cost against n: one insert, one small move, one remove, each until the changed cell is read back.
 
 tvoronoi: ``tvoronoi.DynamicVoronoi`` with each engine (``insert(x, y)``,
-``move(i, x, y)``, ``remove(i)``, then ``diagram().cell_polygon(i)``); where
-it does not exist the tvoronoi rows are reported as pending. Qhull:
+``move(i, x, y)``, ``remove(i)``, then ``diagram().cell_polygon(i)``). Qhull:
 ``scipy.spatial.Delaunay(points, incremental=True).add_points`` with one point
 a call (Qhull has no move or remove: those cost a rebuild, which the build
 benchmark measures as qhull-delaunay).
@@ -38,12 +37,6 @@ QHULL_BUDGET = 60.0
 QHULL_MIN_OPS = 7
 # A small move: this fraction of the mean distance between sites, in a random direction.
 MOVE_FRACTION = 0.1
-
-
-def dynamic_available() -> bool:
-    import tvoronoi
-
-    return hasattr(tvoronoi, "DynamicVoronoi")
 
 
 def measure_dynamic(pts, box, ops: int, rng, engine: str) -> tuple[list, list]:
@@ -157,9 +150,8 @@ def run_all(sizes: list[int], ops: int, out: Path) -> list[dict]:
     """Measure every tool at every size, one process each; write updates.csv."""
     import statistics
 
-    pending = not dynamic_available()
-    tools = ([] if pending else list(DYNAMIC_ENGINES)) + ["qhull-incremental"]
-    print("update cost" + (" (tvoronoi.DynamicVoronoi pending: Qhull only)" if pending else ""), flush=True)
+    tools = [*DYNAMIC_ENGINES, "qhull-incremental"]
+    print("update cost", flush=True)
     rows, notes = [], []
     for n in sizes:
         for tool in tools:
@@ -180,7 +172,7 @@ def run_all(sizes: list[int], ops: int, out: Path) -> list[dict]:
             for kind, ts in by_kind.items():
                 print(f"  {tool:26s} {kind:10s} n={n:>9,}  median {statistics.median(ts) * 1e3:9.3f} ms", flush=True)
     write_csv(out / "updates.csv", rows)
-    status = {"dynamic": "pending" if pending else "measured", "notes": notes}
+    status = {"notes": notes}
     from common import atomic_write
 
     atomic_write(out / "updates.json", json.dumps(status, indent=2) + "\n")

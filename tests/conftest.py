@@ -12,7 +12,7 @@ settings.register_profile("ci", derandomize=True, deadline=None)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
-from tvoronoi.generators import clustered, gaussian, uniform
+from tvoronoi.generators import clustered, gaussian, uniform  # noqa: E402
 
 SEED = 20261122
 

@@ -16,7 +16,8 @@ import pytest
 import tvoronoi
 from conftest import DATASETS
 from test_geojson import check_cells_document, grown_box, hull_size, load, temp_files
-from tvoronoi import cli, geojson
+from tvoronoi import cli
+from tvoronoi.writers import geojson_diagram
 
 ROOT = Path(__file__).resolve().parents[1]
 DUPLICATE_WARNING = (
@@ -291,7 +292,7 @@ def test_write_failure_exits_1_and_leaves_files_untouched(capsys, monkeypatch, t
     def disk_full(*args, **kwargs):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(geojson, "write_delaunay", disk_full)
+    monkeypatch.setattr(geojson_diagram, "write_delaunay", disk_full)
     before = snapshot(existing)
     tri = tmp_path / "tri.geojson"
     status, _, stderr = run(capsys, "batch", points_csv, "-o", existing, "--delaunay", tri, "--force")
@@ -311,7 +312,7 @@ def test_interrupt_removes_the_temporary_file(capsys, monkeypatch, tmp_path, poi
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(geojson, "write_cells", interrupted)
+    monkeypatch.setattr(geojson_diagram, "write_cells", interrupted)
     before = snapshot(existing)
     status, _, stderr = run(capsys, "batch", points_csv, "-o", existing, "--force")
     assert status == 130 and stderr.endswith("tvoronoi: error: interrupted\n")

@@ -41,7 +41,7 @@ def assert_equals_fresh_build(dv, box=BOX):
     # the full export agrees with the view
     full = view.to_diagram()
     assert full.n_vertices == fresh.n_vertices
-    for place, members in places.items():
+    for members in places.values():
         for _, i in members:
             assert len(full.cell_polygon(i)) == len(view.cell_polygon(i))
 
@@ -99,7 +99,7 @@ TestDynamicFortune.settings = settings(max_examples=60, stateful_step_count=25, 
 def test_long_random_sequence(engine, rng):
     pts = uniform(300, seed=5)
     dv = tvoronoi.DynamicVoronoi(pts, engine=engine, bbox=(-0.1, -0.1, 1.1, 1.1))
-    for step in range(600):
+    for _ in range(600):
         live = np.flatnonzero(dv.diagram().alive)
         r = rng.random()
         if r < 0.4:

@@ -14,9 +14,10 @@ import shapely
 
 import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
-from tvoronoi import geojson
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.geojson import write_cells, write_delaunay
+from tvoronoi.writers import geojson_diagram
+from tvoronoi.writers.geojson_diagram import missing_cells, write_cells, write_delaunay
+from tvoronoi.writers.targets import TEMP_SUFFIX
 from tvoronoi.readers import PointSet
 
 AREA_RTOL = 1e-9
@@ -88,7 +89,7 @@ def hull_size(sites: np.ndarray) -> int:
 
 
 def temp_files(directory) -> list[str]:
-    return [name for name in os.listdir(directory) if name.endswith(geojson.TEMP_SUFFIX)]
+    return [name for name in os.listdir(directory) if name.endswith(TEMP_SUFFIX)]
 
 
 # ---------------------------------------------------------------------------
@@ -177,7 +178,7 @@ def test_cell_that_misses_the_box_is_null():
     doc = load(to_bytes(write_cells, d, None))
     assert len(doc["features"]) == 4
     assert doc["features"][3] == {"type": "Feature", "geometry": None, "properties": {"site": 3}}
-    assert geojson.missing_cells(d).tolist() == [3]
+    assert missing_cells(d).tolist() == [3]
     check_cells_document(doc, sites, box)
 
 
@@ -188,7 +189,7 @@ def test_small_chunks_give_the_same_document(monkeypatch):
     d = tvoronoi.voronoi(sites, bbox=(base.min() - 1, base.min() - 1, base.max() + 1, base.max() + 1))
     whole = to_bytes(write_cells, d, None)
     seen = []
-    monkeypatch.setattr(geojson, "CHUNK_FEATURES", 7)
+    monkeypatch.setattr(geojson_diagram, "CHUNK_FEATURES", 7)
     chunked = to_bytes(write_cells, d, None, progress=lambda done, total: seen.append((done, total)))
     assert chunked == whole
     assert load(chunked)["features"][-1]["geometry"] is None
@@ -259,7 +260,7 @@ def test_failure_leaves_the_existing_file_and_no_temporary(tmp_path, monkeypatch
     path.write_bytes(b"old content")
     before = path.stat()
     points = PointSet(sites, "t.csv", {"bad": [0] * (len(sites) - 1) + [{1, 2}]})  # a set is not JSON
-    monkeypatch.setattr(geojson, "CHUNK_FEATURES", 16)
+    monkeypatch.setattr(geojson_diagram, "CHUNK_FEATURES", 16)
     with pytest.raises(TvoronoiError, match="site 199"):
         write_cells(tvoronoi.voronoi(sites), points, path)
     assert path.read_bytes() == b"old content"

@@ -37,7 +37,7 @@ def test_a_named_pipe_is_written_directly_with_or_without_force(tmp_path, points
     os.mkfifo(fifo)
     for force in ([], ["--force"]):
         received = []
-        reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()))
+        reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()))  # noqa: B023 (joined below)
         reader.start()
         status = cli.main(["batch", str(points), "-o", str(fifo), "-q", *force])
         reader.join(timeout=60)

@@ -181,13 +181,13 @@ async def test_bad_count_is_a_notification_and_the_diagram_stays():
         assert any("count" in text for text in error_toasts(app))
 
 
-def engine_not_available(monkeypatch):
-    """Make the fortune engine fail the way an engine that is not there yet does."""
+def engine_refuses(monkeypatch):
+    """Make the fortune engine raise an EngineError."""
     real = tvoronoi.voronoi
 
     def voronoi(points, *, engine="incremental", **kwargs):
         if engine == "fortune":
-            raise EngineError("engine 'fortune' is not available yet: use engine='incremental'")
+            raise EngineError("engine 'fortune' refused the points: use engine='incremental'")
         return real(points, engine=engine, **kwargs)
 
     monkeypatch.setattr(tvoronoi, "voronoi", voronoi)
@@ -203,7 +203,7 @@ async def pick_fortune(app, pilot):
 
 @pilot_test
 async def test_engine_error_is_a_notification_and_the_diagram_stays(monkeypatch):
-    engine_not_available(monkeypatch)
+    engine_refuses(monkeypatch)
     app = make_app()
     async with app.run_test(size=SIZE, notifications=True) as pilot:
         await pilot.pause()
@@ -213,7 +213,7 @@ async def test_engine_error_is_a_notification_and_the_diagram_stays(monkeypatch)
         assert app.built is built
         assert app.canvas.scene is built.scene
         assert app.canvas.view == view
-        assert any("not available" in text for text in error_toasts(app))
+        assert any("refused the points" in text for text in error_toasts(app))
         assert "incremental" in status_text(app)
 
 

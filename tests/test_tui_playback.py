@@ -236,7 +236,7 @@ async def test_playing_advances_in_real_time():
 
 @pilot_test
 async def test_too_many_sites_is_a_warning(monkeypatch):
-    monkeypatch.setattr(playback, "MAX_SITES", 100)
+    monkeypatch.setattr(playback, "PLAYBACK_MAX_SITES", 100)
     app = make_app()
     async with app.run_test(size=SIZE, notifications=True) as pilot:
         await pilot.pause()
@@ -249,7 +249,7 @@ async def test_too_many_sites_is_a_warning(monkeypatch):
 
 @pilot_test
 async def test_large_point_sets_compute_steps_in_a_worker(monkeypatch):
-    monkeypatch.setattr(playback, "THREAD_MIN_SITES", 100)
+    monkeypatch.setattr(playback, "STEP_THREAD_MIN_SITES", 100)
     app = make_app()
     seen = []
     async with app.run_test(size=SIZE, message_hook=lambda m: seen.append(type(m).__name__)) as pilot:

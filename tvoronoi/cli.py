@@ -14,10 +14,10 @@ from contextlib import contextmanager
 from tvoronoi import __version__
 from tvoronoi.api import ENGINES, INSERTION_ORDERS
 from tvoronoi.errors import CoordinateRangeError, TvoronoiError
+from tvoronoi.fileio import STDIO
 from tvoronoi.readers import FORMATS
 
 PROG = "tvoronoi"
-STDIO = "-"
 # inputs this large show a progress display (on a terminal, without -q)
 PROGRESS_MIN_POINTS = 200_000
 PROGRESS_MIN_BYTES = 4 << 20  # a CSV of about 200,000 points
@@ -244,11 +244,11 @@ def _batch(args, phases: Phases) -> int:
 def _batch_run(args, phases: Phases) -> int:
     import numpy as np
 
-    from tvoronoi import geojson
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
     from tvoronoi.writers.geoparquet import crs_name, projjson
-    from tvoronoi.writers.targets import descriptor_of, is_direct
+    from tvoronoi.writers.geojson_diagram import missing_cells, write_cells, write_delaunay
+    from tvoronoi.writers.targets import descriptor_of, is_direct, output_file
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)
     names = [name for name in (args.output, args.delaunay) if name is not None]
@@ -275,7 +275,7 @@ def _batch_run(args, phases: Phases) -> int:
         # creating the temporary files now shows that they can be written, before any work
         for name in names:
             with _writing(name):
-                outputs[name] = geojson.output_file(name, overwrite=args.force)
+                outputs[name] = output_file(name, overwrite=args.force)
         if args.input != STDIO and _size(args.input) >= PROGRESS_MIN_BYTES:
             phases.show()
         with phases.phase("read") as done:
@@ -311,7 +311,7 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{repeats} repeated point{'s share' if repeats > 1 else ' shares'} the cell of an earlier "
                 f'point (see "duplicates" in the output)'
             )
-        missing = len(geojson.missing_cells(diagram))
+        missing = len(missing_cells(diagram))
         if missing and not args.quiet:
             which = "cells miss the box (their sites lie" if missing > 1 else "cell misses the box (its site lies"
             phases.warn(f'{missing} {which} outside --bbox): written with "geometry": null')
@@ -323,7 +323,7 @@ def _batch_run(args, phases: Phases) -> int:
 
                 write_cells_parquet(diagram, points, stream, crs=crs)
             else:
-                geojson.write_cells(diagram, points, stream, progress=progress, precision=args.precision,
+                write_cells(diagram, points, stream, progress=progress, precision=args.precision,
                                     layout=GEOJSON_LAYOUT[formats[args.output]])
         if args.delaunay is not None:
             with phases.counter("write triangles") as progress, _writing(args.delaunay):
@@ -333,7 +333,7 @@ def _batch_run(args, phases: Phases) -> int:
 
                     write_delaunay_parquet(diagram, stream, crs=crs)
                 else:
-                    geojson.write_delaunay(diagram, stream, progress=progress, precision=args.precision,
+                    write_delaunay(diagram, stream, progress=progress, precision=args.precision,
                                            layout=GEOJSON_LAYOUT[formats[args.delaunay]])
         for name, output in outputs.items():
             with _writing(name):

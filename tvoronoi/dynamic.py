@@ -142,10 +142,6 @@ class DynamicVoronoi:
             mesh.set_site(c, *np.ldexp(self._xy[c], -self._e))
         self._mesh = mesh
 
-    def _after_change(self) -> None:
-        if self._mesh is not None and self._mesh.n_finite == 0:
-            self._rebuild()
-
     # -- updates -----------------------------------------------------------------------------------
 
     def insert(self, x, y) -> int:

@@ -10,7 +10,7 @@ class InputFileError(TvoronoiError):
 
 
 class EngineError(TvoronoiError):
-    """An engine name or option that does not exist (or is not available yet)."""
+    """An engine name or option that does not exist, or an engine run that failed."""
 
 
 class CoordinateRangeError(TvoronoiError):

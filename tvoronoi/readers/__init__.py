@@ -3,22 +3,24 @@
 from __future__ import annotations
 
 import codecs
-import json
 import os
 import sys
 from pathlib import Path
 
+import orjson
+
 from ..errors import InputFileError, TvoronoiError
-from .geojson import _read_geojson
-from .npy import NPY_MAGIC, _read_npy
-from .parquet import PARQUET_MAGIC, _read_parquet
+from ..fileio import STDIO
+from .geojson_points import read_geojson
+from .npy import NPY_MAGIC, read_npy
+from .parquet import PARQUET_MAGIC, read_parquet
 from .pointset import PointSet
-from .tabular import COMMENT, _read_table
+from .tabular import COMMENT, read_table
 
 # the column names recognised and the steps of a table read, reached through the
 # package by the tests that hold the fast path of a table to the slow one
 from .columns import X_NAMES, Y_NAMES  # noqa: F401
-from .tabular import _fast_table, _line_offset, _slow_table, _table_layout  # noqa: F401
+from .tabular import fast_table, line_offset, slow_table, table_layout  # noqa: F401
 
 __all__ = ["FORMATS", "PointSet", "read_points"]
 
@@ -67,7 +69,6 @@ UNSUPPORTED_EXTENSIONS = {
     ".xls": ("Excel workbook", "save the sheet as CSV (File > Save As > CSV)"),
     ".ods": ("OpenDocument spreadsheet", "save the sheet as CSV (File > Save As > CSV)"),
 }
-STDIN = "-"
 STDIN_SOURCE = "<stdin>"
 SNIFF_BYTES = 1 << 16
 
@@ -130,12 +131,12 @@ def read_points(
         fmt = "csv"
         delimiter = delimiter or DELIMITER_OF[suffix]
     if fmt == "npy":
-        return _read_npy(data, source, x, y)
+        return read_npy(data, source, x, y)
     if fmt == "parquet":
-        return _read_parquet(data, source, x, y)
+        return read_parquet(data, source, x, y)
     if fmt == "geojson":
-        return _read_geojson(data, source, x, y, _loads_json)
-    return _read_table(_decode(data, source), source, fmt, x, y, delimiter)
+        return read_geojson(data, source, x, y, _loads_json)
+    return read_table(_decode(data, source), source, fmt, x, y, delimiter)
 
 
 def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
@@ -162,7 +163,7 @@ def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
 
 def _read_bytes(path) -> tuple[str, str, bytes]:
     """Return (source name, lower-case suffix, content) of a file or of standard input."""
-    if isinstance(path, str) and path == STDIN:
+    if isinstance(path, str) and path == STDIO:
         return STDIN_SOURCE, "", sys.stdin.buffer.read()
     try:
         source = os.fsdecode(os.fspath(path))
@@ -244,14 +245,8 @@ def _loads_json(data: bytes, source: str):
     if data.startswith(codecs.BOM_UTF8):
         data = data[len(codecs.BOM_UTF8) :]
     try:
-        import orjson
-    except ImportError:  # orjson is a dependency; json is the stand-in
-        loads = json.loads
-    else:
-        loads = orjson.loads
-    try:
-        return loads(data)
-    except json.JSONDecodeError as e:  # orjson's error derives from it
+        return orjson.loads(data)
+    except orjson.JSONDecodeError as e:
         raise InputFileError(
             f"{source}, line {e.lineno}, column {e.colno}: broken JSON: {e.msg}; fix the file there"
         ) from None

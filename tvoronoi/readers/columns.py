@@ -37,12 +37,12 @@ def is_id_like(name: str) -> bool:
     return bool(words) and (words[-1] in ID_WORDS or words[0] in ("unnamed", "index"))
 
 
-def _col_name(j: int) -> str:
+def col_name(j: int) -> str:
     """The name of column ``j`` (0-based) when the file gives none: col1, col2, ..."""
     return f"col{j + 1}"
 
 
-def _as_index(sel) -> int | None:
+def as_index(sel) -> int | None:
     """A 0-based column index given as an int or a digit string, else None."""
     if isinstance(sel, (int, np.integer)) and not isinstance(sel, bool):
         return int(sel)
@@ -51,7 +51,7 @@ def _as_index(sel) -> int | None:
     return None
 
 
-def _resolve_column(sel, role: str, names: list[str], by_name: bool, source: str) -> int | None:
+def resolve_column(sel, role: str, names: list[str], by_name: bool, source: str) -> int | None:
     """Index of the column ``sel`` chooses for ``role``; with ``sel=None``, the column named like it."""
     n_cols = len(names)
     listing = ", ".join(f"{j}:{name}" for j, name in enumerate(names))
@@ -78,7 +78,7 @@ def _resolve_column(sel, role: str, names: list[str], by_name: bool, source: str
         match = _COL_NAME.fullmatch(key)
         if match and 1 <= int(match.group(1)) <= n_cols:
             return int(match.group(1)) - 1
-    index = _as_index(sel)
+    index = as_index(sel)
     if index is None and not isinstance(sel, str):
         raise TvoronoiError(f"--{role} must be a column name or a 0-based index, got {sel!r}")
     if index is not None and 0 <= index < n_cols:
@@ -89,7 +89,7 @@ def _resolve_column(sel, role: str, names: list[str], by_name: bool, source: str
     )
 
 
-def _check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str = "column") -> None:
+def check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str = "column") -> None:
     """Refuse x and y chosen as the same column (or field)."""
     if ix == iy:
         raise TvoronoiError(f'{source}: x and y are the same {noun} "{names[ix]}"; choose two {noun}s')

@@ -7,13 +7,13 @@ import io
 import numpy as np
 
 from ..errors import InputFileError
-from .columns import LAT_NAMES, LON_NAMES, _check_distinct, _col_name, _resolve_column, describe_choice, is_id_like
-from .pointset import PointSet, _json_column
+from .columns import LAT_NAMES, LON_NAMES, check_distinct, col_name, resolve_column, describe_choice, is_id_like
+from .pointset import PointSet, json_column
 
 NPY_MAGIC = b"\x93NUMPY"
 
 
-def _read_npy(data: bytes, source: str, x, y) -> PointSet:
+def read_npy(data: bytes, source: str, x, y) -> PointSet:
     if not data:
         raise InputFileError(f"{source}: no points found (the file is empty)")
     if not data.startswith(NPY_MAGIC):
@@ -44,16 +44,16 @@ def _read_npy(data: bytes, source: str, x, y) -> PointSet:
         )
     if len(array) == 0:
         raise InputFileError(f"{source}: no points found (the array has 0 rows)")
-    names = [_col_name(j) for j in range(array.shape[1])]
-    ix = _resolve_column(x, "x", names, False, source)
-    iy = _resolve_column(y, "y", names, False, source)
+    names = [col_name(j) for j in range(array.shape[1])]
+    ix = resolve_column(x, "x", names, False, source)
+    iy = resolve_column(y, "y", names, False, source)
     free = [j for j in range(len(names)) if j not in (ix, iy)]
     ix = free.pop(0) if ix is None else ix
     iy = free.pop(0) if iy is None else iy
-    _check_distinct(ix, iy, names, source)
+    check_distinct(ix, iy, names, source)
     xy = np.ascontiguousarray(array[:, [ix, iy]], dtype=np.float64)
     _check_finite_rows(xy, source)
-    columns = {names[j]: _json_column(array[:, j]) for j in range(array.shape[1]) if j not in (ix, iy)}
+    columns = {names[j]: json_column(array[:, j]) for j in range(array.shape[1]) if j not in (ix, iy)}
     return PointSet(xy, source, columns)
 
 
@@ -61,8 +61,8 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     if array.ndim != 1:
         raise InputFileError(f"{source}: a structured array of shape {array.shape}; tvoronoi needs shape (n,)")
     names = list(array.dtype.names)
-    ix = _resolve_column(x, "x", names, True, source)
-    iy = _resolve_column(y, "y", names, True, source)
+    ix = resolve_column(x, "x", names, True, source)
+    iy = resolve_column(y, "y", names, True, source)
     how, skipped = "by name", []
     if ix is None or iy is None:
         numeric = [j for j, name in enumerate(names) if j not in (ix, iy) and array.dtype[name].kind in "iuf"]
@@ -76,7 +76,7 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
         raise InputFileError(
             f"{source}: cannot find the x and y fields among {', '.join(names)}{ids}; choose them with --x/--y"
         )
-    _check_distinct(ix, iy, names, source, noun="field")
+    check_distinct(ix, iy, names, source, noun="field")
     for j in (ix, iy):
         if array.dtype[names[j]].kind not in "iuf" or array.dtype[names[j]].shape:
             raise InputFileError(
@@ -89,7 +89,7 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     xy[:, 0] = array[names[ix]]
     xy[:, 1] = array[names[iy]]
     _check_finite_rows(xy, source)
-    columns = {names[j]: _json_column(array[names[j]]) for j in range(len(names)) if j not in (ix, iy)}
+    columns = {names[j]: json_column(array[names[j]]) for j in range(len(names)) if j not in (ix, iy)}
     lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
     return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, where=lambda i: f"row {i} (0-based)")

@@ -7,14 +7,14 @@ import io
 import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
-from .columns import LAT_NAMES, LON_NAMES, _check_distinct, _resolve_column, describe_choice, is_id_like
+from .columns import LAT_NAMES, LON_NAMES, check_distinct, resolve_column, describe_choice, is_id_like
 from .pointset import PointSet
 
 PARQUET_MAGIC = b"PAR1"
 INSTALL_HINT = "pip install 'tvoronoi[parquet]' (or pip install pyarrow)"
 
 
-def _read_parquet(data: bytes, source: str, x, y) -> PointSet:
+def read_parquet(data: bytes, source: str, x, y) -> PointSet:
     """The sites of a GeoParquet file (its primary geometry column of points) or a Parquet table."""
     try:
         import orjson
@@ -75,8 +75,8 @@ def _xy_table(table, source: str, x, y) -> PointSet:
     names = table.column_names
     numeric = [j for j, name in enumerate(names) if pt.is_integer(table.schema.field(name).type)
                or pt.is_floating(table.schema.field(name).type)]
-    ix = _resolve_column(x, "x", names, True, source)
-    iy = _resolve_column(y, "y", names, True, source)
+    ix = resolve_column(x, "x", names, True, source)
+    iy = resolve_column(y, "y", names, True, source)
     how, skipped = "by name", []
     if ix is None or iy is None:
         skipped = [names[j] for j in numeric if j not in (ix, iy) and is_id_like(names[j])]
@@ -90,7 +90,7 @@ def _xy_table(table, source: str, x, y) -> PointSet:
             f"{source}: no geo metadata and no x and y columns among {', '.join(names)}{ids}; "
             f"choose them with --x/--y"
         )
-    _check_distinct(ix, iy, names, source)
+    check_distinct(ix, iy, names, source)
     for j in (ix, iy):
         if j not in numeric:
             raise InputFileError(

@@ -125,7 +125,7 @@ def _convert_value(s: str):
     return s
 
 
-def _convert_column(values, plain: bool) -> list:
+def convert_column(values, plain: bool) -> list:
     """A table column as JSON-ready values of one type: the column is typed, not each value.
 
     Empty values are None. The rest are ints if every one is an int literal (within 64 bits),
@@ -183,7 +183,7 @@ def _is_text(distinct) -> bool:
     return False
 
 
-def _json_column(values: np.ndarray) -> list:
+def json_column(values: np.ndarray) -> list:
     """A numpy column as JSON-ready Python values: NaN/inf become None, bytes are decoded."""
     kind = values.dtype.kind
     if values.ndim == 1 and kind in "iubU":

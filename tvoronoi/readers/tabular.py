@@ -18,16 +18,16 @@ from .columns import (
     LON_NAMES,
     X_NAMES,
     Y_NAMES,
-    _as_index,
-    _check_distinct,
-    _col_name,
-    _resolve_column,
+    as_index,
+    check_distinct,
+    col_name,
+    resolve_column,
     describe_choice,
     is_id_like,
 )
-from tvoronoi.bulk import gc_paused
+from tvoronoi.fileio import gc_paused
 
-from .pointset import PointSet, _convert_column
+from .pointset import PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
 # a table text up to this size is kept to name the line of a site in a later message
@@ -54,7 +54,7 @@ class _Layout:
     choice: str | None = None  # which columns became x and y and why, when the caller chose neither
 
 
-def _read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = None) -> PointSet:
+def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = None) -> PointSet:
     # the header and the first data row are near the top: look there first, so that
     # a large file is not scanned for them
     head = text
@@ -63,21 +63,21 @@ def _read_table(text: str, source: str, kind: str, x, y, delimiter: str | None =
     if kind == "csv" and delimiter is None:
         delimiter = sniff_delimiter(head)
     try:
-        layout = _table_layout(head, source, kind, x, y, delimiter or ",")
+        layout = table_layout(head, source, kind, x, y, delimiter or ",")
     except InputFileError:
         if head is text:
             raise
         head = text
-        layout = _table_layout(text, source, kind, x, y, delimiter or ",")
-    body = text[_line_offset(head, layout.header_lines) :]
+        layout = table_layout(text, source, kind, x, y, delimiter or ",")
+    body = text[line_offset(head, layout.header_lines) :]
     try:
-        fast = _fast_table(body, kind, layout)
+        fast = fast_table(body, kind, layout)
     except (ValueError, csv.Error):
         fast = None
     if fast is None:
         # the fast path met something it does not handle or a bad value: walk the
         # file row by row, which either reads it or names the first bad line
-        points = _slow_table(text, source, kind, layout)
+        points = slow_table(text, source, kind, layout)
     else:
         points = PointSet(fast[0], source, fast[1])
         points.where = _fast_lines(text, body, source, kind, layout, len(points))
@@ -167,7 +167,7 @@ def _is_blank(fields: list[str]) -> bool:
     return not fields or (len(fields) == 1 and not fields[0].strip())
 
 
-def _line_offset(text: str, n_lines: int) -> int:
+def line_offset(text: str, n_lines: int) -> int:
     """Character offset of the start of line ``n_lines + 1``."""
     offset = 0
     lines = io.StringIO(text, newline="")
@@ -196,7 +196,7 @@ def _decimal_points(values, delimiter: str):
     return [v.replace(",", ".") for v in values]
 
 
-def _table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") -> _Layout:
+def table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") -> _Layout:
     """Find the header (if any), the column names and the x and y columns from the first rows."""
     records = _records(text, kind, source, delimiter)
     first = next(records, None)
@@ -216,10 +216,10 @@ def _table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",")
             raise InputFileError(f"{source}: no points found (the file has only a header, line {line_no})")
         first_line, first_fields = data
     else:
-        names = [_col_name(j) for j in range(len(fields))]
+        names = [col_name(j) for j in range(len(fields))]
         header_lines, first_line, first_fields = 0, line_no, fields
-    ix = _resolve_column(x, "x", names, has_header, source)
-    iy = _resolve_column(y, "y", names, has_header, source)
+    ix = resolve_column(x, "x", names, has_header, source)
+    iy = resolve_column(y, "y", names, has_header, source)
     how = "by name" if has_header else "the first two columns"
     skipped: list[str] = []
     if ix is None or iy is None:
@@ -241,7 +241,7 @@ def _table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",")
             f"and the row has too few numeric columns{ids}; columns: {', '.join(names)}; "
             f"choose them with --x/--y"
         )
-    _check_distinct(ix, iy, names, source)
+    check_distinct(ix, iy, names, source)
     choice = None
     if x is None or y is None:
         choice = describe_choice(names, ix, iy, how if x is None and y is None else "by option and " + how, skipped)
@@ -258,10 +258,10 @@ def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]]
     """
     numeric = [number(f) for f in fields]
     lowered = [f.strip().lower() for f in fields]
-    chosen = [s.strip().lower() for s in (x, y) if isinstance(s, str) and _as_index(s) is None]
+    chosen = [s.strip().lower() for s in (x, y) if isinstance(s, str) and as_index(s) is None]
     if any(name in lowered for name in chosen):
         return True
-    explicit = [i for i in (_as_index(x), _as_index(y)) if i is not None and i < len(fields)]
+    explicit = [i for i in (as_index(x), as_index(y)) if i is not None and i < len(fields)]
     if any(not numeric[i] for i in explicit) or sum(numeric) < 2:
         return True
     named = [j for j, name in enumerate(lowered) if name in X_NAMES + Y_NAMES and not numeric[j]]
@@ -287,7 +287,7 @@ def _unique_names(names: list[str]) -> list[str]:
     out: list[str] = []
     seen: set[str] = set()
     for j, name in enumerate(names):
-        name = name or _col_name(j)
+        name = name or col_name(j)
         base, k = name, 2
         while name in seen:
             name, k = f"{base}_{k}", k + 1
@@ -300,7 +300,7 @@ def _unique_names(names: list[str]) -> list[str]:
 # the rows: in bulk, else one by one
 
 
-def _fast_table(body: str, kind: str, layout: _Layout):
+def fast_table(body: str, kind: str, layout: _Layout):
     """Read the rows after the header in bulk; None (or ValueError) when a row needs a closer look."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     n_cols = len(names)
@@ -345,7 +345,7 @@ def _fast_table(body: str, kind: str, layout: _Layout):
     return xy, _extras(columns, layout, body)
 
 
-def _slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
+def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
     """Read a table row by row, keeping line numbers, and raise on the first row that is not a site.
 
     The sites' ``where`` gives the line number of each row (not yet a label)."""
@@ -390,7 +390,7 @@ def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
     """The columns other than x and y, as JSON-ready values; ``text`` holds the rows they come from."""
     plain = text.isascii() and "_" not in text
     return {
-        name: _convert_column(columns[j], plain)
+        name: convert_column(columns[j], plain)
         for j, name in enumerate(layout.names)
         if j not in (layout.ix, layout.iy)
     }

@@ -25,7 +25,7 @@ from tvoronoi.api import ENGINES
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import DISTRIBUTIONS, generate
 from tvoronoi.tui import editing, playback
-from tvoronoi.tui.building import THREAD_MIN_SITES, Built, BuildingMixin, Clock
+from tvoronoi.tui.building import BUILD_THREAD_MIN_SITES, Built, BuildingMixin, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
@@ -39,7 +39,7 @@ DEFAULT_COUNT = 300
 DEFAULT_SEED = 0
 DEFAULT_PARAMS = {"sigma": "0.15", "clusters": "10", "spread": "0.02"}
 # A guard against a typo eating the machine's memory.
-MAX_SITES = 5_000_000
+GENERATE_MAX_SITES = 5_000_000
 # Width below which the side panel starts hidden (`p` shows it).
 NARROW_WIDTH = 80
 
@@ -156,7 +156,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                     yield Label("count")
                     yield _tip(
                         Input(str(DEFAULT_COUNT), type="integer", compact=True, id="count"),
-                        f"Number of points (0 to {MAX_SITES:,}); {THREAD_MIN_SITES:,} or more build "
+                        f"Number of points (0 to {GENERATE_MAX_SITES:,}); {BUILD_THREAD_MIN_SITES:,} or more build "
                         "in the background. Enter generates.",
                     )
                 with Horizontal(classes="row"):
@@ -329,8 +329,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         """The distribution, count, seed and parameters set in the panel."""
         distribution = str(self.query_one("#distribution", Select).value)
         count = self._read_int("count", "count", 0)
-        if count > MAX_SITES:
-            raise TvoronoiError(f"count {count:,} is more than the UI takes ({MAX_SITES:,}); use the batch mode")
+        if count > GENERATE_MAX_SITES:
+            raise TvoronoiError(
+                f"count {count:,} is more than the UI takes ({GENERATE_MAX_SITES:,}); use the batch mode"
+            )
         seed = self._read_int("seed", "seed", 0)
         params = {}
         for name, kind in PARAMETERS[distribution]:

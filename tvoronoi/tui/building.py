@@ -16,7 +16,7 @@ from tvoronoi.tui.raster import Scene
 
 # Work on this many sites or more runs in a worker thread; the status line and the panel's
 # progress bar say so, and the canvas keeps the focus (and the last diagram) meanwhile.
-THREAD_MIN_SITES = 100_000
+BUILD_THREAD_MIN_SITES = 100_000
 
 Clock = Callable[[], float]
 
@@ -99,7 +99,7 @@ class BuildingMixin:
                 pts = make_points()
             return build(pts, engine, source, self.clock, point_set=ps, bbox=bbox)
 
-        if size is not None and size < THREAD_MIN_SITES:
+        if size is not None and size < BUILD_THREAD_MIN_SITES:
             try:
                 built = job()
             except TvoronoiError as exc:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 from rich.segment import Segment
@@ -130,8 +129,6 @@ class DiagramCanvas(Widget, can_focus=True):
         self.editable = True
         # True while the view is the fitted one: a resize then fits again
         self.fitted = True
-        self.last_draw_ms = 0.0
-        self.drawn_at = 0.0  # perf_counter() when the last frame was drawn
         self._frame_key: tuple | None = None
         self._lines: list[list[Segment]] = []
         self._frame: Frame | None = None
@@ -359,7 +356,6 @@ class DiagramCanvas(Widget, can_focus=True):
         key = (base, version, self.cursor)
         if key == self._frame_key:
             return self._lines
-        start = time.perf_counter()
         if scene is None:
             self._frame = None
             self._lines = [[] for _ in range(size.height)]
@@ -372,8 +368,6 @@ class DiagramCanvas(Widget, can_focus=True):
             self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
         self._frame_version, self._frame_cursor = version, self.cursor
-        self.drawn_at = time.perf_counter()
-        self.last_draw_ms = (self.drawn_at - start) * 1000
         return self._lines
 
     def palette(self) -> Palette:

@@ -8,8 +8,6 @@ save start from the live sites.
 
 from __future__ import annotations
 
-import time
-
 from textual import work
 from textual.binding import Binding
 from textual.message import Message
@@ -23,7 +21,6 @@ from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 # A dynamic diagram is made ahead, in a worker, for diagrams up to this many sites;
 # larger ones get theirs at the first edit.
 PREPARE_MAX_SITES = 200_000
-NO_DYNAMIC = "editing needs dynamic updates (tvoronoi.DynamicVoronoi), which this build lacks"
 
 BINDINGS = [
     Binding("a", "add_site", "Add", show=False),
@@ -60,10 +57,6 @@ EDITING_ACTIONS = {"add_site", "remove_site", "move_site", "toggle_cursor", "cur
 MOVING_ACTIONS = {"nudge", "drop_site", "cancel_move"}
 
 
-def dynamic_available() -> bool:
-    return hasattr(tvoronoi, "DynamicVoronoi")
-
-
 def make_live(built) -> LiveScene:
     """A LiveScene over a new DynamicVoronoi of a built diagram's points (any thread)."""
     diagram = built.diagram
@@ -87,8 +80,6 @@ class EditingMixin:
     _prepared: tuple | None = None
     # (site id, where it was) while a site is picked up with m
     _moving: tuple[int, tuple[float, float]] | None = None
-    # perf_counter() when the last edit began (the canvas notes when its frame was drawn)
-    edit_started = 0.0
     last_edit_ms = 0.0
     n_edits = 0
 
@@ -104,7 +95,7 @@ class EditingMixin:
     def prepare_editing(self) -> None:
         """Make the dynamic diagram of the shown points in a worker, ahead of the first edit."""
         built = self.built
-        if built is None or not dynamic_available() or len(built.points) > PREPARE_MAX_SITES:
+        if built is None or len(built.points) > PREPARE_MAX_SITES:
             return
         self._prepare_in_thread(built)
 
@@ -125,9 +116,6 @@ class EditingMixin:
         if self.live is not None:
             return self.live
         if self.built is None:
-            return None
-        if not dynamic_available():
-            self.notify(NO_DYNAMIC, title="Not edited", severity="warning", timeout=6)
             return None
         if self._prepared is not None and self._prepared[0] is self.built:
             live = self._prepared[1]
@@ -166,7 +154,6 @@ class EditingMixin:
         live = self._editor()
         if live is None:
             return False
-        self.edit_started = time.perf_counter()
         start = self.clock()
         try:
             change(live)
@@ -215,9 +202,6 @@ class EditingMixin:
 
     def action_remove_site(self) -> None:
         """Delete the site under the cursor or the mouse pointer."""
-        if not dynamic_available():
-            self.notify(NO_DYNAMIC, title="Not edited", severity="warning", timeout=6)
-            return
         site = self._site_under_cursor()
         if site is None:
             self.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
@@ -231,9 +215,6 @@ class EditingMixin:
         """Pick up the site under the cursor (m again drops it)."""
         if self._moving is not None:
             self.action_drop_site()
-            return
-        if not dynamic_available():
-            self.notify(NO_DYNAMIC, title="Not edited", severity="warning", timeout=6)
             return
         site = self._site_under_cursor()
         if site is None:

@@ -105,7 +105,7 @@ class FilesMixin:
         if path is None or self.built is None:
             return
         try:
-            from tvoronoi.geojson import write_cells
+            from tvoronoi.writers.geojson_diagram import write_cells
         except ImportError:
             self.notify("saving GeoJSON is not available in this build", severity="error")
             return

@@ -1,7 +1,7 @@
 """Step-by-step playback of the selected engine: a trace, a timeline, a timer and the keys that drive them.
 
 Each step is recomputed from the trace (the engine reruns up to it) and drawn
-as a picture (tui.overlay). Up to ``THREAD_MIN_SITES`` sites that takes a few
+as a picture (tui.overlay). Up to ``STEP_THREAD_MIN_SITES`` sites that takes a few
 milliseconds and happens at once; above, a worker computes the latest step
 asked for while the timeline already shows it, so neither scrubbing nor fast
 playback ever waits on the engine.
@@ -22,9 +22,9 @@ from tvoronoi.tui.timeline import Timeline
 
 # Playback refuses larger point sets: a step of Fortune's sweep costs ~2 ms per
 # 1,000 sites, and the picture is drawn on every step.
-MAX_SITES = 20_000
+PLAYBACK_MAX_SITES = 20_000
 # From this many sites on, steps are computed in a worker thread.
-THREAD_MIN_SITES = 2_000
+STEP_THREAD_MIN_SITES = 2_000
 # Steps per second to choose from with < and >.
 SPEEDS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1_000, 2_000)
 DEFAULT_SPEED = 20
@@ -79,7 +79,7 @@ class Player:
         else:
             self.trace = tvoronoi.incremental_steps(self.points, bbox=bbox)
         self.n_steps = len(self.trace)
-        self.threaded = len(self.points) >= THREAD_MIN_SITES
+        self.threaded = len(self.points) >= STEP_THREAD_MIN_SITES
         self.index = 0          # the step asked for
         self.step = None        # the step on screen
         self.busy = False       # a worker is computing a step
@@ -136,9 +136,9 @@ class PlaybackMixin:
         if self.built is None:
             return
         n = self.live.n_sites if self.live is not None else len(self.built.points)
-        if n > MAX_SITES:
+        if n > PLAYBACK_MAX_SITES:
             self.notify(
-                f"playback takes up to {MAX_SITES:,} sites and this diagram has {n:,}: "
+                f"playback takes up to {PLAYBACK_MAX_SITES:,} sites and this diagram has {n:,}: "
                 "generate fewer points to watch the engine work",
                 title="Too many sites", severity="warning", timeout=8,
             )

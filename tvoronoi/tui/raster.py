@@ -312,11 +312,6 @@ def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
     return owner
 
 
-def cell_fill(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
-    """The palette index of the cell under each character's centre (-1 outside the box or no sites)."""
-    return fill_of(scene, cell_owner(scene, view, cols, rows))
-
-
 def fill_of(scene: Scene, owner: np.ndarray) -> np.ndarray:
     """The palette index of each owner (-1 stays -1)."""
     fill = np.full(owner.shape, -1, np.int16)

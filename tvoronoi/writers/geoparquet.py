@@ -215,13 +215,13 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         If writing fails (an existing file at ``out`` is then left untouched).
     """
     pa = require_pyarrow()
-    from tvoronoi.geojson import MIN_RING_POINTS, _closed_rings, _renames
+    from tvoronoi.writers.geojson_diagram import MIN_RING_POINTS, closed_rings, property_renames
 
     n_sites = diagram.n_sites
     rows = np.arange(n_sites)
     distinct = diagram.site_of == rows
     has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
-    xy, first, last = _closed_rings(diagram, 0, n_sites, has_ring)
+    xy, first, last = closed_rings(diagram, 0, n_sites, has_ring)
     ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
     geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(xy), ring_offsets, has_ring[distinct])
     kept = rows[distinct]
@@ -232,7 +232,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
                 f"the point set has {len(points)} rows but the diagram has {n_sites} sites; "
                 f"pass the points the diagram was built from"
             )
-        renames = _renames(points.property_names)
+        renames = property_renames(points.property_names)
         for name in points.property_names:
             if points.records is not None:
                 values = [points.records[i].get(name) for i in kept.tolist()]

@@ -21,9 +21,10 @@ import sys
 from contextlib import contextmanager
 from typing import BinaryIO, Iterator
 
-__all__ = ["STDOUT", "TEMP_SUFFIX", "AtomicFile", "DirectFile", "StdoutFile", "open_output", "output_file"]
+from tvoronoi.fileio import STDIO
 
-STDOUT = "-"
+__all__ = ["STDIO", "TEMP_SUFFIX", "AtomicFile", "DirectFile", "StdoutFile", "open_output", "output_file"]
+
 TEMP_SUFFIX = ".tmp"
 NEW_FILE_MODE = 0o666  # before the umask, as open() would create it
 WRITE_BUFFER = 1 << 20
@@ -151,7 +152,7 @@ class StdoutFile:
 
     direct = True
 
-    def __init__(self, fd: int = 1, path: str = STDOUT):
+    def __init__(self, fd: int = 1, path: str = STDIO):
         self.path = path
         if fd == 1:
             self.file: BinaryIO = sys.stdout.buffer
@@ -198,7 +199,7 @@ def descriptor_of(path: str) -> int | None:
 
 def is_direct(out) -> bool:
     """Whether ``out`` is written directly: ``"-"``, a descriptor name, a character device or a pipe."""
-    if isinstance(out, str) and (out == STDOUT or descriptor_of(out) is not None):
+    if isinstance(out, str) and (out == STDIO or descriptor_of(out) is not None):
         return True
     try:
         mode = os.stat(out).st_mode
@@ -222,7 +223,7 @@ def output_file(out, *, overwrite: bool = True) -> AtomicFile | DirectFile | Std
         The output cannot be created or opened; a block device or a socket (never written).
     """
     if isinstance(out, str):
-        if out == STDOUT:
+        if out == STDIO:
             return StdoutFile()
         fd = descriptor_of(out)
         if fd is not None:

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 
 import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
-from tvoronoi.bulk import gc_paused
+from tvoronoi.fileio import gc_paused
 
 from .pointset import PointSet
 
@@ -152,7 +153,7 @@ def _checked_sites(doc, source: str):
     return xs, ys, records, wheres.__getitem__
 
 
-def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
+def read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
     """The sites of a GeoJSON file; ``loads(data, source)`` parses it (the package's JSON decoder)."""
     if x is not None or y is not None:
         raise TvoronoiError(
@@ -183,9 +184,8 @@ def _read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
         xy[:, 1] = [float(v) if abs(v) < 1e308 else math.inf for v in ys]
     bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))
     if len(bad):
-        for i, (where, part, position, _) in enumerate(_geojson_sites(doc, source)):
-            if i == bad[0]:
-                break
+        # the first bad site, found again with where it came from
+        where, part, position, _ = next(itertools.islice(_geojson_sites(doc, source), int(bad[0]), None))
         if part is not None:
             where = f"{where}, point {part}"
         role = "x" if not math.isfinite(xy[bad[0], 0]) else "y"

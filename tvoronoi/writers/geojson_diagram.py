@@ -7,13 +7,11 @@ from typing import Callable
 import numpy as np
 import orjson
 
-from tvoronoi.bulk import gc_paused
+from tvoronoi.fileio import gc_paused
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.writers.targets import STDOUT, TEMP_SUFFIX, AtomicFile, StdoutFile, open_output, output_file
+from tvoronoi.writers.targets import open_output
 
-# the output targets live in tvoronoi.writers.targets and stay importable from here
-__all__ = ["write_cells", "write_delaunay", "missing_cells", "open_output", "output_file", "STDOUT",
-           "AtomicFile", "StdoutFile", "TEMP_SUFFIX"]
+__all__ = ["write_cells", "write_delaunay", "missing_cells"]
 
 # features serialized per orjson call: large enough to amortise numpy and orjson
 # calls, small enough that a chunk of text stays a few megabytes
@@ -101,7 +99,7 @@ def _ring_texts(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> tuple[me
     return memoryview(text), open_[first].tolist(), (close[last] + 1).tolist()
 
 
-def _closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closed rings of the cells of rows a..b-1 where ``keep`` (a (b-a,) bool mask) holds.
 
     Returns (xy, first, last) as :func:`_ring_texts` takes them.
@@ -135,7 +133,7 @@ def missing_cells(diagram) -> np.ndarray:
 # properties
 
 
-def _renames(names: list[str]) -> dict[str, str]:
+def property_renames(names: list[str]) -> dict[str, str]:
     """New names for site properties that clash with tvoronoi's own ("site" becomes "site_2")."""
     renames = {}
     taken = set(names) | set(RESERVED)
@@ -161,7 +159,7 @@ def _properties_writer(diagram, points) -> Callable[[int], bytes]:
                 f"the point set has {len(points)} rows but the diagram has {diagram.n_sites} sites; "
                 f"pass the points the diagram was built from"
             )
-        renames = _renames(points.property_names)
+        renames = property_renames(points.property_names)
         if points.records is not None:
             records = points.records
         else:
@@ -263,7 +261,7 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
             b = min(a + CHUNK_FEATURES, n_sites)
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
-            xy, first, last = _closed_rings(diagram, a, b, keep)
+            xy, first, last = closed_rings(diagram, a, b, keep)
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
             features = []

@@ -1,7 +1,10 @@
-"""Helpers for building or writing millions of small Python objects at once."""
+"""What the point readers and the output writers share: the name of standard input/output, bulk work."""
 
 import gc
 from contextlib import contextmanager
+
+# the file name that means standard input (a point file) or standard output (an output)
+STDIO = "-"
 
 
 @contextmanager
