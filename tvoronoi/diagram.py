@@ -125,3 +125,49 @@ class Diagram:
             out.append(h)
             h = int(self.he_next[h])
         return np.asarray(out, np.int32)
+
+    def to_shapely(self) -> np.ndarray:
+        """The cells as shapely Polygons, one per input row, built in one call.
+
+        Returns
+        -------
+        ndarray of shape (n,), dtype object
+            Polygon i has the counter-clockwise exterior ring of
+            ``cell_polygon(i)``, closed; it is None for a row without a cell
+            (a repeated point, a cell that misses the box).
+
+        >>> import tvoronoi
+        >>> d = tvoronoi.voronoi([[0, 0], [2, 0]], bbox=(-1, -1, 3, 1))
+        >>> [p.area for p in d.to_shapely()]
+        [4.0, 4.0]
+        """
+        from tvoronoi.shapes import cell_polygons
+
+        return cell_polygons(self)
+
+    def to_geopandas(self, properties=None, crs=None):
+        """The cells as a geopandas GeoDataFrame with one row per input point.
+
+        Parameters
+        ----------
+        properties : mapping or DataFrame, optional
+            Columns to carry, one value per input point, taken by position.
+        crs : optional
+            The coordinates' CRS, in any form geopandas accepts ("EPSG:4326").
+
+        Returns
+        -------
+        geopandas.GeoDataFrame
+            Columns ``site`` (the input row), the properties, ``geometry``
+            (the cells as in :meth:`to_shapely`; missing where a row has no
+            cell).
+
+        Raises
+        ------
+        TvoronoiError
+            geopandas is not installed (``pip install geopandas``), or the
+            properties do not fit.
+        """
+        from tvoronoi.shapes import cells_frame
+
+        return cells_frame(self, properties, crs)
