@@ -147,3 +147,110 @@ def test_to_geopandas_without_geopandas(monkeypatch):
     monkeypatch.setitem(sys.modules, "geopandas", None)
     with pytest.raises(TvoronoiError, match="pip install geopandas"):
         tvoronoi.voronoi(XY).to_geopandas()
+
+
+# --- nearest-site queries ----------------------------------------------------------------------------------
+
+
+def nearest_reference(sites, qx, qy):
+    """The lowest row among the sites nearest to each query, exactly: doubles shortlist, Fractions decide."""
+    from fractions import Fraction
+
+    sites = np.asarray(sites, float)
+    out = []
+    for x, y in zip(np.ravel(qx), np.ravel(qy)):
+        d2 = (sites[:, 0] - x) ** 2 + (sites[:, 1] - y) ** 2
+        near = np.flatnonzero(d2 <= d2.min() * (1 + 1e-6) + 1e-300)
+        fx, fy = Fraction(float(x)), Fraction(float(y))
+        exact = [(Fraction(float(sites[i, 0])) - fx) ** 2 + (Fraction(float(sites[i, 1])) - fy) ** 2 for i in near]
+        best = min(exact)
+        out.append(min(int(i) for i, v in zip(near, exact) if v == best))
+    return np.asarray(out)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 50, 3000])
+def test_locate_matches_ckdtree(n):
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(SEED + n)
+    sites = rng.random((n, 2))
+    d = tvoronoi.voronoi(sites)
+    q = np.concatenate([rng.random((4000, 2)) * 1.6 - 0.3, rng.normal(0, 1e3, (500, 2))])
+    got = d.locate(q[:, 0], q[:, 1])
+    assert got.dtype == np.int32
+    np.testing.assert_array_equal(got, cKDTree(sites).query(q)[1])
+    # Voronoi vertices: three sites nearly (or exactly) as near, which cKDTree may pick any of
+    v = d.vertices[:200]
+    np.testing.assert_array_equal(d.locate(v[:, 0], v[:, 1]), nearest_reference(sites, v[:, 0], v[:, 1]))
+
+
+@pytest.mark.parametrize("name", sorted(DATASETS))
+def test_locate_matches_exact_reference(name):
+    rng = np.random.default_rng(SEED)
+    sites = DATASETS[name]
+    d = tvoronoi.voronoi(sites)
+    lo, hi = sites.min(axis=0), sites.max(axis=0)
+    span = np.maximum(hi - lo, np.abs(hi) * 1e-3 + 1e-300)
+    # random queries, the sites themselves, midpoints of Delaunay edges (exact ties on grid data), vertices
+    edges = np.c_[d.he_face, d.he_face[d.he_twin]] if d.n_edges else np.empty((0, 2), int)
+    mids = (sites[edges[:, 0]] + sites[edges[:, 1]]) / 2
+    q = np.concatenate([lo + rng.random((300, 2)) * span * 1.4 - span * 0.2, sites, mids[:300], d.vertices[:100]])
+    np.testing.assert_array_equal(d.locate(q[:, 0], q[:, 1]), nearest_reference(sites, q[:, 0], q[:, 1]))
+
+
+def test_locate_lattice_ties_go_to_the_lowest_row():
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(SEED)
+    grid = np.array([(i, j) for i in range(40) for j in range(30)], float)[rng.permutation(1200)]
+    grid = np.concatenate([grid, grid[:100]])  # repeated points: their first row answers
+    d = tvoronoi.voronoi(grid)
+    q = rng.integers(-6, 90, (20000, 2)) / 2.0  # on sites, on bisectors, on Voronoi vertices
+    got = d.locate(q[:, 0], q[:, 1])
+    # every answer is at the nearest distance (cKDTree), and the lowest row at it
+    dist = np.hypot(*(grid[got] - q).T)
+    np.testing.assert_array_equal(dist, cKDTree(grid).query(q)[0])
+    d2 = ((q[:, None, :] - grid[None, :, :]) ** 2).sum(-1)
+    np.testing.assert_array_equal(got, np.argmax(d2 == d2.min(axis=1, keepdims=True), axis=1))
+
+
+def test_locate_decides_ties_beyond_double_precision():
+    d = tvoronoi.voronoi([[0.0, 0.0], [1.0, 0.0]])
+    # far above the bisector x = 0.5: doubles see one distance, the exact test sees which side
+    x = [0.5 + 2.0**-53, 0.5, 0.5 - 2.0**-54]
+    assert d.locate(x, [1e15] * 3).tolist() == [1, 0, 0]
+    # sites mirrored in y = x (coordinates that are not dyadic): every query on y = x is an exact tie
+    t = np.array([1e12 + 0.1, -3.7, 0.2, 12345.678])
+    for sites in ([[0.1, 0.3], [0.3, 0.1]], [[0.3, 0.1], [0.1, 0.3]]):
+        assert tvoronoi.voronoi(sites).locate(t, t).tolist() == [0, 0, 0, 0]
+
+
+def test_locate_shapes_and_errors():
+    d = tvoronoi.voronoi(XY)
+    assert d.locate(np.zeros((2, 3)), 2.0).shape == (2, 3)
+    assert d.locate(0.0, 0.0).shape == ()
+    assert d.locate([], []).shape == (0,)
+    with pytest.raises(TvoronoiError, match="query point 1"):
+        d.locate([0.0, np.nan], [0.0, 1.0])
+    with pytest.raises(TvoronoiError, match="query point 0"):
+        d.locate([1e300], [0.0])
+    with pytest.raises(TvoronoiError, match="no sites"):
+        tvoronoi.voronoi(np.empty((0, 2))).locate([0.0], [0.0])
+
+
+def test_locate_hypothesis():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    coords = st.integers(-6, 6)
+
+    @settings(max_examples=200, deadline=None)
+    @given(st.lists(st.tuples(coords, coords), min_size=1, max_size=25),
+           st.lists(st.tuples(coords, coords), min_size=1, max_size=20))
+    def check(sites, queries):
+        sites = np.asarray(sites, float)
+        q = np.asarray(queries, float) / 2.0
+        got = tvoronoi.voronoi(sites).locate(q[:, 0], q[:, 1])
+        np.testing.assert_array_equal(got, nearest_reference(sites, q[:, 0], q[:, 1]))
+
+    check()

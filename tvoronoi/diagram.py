@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -171,3 +172,42 @@ class Diagram:
         from tvoronoi.shapes import cells_frame
 
         return cells_frame(self, properties, crs)
+
+    @cached_property
+    def _locator(self):
+        from tvoronoi.locate import SiteLocator
+
+        return SiteLocator(self)
+
+    def locate(self, xs, ys) -> np.ndarray:
+        """The input row of the site nearest to each query point (x, y).
+
+        Walks the Delaunay graph from a nearby site, each step decided by an
+        exact comparison of squared distances. Queries may lie anywhere,
+        inside the box or not, within the range rule of the sites (2^170
+        around their scale).
+
+        Parameters
+        ----------
+        xs, ys : array_like
+            Query coordinates, of one shape (or broadcastable).
+
+        Returns
+        -------
+        ndarray of int32, of the queries' shape
+            For each query, the lowest input row among the sites nearest to
+            it: a tie between equidistant sites goes to the lower row, and a
+            repeated point to its first row (``site_of``).
+
+        Raises
+        ------
+        TvoronoiError
+            Non-finite or out-of-range queries (naming the first), or a
+            diagram without sites.
+
+        >>> import tvoronoi
+        >>> d = tvoronoi.voronoi([[0, 0], [2, 0], [0, 2], [2, 2]])
+        >>> d.locate([0.2, 1.9, 1.0, 50.0], [0.1, 2.5, 1.0, -3.0]).tolist()
+        [0, 3, 0, 1]
+        """
+        return self._locator.locate(xs, ys)
