@@ -1,4 +1,4 @@
-"""Nearest-site queries on a Diagram: the Voronoi neighbour graph, start sites from a coarse grid, the kernel walk."""
+"""Nearest-site queries on a Diagram: scaled sites, start sites from a coarse grid, the kernel's walk."""
 
 from __future__ import annotations
 
@@ -16,24 +16,22 @@ SITES_PER_BUCKET = 2.0
 
 
 class SiteLocator:
-    """What nearest-site queries on one diagram share: scaled sites, neighbour lists, the start grid."""
+    """What nearest-site queries on one diagram share: scaled sites, the half-edges, the start grid."""
 
     def __init__(self, diagram):
         sites = np.asarray(diagram.sites, np.float64)
         self.n_sites = len(sites)
         self.e = scale_exponent(sites)
         self.scaled = np.ascontiguousarray(np.ldexp(sites, -self.e))
-        # the Voronoi neighbour graph (the Delaunay graph) in CSR form, from the half-edges
-        faces = np.asarray(diagram.he_face, np.int32)
-        others = faces[diagram.he_twin] if len(faces) else faces
-        order = np.argsort(faces, kind="stable")  # a radix sort on int32
-        self.adj = np.ascontiguousarray(others[order], dtype=np.int32)
-        self.adj_offsets = np.zeros(self.n_sites + 1, np.int64)
-        np.cumsum(np.bincount(faces, minlength=self.n_sites), out=self.adj_offsets[1:])
+        # the Voronoi neighbour graph (the Delaunay graph): the kernel reads it off the half-edges
+        self.face_edge = np.ascontiguousarray(diagram.face_edge, np.int32)
+        self.he_next = np.ascontiguousarray(diagram.he_next, np.int32)
+        self.he_twin = np.ascontiguousarray(diagram.he_twin, np.int32)
+        self.he_face = np.ascontiguousarray(diagram.he_face, np.int32)
         # only first copies are graph nodes: a repeated point's row is never an answer
         distinct = np.flatnonzero(np.asarray(diagram.site_of) == np.arange(self.n_sites))
         self.first = int(distinct[0]) if len(distinct) else -1
-        # a grid over the sites' bounding box, each cell holding one of its sites (or -1)
+        # a grid over the sites' bounding box, each cell holding one of its sites, or -1 until filled below
         side = max(1, math.ceil(math.sqrt(len(distinct) / SITES_PER_BUCKET)))
         self.side = side
         self.lo = sites.min(axis=0) if len(sites) else np.zeros(2)
@@ -84,7 +82,7 @@ class SiteLocator:
         found = np.empty(len(q), np.int32)
         mark = np.full(self.n_sites, -1, np.int64)
         stack = np.empty(self.n_sites, np.int32)
-        nearest_sites(self.scaled, self.adj_offsets, self.adj, np.ascontiguousarray(scaled[order, 0]),
+        nearest_sites(self.scaled, self.face_edge, self.he_next, self.he_twin, self.he_face, np.ascontiguousarray(scaled[order, 0]),
                       np.ascontiguousarray(scaled[order, 1]), start, self.first, found, mark, stack)
         out = np.empty(len(q), np.int32)
         out[order] = found

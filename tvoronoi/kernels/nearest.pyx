@@ -77,20 +77,21 @@ cdef inline int closer(double qx, double qy, double ax, double ay, double bx, do
     return closer_exact(qx, qy, ax, ay, bx, by)
 
 
-def nearest_sites(const double[:, ::1] sites, const int64_t[::1] adj_offsets, const int32_t[::1] adj,
+def nearest_sites(const double[:, ::1] sites, const int32_t[::1] face_edge, const int32_t[::1] he_next,
+                  const int32_t[::1] he_twin, const int32_t[::1] he_face,
                   const double[::1] qx, const double[::1] qy, const int32_t[::1] start, int32_t first,
                   int32_t[::1] out, int64_t[::1] mark, int32_t[::1] stack) -> int:
     """Write in out[k] the lowest row among the sites nearest to (qx[k], qy[k]).
 
-    ``sites`` are scaled by the diagram's 2^-e and so are the queries; ``adj`` lists, in CSR form
-    (``adj_offsets``), the Voronoi neighbours of every site that has a cell (repeated points have none
-    and are never visited). A query starts from ``start[k]`` (a site with neighbours, or -1: the previous
-    query's answer, ``first`` for the first query). ``mark`` (n, filled with -1) and ``stack`` (n) are
-    scratch. Returns 0.
+    ``sites`` are scaled by the diagram's 2^-e and so are the queries. The neighbours of a site are the
+    cells across the half-edges of its cell (``face_edge``, ``he_next``, ``he_twin``, ``he_face`` of the
+    Diagram); repeated points have no cell and are never visited. A query starts from ``start[k]`` (the
+    first copy of a site), or, where it is -1, from the previous query's answer (``first`` for the first
+    query). ``mark`` (n, filled with -1) and ``stack`` (n) are scratch. Returns 0.
     """
     cdef Py_ssize_t n_queries = qx.shape[0]
     cdef Py_ssize_t k
-    cdef int64_t e
+    cdef int32_t e, e0
     cdef int32_t cur = first, best, i, j, low, top
     cdef double x, y
     with nogil:
@@ -105,10 +106,15 @@ def nearest_sites(const double[:, ::1] sites, const int64_t[::1] adj_offsets, co
             # (the Delaunay graph has no local minimum but the nearest sites)
             while True:
                 best = cur
-                for e in range(adj_offsets[cur], adj_offsets[cur + 1]):
-                    j = adj[e]
+                e0 = face_edge[cur]
+                e = e0
+                while e >= 0:
+                    j = he_face[he_twin[e]]
                     if closer(x, y, sites[j, 0], sites[j, 1], sites[best, 0], sites[best, 1]) < 0:
                         best = j
+                    e = he_next[e]
+                    if e == e0:
+                        break
                 if best == cur:
                     break
                 cur = best
@@ -121,13 +127,18 @@ def nearest_sites(const double[:, ::1] sites, const int64_t[::1] adj_offsets, co
             while top > 0:
                 top -= 1
                 i = stack[top]
-                for e in range(adj_offsets[i], adj_offsets[i + 1]):
-                    j = adj[e]
+                e0 = face_edge[i]
+                e = e0
+                while e >= 0:
+                    j = he_face[he_twin[e]]
                     if mark[j] != k and closer(x, y, sites[j, 0], sites[j, 1], sites[cur, 0], sites[cur, 1]) == 0:
                         mark[j] = k
                         stack[top] = j
                         top += 1
                         if j < low:
                             low = j
+                    e = he_next[e]
+                    if e == e0:
+                        break
             out[k] = low
     return 0
