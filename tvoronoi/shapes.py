@@ -45,7 +45,8 @@ def cell_polygons(diagram) -> np.ndarray:
     ring_of_vertex = np.repeat(np.arange(len(ring_lengths)), ring_lengths)
     ids[np.arange(len(vertex_ids)) + ring_of_vertex] = vertex_ids
     ids[closed_offsets[1:] - 1] = ids[closed_offsets[:-1]]
-    coords = np.ascontiguousarray(np.asarray(diagram.cell_points, np.float64)[ids])
+    # np.take gathers whole rows several times faster than fancy indexing
+    coords = np.take(np.ascontiguousarray(diagram.cell_points, np.float64), ids, axis=0)
     polygon_offsets = np.arange(len(ring_lengths) + 1, dtype=np.int64)
     out[has_cell] = shapely.from_ragged_array(
         shapely.GeometryType.POLYGON, coords, (closed_offsets, polygon_offsets)
