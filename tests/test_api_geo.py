@@ -254,3 +254,23 @@ def test_locate_hypothesis():
         np.testing.assert_array_equal(got, nearest_reference(sites, q[:, 0], q[:, 1]))
 
     check()
+
+
+def test_locate_on_a_dynamic_diagram_skips_removed_sites():
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(SEED)
+    xy = rng.random((800, 2))
+    dv = tvoronoi.DynamicVoronoi(xy[:500])
+    for p in xy[500:]:
+        dv.insert(*p)
+    for i in range(0, 800, 3):
+        dv.remove(i)
+    d = dv.diagram().to_diagram()
+    alive = np.setdiff1d(np.arange(800), np.arange(0, 800, 3))
+    q = rng.random((5000, 2)) * 1.4 - 0.2
+    np.testing.assert_array_equal(d.locate(q[:, 0], q[:, 1]), alive[cKDTree(xy[alive]).query(q)[1]])
+    dv = tvoronoi.DynamicVoronoi([[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]])
+    dv.remove(0)
+    dv.remove(2)
+    assert dv.diagram().to_diagram().locate([0.0, 5.0], [0.0, -3.0]).tolist() == [1, 1]

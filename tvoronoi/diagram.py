@@ -197,7 +197,9 @@ class Diagram:
         ndarray of int32, of the queries' shape
             For each query, the lowest input row among the sites nearest to
             it: a tie between equidistant sites goes to the lower row, and a
-            repeated point to its first row (``site_of``).
+            repeated point to the row that holds its cell (``site_of``).
+            Rows without a cell edge (repeated points, the removed sites of
+            a dynamic diagram) are never answers.
 
         Raises
         ------

@@ -28,8 +28,7 @@ class SiteLocator:
         self.he_next = np.ascontiguousarray(diagram.he_next, np.int32)
         self.he_twin = np.ascontiguousarray(diagram.he_twin, np.int32)
         self.he_face = np.ascontiguousarray(diagram.he_face, np.int32)
-        # only first copies are graph nodes: a repeated point's row is never an answer
-        distinct = np.flatnonzero(np.asarray(diagram.site_of) == np.arange(self.n_sites))
+        distinct = _graph_nodes(diagram)
         self.first = int(distinct[0]) if len(distinct) else -1
         # a grid over the sites' bounding box, each cell holding one of its sites, or -1 until filled below
         side = max(1, math.ceil(math.sqrt(len(distinct) / SITES_PER_BUCKET)))
@@ -87,6 +86,17 @@ class SiteLocator:
         out = np.empty(len(q), np.int32)
         out[order] = found
         return out.reshape(shape)
+
+
+def _graph_nodes(diagram) -> np.ndarray:
+    """The rows a walk may visit: those with a cell edge; else (a lone site) the row with a cell; else the
+    first copies. Repeated points, and the rows of removed sites in a dynamic diagram, are never answers."""
+    for rows in (np.flatnonzero(np.asarray(diagram.face_edge) >= 0),
+                 np.flatnonzero(np.diff(np.asarray(diagram.cell_offsets)) > 0),
+                 np.flatnonzero(np.asarray(diagram.site_of) == np.arange(diagram.n_sites))):
+        if len(rows):
+            return rows
+    return np.empty(0, np.intp)
 
 
 def _fill_along(grid: np.ndarray, axis: int) -> np.ndarray:
