@@ -50,6 +50,26 @@ def test_voronoi_takes_geospatial_points(make):
     np.testing.assert_array_equal(got.cell_points, want.cell_points)
 
 
+def test_shapely_points_round_trip_hypothesis():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+    from hypothesis.extra.numpy import arrays
+
+    # within the range rule (2^170 between the largest and the smallest nonzero coordinate)
+    finite = st.one_of(st.just(0.0), st.floats(1e-6, 1e6), st.floats(-1e6, -1e-6))
+
+    @settings(max_examples=100, deadline=None)
+    @given(arrays(np.float64, st.tuples(st.integers(1, 30), st.just(2)), elements=finite))
+    def check(xy):
+        for given_points in (shapely.MultiPoint(xy), list(shapely.points(xy)), gpd.GeoSeries(shapely.points(xy)),
+                             pd.DataFrame({"lon": xy[:, 0], "lat": xy[:, 1]})):
+            got = as_points(given_points)
+            assert got.flags.c_contiguous and got.dtype == np.float64
+            np.testing.assert_array_equal(got, xy)
+
+    check()
+
+
 def test_dynamic_and_empty_inputs():
     dv = tvoronoi.DynamicVoronoi(shapely.MultiPoint(XY))
     np.testing.assert_array_equal(dv.diagram().sites, XY)
