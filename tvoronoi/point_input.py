@@ -63,7 +63,7 @@ def foreign_points(points):
         if hasattr(points, "columns"):
             return _frame_points(points)
         values = points.to_numpy()
-        if values.dtype == object and len(values) and any(_is_shapely(v) for v in values[:1]):
+        if values.dtype == object and len(values) and _is_shapely(values[0]):
             return _geometry_points(values, labels=points.index)
         return None
     if _is_shapely(points):

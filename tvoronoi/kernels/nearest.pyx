@@ -85,9 +85,9 @@ def nearest_sites(const double[:, ::1] sites, const int32_t[::1] face_edge, cons
 
     ``sites`` are scaled by the diagram's 2^-e and so are the queries. The neighbours of a site are the
     cells across the half-edges of its cell (``face_edge``, ``he_next``, ``he_twin``, ``he_face`` of the
-    Diagram); repeated points have no cell and are never visited. A query starts from ``start[k]`` (the
-    first copy of a site), or, where it is -1, from the previous query's answer (``first`` for the first
-    query). ``mark`` (n, filled with -1) and ``stack`` (n) are scratch. Returns 0.
+    Diagram); repeated points have no cell and are never visited. A query starts from ``start[k]`` (a row
+    the walk may visit: one with a cell edge, or the lone site), or, where it is -1, from the previous
+    query's answer (``first`` for the first query). ``mark`` (n, filled with -1) and ``stack`` (n) are scratch. Returns 0.
     """
     cdef Py_ssize_t n_queries = qx.shape[0]
     cdef Py_ssize_t k
