@@ -9,6 +9,7 @@ import numpy as np
 from tvoronoi.diagram import Diagram
 from tvoronoi.engines import scale_exponent
 from tvoronoi.errors import CoordinateRangeError, EngineError, TvoronoiError
+from tvoronoi.point_input import explain_failure, foreign_points
 
 ENGINES = ("incremental", "fortune")
 INSERTION_ORDERS = ("brio", "random")
@@ -51,15 +52,29 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
 def as_points(points) -> np.ndarray:
     """Check and convert points to a C-contiguous (n, 2) float64 array.
 
+    Besides (n, 2) arrays and sequences of pairs, takes shapely Points (a MultiPoint, a sequence or
+    array of Points), a geopandas GeoSeries or GeoDataFrame of points, and a pandas DataFrame with
+    x/y (lon/lat, easting/northing...) columns: see ``point_input.foreign_points``.
+
     Raises
     ------
     TvoronoiError
-        Wrong shape, non-numeric values, NaN or infinity (naming the row).
+        Wrong shape, non-numeric values, NaN or infinity, a geometry that is not a point or an empty
+        point (naming the row).
+
+    Examples
+    --------
+    >>> import shapely
+    >>> as_points([shapely.Point(0, 1), shapely.Point(2, 3)]).tolist()
+    [[0.0, 1.0], [2.0, 3.0]]
     """
-    try:
-        pts = np.asarray(points, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TvoronoiError(f"points must be numbers in an (n, 2) array: {exc}") from None
+    pts = foreign_points(points)
+    if pts is None:
+        try:
+            pts = np.asarray(points, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            why = explain_failure(points)
+            raise TvoronoiError(why or f"points must be numbers in an (n, 2) array: {exc}") from None
     if pts.size == 0:
         return np.empty((0, 2), np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
@@ -118,8 +133,11 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
 
     Parameters
     ----------
-    points : array_like, shape (n, 2)
+    points : array_like, shape (n, 2), or shapely / geopandas / pandas points
         Finite coordinates. Repeated points are allowed: they share one cell.
+        Also a shapely MultiPoint or sequence of Points, a GeoSeries or
+        GeoDataFrame of points, or a DataFrame with x/y (lon/lat,
+        easting/northing...) columns; cell i is then the row i.
     engine : {"incremental", "fortune"}
         The randomized incremental algorithm, or Fortune's sweepline.
     bbox : (xmin, ymin, xmax, ymax), optional

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -125,3 +126,90 @@ class Diagram:
             out.append(h)
             h = int(self.he_next[h])
         return np.asarray(out, np.int32)
+
+    def to_shapely(self) -> np.ndarray:
+        """The cells as shapely Polygons, one per input row, built in one call.
+
+        Returns
+        -------
+        ndarray of shape (n,), dtype object
+            Polygon i has the counter-clockwise exterior ring of
+            ``cell_polygon(i)``, closed; it is None for a row without a cell
+            (a repeated point, a cell that misses the box).
+
+        >>> import tvoronoi
+        >>> d = tvoronoi.voronoi([[0, 0], [2, 0]], bbox=(-1, -1, 3, 1))
+        >>> [p.area for p in d.to_shapely()]
+        [4.0, 4.0]
+        """
+        from tvoronoi.shapes import cell_polygons
+
+        return cell_polygons(self)
+
+    def to_geopandas(self, properties=None, crs=None):
+        """The cells as a geopandas GeoDataFrame with one row per input point.
+
+        Parameters
+        ----------
+        properties : mapping or DataFrame, optional
+            Columns to carry, one value per input point, taken by position.
+        crs : optional
+            The coordinates' CRS, in any form geopandas accepts ("EPSG:4326").
+
+        Returns
+        -------
+        geopandas.GeoDataFrame
+            Columns ``site`` (the input row), the properties, ``geometry``
+            (the cells as in :meth:`to_shapely`; missing where a row has no
+            cell).
+
+        Raises
+        ------
+        TvoronoiError
+            geopandas is not installed (``pip install geopandas``), or the
+            properties do not fit.
+        """
+        from tvoronoi.shapes import cells_frame
+
+        return cells_frame(self, properties, crs)
+
+    @cached_property
+    def _locator(self):
+        from tvoronoi.locate import SiteLocator
+
+        return SiteLocator(self)
+
+    def locate(self, xs, ys) -> np.ndarray:
+        """The input row of the site nearest to each query point (x, y).
+
+        Walks the Delaunay graph from a nearby site, each step decided by an
+        exact comparison of squared distances. Queries may lie anywhere,
+        inside the box or not, within the range rule of the sites (2^170
+        around their scale).
+
+        Parameters
+        ----------
+        xs, ys : array_like
+            Query coordinates, of one shape (or broadcastable).
+
+        Returns
+        -------
+        ndarray of int32, of the queries' shape
+            For each query, the lowest input row among the sites nearest to
+            it: a tie between equidistant sites goes to the lower row, and a
+            repeated point to the row that holds its cell (``site_of``).
+            Rows without a cell edge (repeated points, the removed sites of
+            a dynamic diagram) are never answers.
+
+        Raises
+        ------
+        TvoronoiError
+            Non-finite or out-of-range queries (naming the first), or a
+            diagram without sites.
+
+        >>> import tvoronoi
+        >>> d = tvoronoi.voronoi([[0, 0], [2, 0], [0, 2], [2, 2]])
+        >>> d.locate([0.2, 1.9, 1.0, 50.0], [0.1, 2.5, 1.0, -3.0]).tolist()
+        [0, 3, 0, 1]
+        """
+        return self._locator.locate(xs, ys)
