@@ -527,3 +527,29 @@ def test_an_inconsistent_sweep_stops_a_dynamic_diagram_too(monkeypatch):
     monkeypatch.setattr(fortune, "sweep", lambda xs, ys: {**real(xs, ys), "status": fortune.STATUS_BROKEN})
     with pytest.raises(tvoronoi.TvoronoiError, match="inconsistent state"):
         tvoronoi.DynamicVoronoi(np.random.default_rng(SEED).random((20, 2)), engine="fortune")
+
+
+@pytest.mark.parametrize("noise", [1e-17, 1e-13, 1e-9])
+@pytest.mark.parametrize("scale", [1.0, 2.0 ** -60, 2.0 ** -150])
+def test_fine_filter_holds_and_decides_on_noisy_squares(noise, scale):
+    """The double-double stage's bound holds on the triangles of noisy lattice squares (the near-cocircular
+    pairs that reach it), at several scales, and it decides them: exact integers stay the exception."""
+    from decimal import Decimal
+    rng = np.random.default_rng(SEED + 3)
+    decided = 0
+    for _ in range(120):
+        i, j = rng.integers(0, 50, 2)
+        sq = (np.array([(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)], float) / 64
+              + noise * rng.standard_normal((4, 2))) * scale
+        for a, b, c in ((0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)):
+            tri = tuple(float(v) for v in (*sq[a], *sq[b], *sq[c]))
+            if _orient(*[(Fraction(tri[2 * k]), Fraction(tri[2 * k + 1])) for k in range(3)]) <= 0:
+                continue
+            fine = fortune.circle_event_top_fine(*tri)
+            if fine is None:
+                continue
+            head, tail, err = fine
+            assert abs(Decimal(head) + Decimal(tail) - _exact_top(tri)) <= Decimal(err)
+            assert err <= 1e-28 * max(abs(head), 1e-300)
+            decided += 1
+    assert decided > 300

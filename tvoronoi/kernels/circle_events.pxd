@@ -4,7 +4,7 @@
 #   1. circle_top_fast / circle_top: the top and an interval [lo, hi] that holds it (two doubles compared);
 #   2. the top as base + rise, base the highest site's y, rise with its own bound (relative_sign): near
 #      ties much closer than an ulp of the top (sites within 1e-16 of a line) are far apart in the rises;
-#   3. circle_top_fine: the same computation in binary128 with its bound;
+#   3. circle_top_fine: the same computation in double-double arithmetic with its bound;
 #   4. exact integer arithmetic (event_order_exact.pxd).
 #
 # For sites a, b, c counter-clockwise, relative to an origin o among them (B, C: from o to the other two,
@@ -302,106 +302,176 @@ cdef inline int relative_sign(double base_i, double rise_i, double err_i,
 
 
 # ---------------------------------------------------------------------------------------------------------
-# the second filter, for near ties: the same top in binary128 (quad precision, u = 2^-113)
+# the second filter, for near ties: the same top in double-double arithmetic (about 106 bits)
 #
-# Sites within 1e-16 of a line give circle events whose tops differ from each other and from the next
-# sites by less than a double's ulp; exact integer arithmetic for each of those comparisons would cost
-# ~10 us. The same computation in quad precision (libgcc's correctly rounded soft-float, about 1 us)
-# separates them. Its error bound repeats the one above with u = 2^-113, except:
-#   - no underflow or overflow: quad's exponent range holds any product of six doubles;
-#   - the square root is one Newton step from the double square root: relative error below
-#     e0^2 / 2 + 3 u with e0 < 2^-52, so |r - R| <= 2^-103 r + Ex + Ey;
-#   - the determinant is bounded by its permanent, 4 u (|p1| + |p2|) (each product rounded once, the
-#     differences checked exact); when that is not small against det the filter gives up (integers);
-#   - the bound is computed in quad too (about 30 operations: a factor 1 + 2^-60 covers them).
+# Sites within 1e-16 of a line, or the two triangles of a near-cocircular quad (every square of a noisy
+# lattice), give circle events whose tops differ from each other and from the next sites by less than a
+# double's ulp; exact integer arithmetic for each of those comparisons would cost ~10 us. The same
+# computation in double-double arithmetic (pairs hi + lo of doubles, hardware operations only) separates
+# them. Its error bound repeats the one above with u replaced by U = 2^-100 per operation: the
+# double-double operations below are the accurate ones of Joldes, Muller and Popescu (2017), whose
+# relative errors are at most 3 u^2 (sum), 7 u^2 (product) and 15 u^2 + 56 u^3 (quotient), u = 2^-53,
+# all below 64 u^2 = U. Except:
+#   - the coordinate differences are exact double-doubles (two_diff);
+#   - no underflow: every nonzero difference must lie in [2^-200, 2^200] and the centre offsets and the
+#     radius above 2^-300, so that each low part stays a normal double; else the filter gives up;
+#   - the square root is one Newton step from the double square root of the high part: relative error
+#     below e0^2 / 2 + 3 U with e0 < 2^-52, so |r - R| <= 2^-98 r + Ex + Ey;
+#   - the bound is computed in doubles from the high parts (about 30 operations, each within 2^-53, and
+#     the high parts within 2^-52 of the values): a factor 1 + 2^-40 covers them.
 
 cdef extern from *:
     """
-    /* 2^-113, 2^-103, 2^-60 as exact double constants */
-    #define TVORONOI_QUAD_EPS 9.6296497219361792652798897129246E-35
-    #define TVORONOI_QUAD_SQRT_ERR 9.8607613152626475676466070660348E-32
-    #define TVORONOI_QUAD_BOUND_SLACK 8.6736173798840354720596224069595E-19
+    /* 2^-100, 2^-98, 2^-40, 2^-200, 2^200, 2^-300 as exact double constants */
+    #define TVORONOI_DD_EPS 0x1p-100
+    #define TVORONOI_DD_SQRT_ERR 0x1p-98
+    #define TVORONOI_DD_BOUND_SLACK 0x1p-40
+    #define TVORONOI_DD_TINY_DIFF 0x1p-200
+    #define TVORONOI_DD_HUGE_DIFF 0x1p200
+    #define TVORONOI_DD_TINY 0x1p-300
     """
-    ctypedef long double quad "__float128"
-    const double QUAD_EPS "TVORONOI_QUAD_EPS"
-    const double QUAD_SQRT_ERR "TVORONOI_QUAD_SQRT_ERR"
-    const double QUAD_BOUND_SLACK "TVORONOI_QUAD_BOUND_SLACK"
+    const double DD_EPS "TVORONOI_DD_EPS"
+    const double DD_SQRT_ERR "TVORONOI_DD_SQRT_ERR"
+    const double DD_BOUND_SLACK "TVORONOI_DD_BOUND_SLACK"
+    const double DD_TINY_DIFF "TVORONOI_DD_TINY_DIFF"
+    const double DD_HUGE_DIFF "TVORONOI_DD_HUGE_DIFF"
+    const double DD_TINY "TVORONOI_DD_TINY"
 
 
-cdef inline quad qabs(quad v) noexcept nogil:
-    return -v if v < 0 else v
+cdef inline (double, double) dd_add(double ah, double al, double bh, double bl) noexcept nogil:
+    # (ah + al) + (bh + bl), relative error <= 3 u^2 (AccurateDWPlusDW)
+    cdef double sh, sl, th, tl
+    sh, sl = two_sum(ah, bh)
+    th, tl = two_sum(al, bl)
+    sl = sl + th
+    sh, sl = fast_two_sum(sh, sl)
+    sl = sl + tl
+    return fast_two_sum(sh, sl)
 
 
-cdef inline bint quad_difference(double a, double b, quad* d) noexcept nogil:
-    """d = a - b in quad; True when that is exact (the two-sum tail, in quad, is zero)."""
-    cdef quad qa = a, qb = b
-    cdef quad x = qa - qb
-    cdef quad b_virtual = qa - x
-    cdef quad a_virtual = x + b_virtual
-    d[0] = x
-    return (b_virtual - qb) + (qa - a_virtual) == 0
+cdef inline (double, double) dd_mul(double ah, double al, double bh, double bl) noexcept nogil:
+    # (ah + al) (bh + bl), relative error <= 7 u^2 (DWTimesDW1, no fused multiply-add)
+    cdef double ch, cl
+    ch, cl = two_product(ah, bh)
+    cl = cl + (ah * bl + al * bh)
+    return fast_two_sum(ch, cl)
+
+
+cdef inline (double, double) dd_div(double ah, double al, double bh, double bl) noexcept nogil:
+    # (ah + al) / (bh + bl), relative error <= 15 u^2 + 56 u^3 (DWDivDW2)
+    cdef double th = ah / bh, rh, rl, ph, pl, d
+    rh, rl = two_product(bh, th)
+    rl = rl + bl * th
+    rh, rl = fast_two_sum(rh, rl)
+    ph, pl = dd_add(ah, al, -rh, -rl)
+    d = ph / bh
+    return fast_two_sum(th, d)
+
+
+cdef inline bint dd_difference(double a, double b, double* h, double* l) noexcept nogil:
+    """a - b as an exact double-double; False when it is nonzero and outside [2^-200, 2^200]."""
+    h[0], l[0] = two_diff(a, b)
+    cdef double m = fabs(h[0])
+    return m == 0.0 or (DD_TINY_DIFF <= m <= DD_HUGE_DIFF)
 
 
 cdef inline bint circle_top_fine(double ax, double ay, double bx, double by, double cx, double cy,
-                                 quad* top, quad* err) noexcept nogil:
-    """The top of the circle through a, b, c (counter-clockwise) in quad precision, |exact - top| <= err.
+                                 double* fine) noexcept nogil:
+    """The top of the circle through a, b, c (counter-clockwise) in double-double precision:
+    fine[0] + fine[1] within fine[2] of the exact top.
 
-    False when this filter cannot bound it (inexact differences, a nearly collinear triple).
+    False when this filter cannot bound it (differences out of its range, a nearly collinear triple).
     """
-    cdef quad u = QUAD_EPS
-    cdef quad bdx, bdy, cdx, cdy, p1, p2, det, e_det, bb, cc, t1, t2, t3, t4, ux, uy, x, r
-    cdef quad h, t, e_x, e_y, e_r, e_s, e_h, margin
-    cdef quad s = 0
-    cdef double r0
-    if not (quad_difference(bx, ax, &bdx) and quad_difference(by, ay, &bdy)
-            and quad_difference(cx, ax, &cdx) and quad_difference(cy, ay, &cdy)):
+    cdef double u = DD_EPS
+    cdef double bdx, bdxl, bdy, bdyl, cdx, cdxl, cdy, cdyl
+    cdef double p1, p1l, p2, p2l, det, detl, e_det, margin, bb, bbl, cc, ccl, q, ql
+    cdef double t1, t1l, t2, t2l, t3, t3l, t4, t4l, ux, uxl, uy, uyl, x, xl, r0, r, rl
+    cdef double h, hl, t, tl, sv = 0.0, svl = 0.0, e_x, e_y, e_r, e_s, e_h
+    if not (dd_difference(bx, ax, &bdx, &bdxl) and dd_difference(by, ay, &bdy, &bdyl)
+            and dd_difference(cx, ax, &cdx, &cdxl) and dd_difference(cy, ay, &cdy, &cdyl)):
         return False
-    p1 = bdx * cdy
-    p2 = bdy * cdx
-    det = 2 * (p1 - p2)
-    e_det = 8 * u * (qabs(p1) + qabs(p2))
+    p1, p1l = dd_mul(bdx, bdxl, cdy, cdyl)
+    p2, p2l = dd_mul(bdy, bdyl, cdx, cdxl)
+    det, detl = dd_add(p1, p1l, -p2, -p2l)
+    det = 2.0 * det
+    detl = 2.0 * detl
+    # (each product rounded once, the difference once: 4 U of the permanent covers both)
+    e_det = 8.0 * u * (fabs(p1) + fabs(p2)) * (1.0 + DD_BOUND_SLACK)
     margin = det - e_det
     if not (margin > det / 2):
         return False
     # the centre, relative to a, and the radius (one Newton step from the double square root)
-    bb = bdx * bdx + bdy * bdy
-    cc = cdx * cdx + cdy * cdy
-    t1 = cdy * bb; t2 = bdy * cc; t3 = bdx * cc; t4 = cdx * bb
-    ux = (t1 - t2) / det
-    uy = (t3 - t4) / det
-    x = ux * ux + uy * uy
-    r0 = sqrt(<double>x)
-    if not (r0 > 1e-150 and r0 < INFINITY):      # (a subnormal double would not give 52 bits)
+    bb, bbl = dd_mul(bdx, bdxl, bdx, bdxl)
+    q, ql = dd_mul(bdy, bdyl, bdy, bdyl)
+    bb, bbl = dd_add(bb, bbl, q, ql)
+    cc, ccl = dd_mul(cdx, cdxl, cdx, cdxl)
+    q, ql = dd_mul(cdy, cdyl, cdy, cdyl)
+    cc, ccl = dd_add(cc, ccl, q, ql)
+    t1, t1l = dd_mul(cdy, cdyl, bb, bbl)
+    t2, t2l = dd_mul(bdy, bdyl, cc, ccl)
+    t3, t3l = dd_mul(bdx, bdxl, cc, ccl)
+    t4, t4l = dd_mul(cdx, cdxl, bb, bbl)
+    q, ql = dd_add(t1, t1l, -t2, -t2l)
+    ux, uxl = dd_div(q, ql, det, detl)
+    q, ql = dd_add(t3, t3l, -t4, -t4l)
+    uy, uyl = dd_div(q, ql, det, detl)
+    if (ux != 0.0 and fabs(ux) < DD_TINY) or (uy != 0.0 and fabs(uy) < DD_TINY):
         return False
-    r = (r0 + x / r0) / 2
+    x, xl = dd_mul(ux, uxl, ux, uxl)
+    q, ql = dd_mul(uy, uyl, uy, uyl)
+    x, xl = dd_add(x, xl, q, ql)
+    r0 = sqrt(x)
+    if not (r0 > DD_TINY and r0 < INFINITY):
+        return False
+    q, ql = dd_div(x, xl, r0, 0.0)
+    r, rl = dd_add(r0, 0.0, q, ql)
+    r = 0.5 * r
+    rl = 0.5 * rl
     # the top, without cancellation when the centre lies below a
     if uy >= 0:
-        h = uy + r
+        h, hl = dd_add(uy, uyl, r, rl)
     else:
-        s = r - uy
-        h = ux * ux / s
-    t = ay + h
-    # its error bound
-    e_x = (u * qabs(ux) * det * (1 + 2 * u) + 8 * u * (qabs(t1) + qabs(t2)) + qabs(ux) * e_det) / margin
-    e_y = (u * qabs(uy) * det * (1 + 2 * u) + 8 * u * (qabs(t3) + qabs(t4)) + qabs(uy) * e_det) / margin
-    e_r = QUAD_SQRT_ERR * r + e_x + e_y
+        sv, svl = dd_add(r, rl, -uy, -uyl)
+        q, ql = dd_mul(ux, uxl, ux, uxl)
+        h, hl = dd_div(q, ql, sv, svl)
+    t, tl = dd_add(ay, 0.0, h, hl)
+    # its error bound (in doubles, from the high parts; see the notes above)
+    e_x = (u * fabs(ux) * det * (1 + 2 * u) + 8 * u * (fabs(t1) + fabs(t2)) + fabs(ux) * e_det) / margin
+    e_y = (u * fabs(uy) * det * (1 + 2 * u) + 8 * u * (fabs(t3) + fabs(t4)) + fabs(uy) * e_det) / margin
+    e_r = DD_SQRT_ERR * r + e_x + e_y
     if uy >= 0:
         e_h = e_y + e_r + u * h
     else:
-        e_s = e_r + e_y + u * s
-        if not (s > e_s):
+        e_s = e_r + e_y + u * sv
+        if not (sv > e_s * (1.0 + DD_BOUND_SLACK)):
             return False
-        e_h = (u * h * s * (1 + 2 * u) + e_x * (2 * qabs(ux) + e_x) + u * ux * ux + h * e_s) / (s - e_s)
-    top[0] = t
-    err[0] = (e_h + u * qabs(t)) * (1 + QUAD_BOUND_SLACK) + 2 * u * qabs(t)
+        e_h = (u * h * sv * (1 + 2 * u) + e_x * (2 * fabs(ux) + e_x) + u * ux * ux + h * e_s) / (sv - e_s)
+    fine[0] = t
+    fine[1] = tl
+    fine[2] = ((e_h + u * fabs(t)) * (1 + DD_BOUND_SLACK) + 2 * u * fabs(t)) * (1 + DD_BOUND_SLACK)
     return True
 
 
-cdef inline int fine_sign(quad d, quad slack) noexcept nogil:
-    """Sign of an exact value within slack of the quad value d; 0 when the slack hides it."""
-    slack = slack * (1 + QUAD_BOUND_SLACK) + QUAD_EPS * 4 * qabs(d)
-    if d > slack:
+cdef inline int fine_sign(double dh, double dl, double slack) noexcept nogil:
+    """Sign of an exact value within slack of the double-double dh + dl, itself the rounded difference of
+    two double-doubles (relative error 3 u^2); 0 when the slack hides it."""
+    slack = slack * (1 + DD_BOUND_SLACK) + DD_EPS * 4 * fabs(dh)
+    if dh > slack:
         return 1
-    if -d > slack:
+    if -dh > slack:
         return -1
     return 0
+
+
+cdef inline int fine_order(const double* f, const double* g) noexcept nogil:
+    """Sign of top f - top g for two fine tops (hi, lo, err); 0 when their bounds overlap."""
+    cdef double dh, dl
+    dh, dl = dd_add(f[0], f[1], -g[0], -g[1])
+    return fine_sign(dh, dl, f[2] + g[2])
+
+
+cdef inline int fine_site(const double* f, double y) noexcept nogil:
+    """Sign of top f - y; 0 when the bound hides it."""
+    cdef double dh, dl
+    dh, dl = dd_add(f[0], f[1], -y, 0.0)
+    return fine_sign(dh, dl, f[2])

@@ -1,5 +1,5 @@
 # Fortune's event queue (fortune.pyx): pending circle events in a binary heap, ordered exactly by the top of
-# their circles (circle_events.pxd: a double filter, the rises above the highest site, a quad filter, then
+# their circles (circle_events.pxd: a double filter, the rises above the highest site, a double-double filter, then
 # exact integers in event_order_exact.pxd), and the exact choice between the next site and the first
 # circle event. Inline helpers, compiled into the fortune module.
 

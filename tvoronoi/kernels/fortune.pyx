@@ -16,7 +16,9 @@ from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
-from tvoronoi.kernels.circle_events cimport circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_sign, quad
+from tvoronoi.kernels.circle_events cimport (
+    circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_order, fine_site,
+)
 from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
 from tvoronoi.kernels.sweep_state cimport (
     Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
@@ -41,7 +43,7 @@ from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, 
 # coordinate comparisons), whether three arcs converge (orient2d), and the
 # order of events (circle_events.pxd: a rounded top of each circle with a
 # proven error bound; near ties by the rise above the highest site, then in
-# quad precision, then in exact integers, event_order_exact.pxd). At an
+# double-double precision, then in exact integers, event_order_exact.pxd). At an
 # exact tie a site comes before a circle event, and circle events with equal
 # tops go by their rounded centre x: events at one height with different
 # centres share no arc and commute, events at one centre are cocircular sites,
@@ -68,7 +70,7 @@ STATUS_MESSAGES = {
 
 # ---------------------------------------------------------------------------------------------------------
 # the event order at near ties (event_queue.pxd settles the rest): the rises above the highest sites, the
-# quad filter, then exact integers
+# double-double filter, then exact integers
 
 cdef void event_rise(Sweep* s, int ev, double* base, double* rise, double* rise_err) noexcept nogil:
     """The top of event ev as base + rise (within rise_err): computed once, when a near tie needs it."""
@@ -85,13 +87,12 @@ cdef void event_rise(Sweep* s, int ev, double* base, double* rise, double* rise_
 
 
 cdef bint fine_top(Sweep* s, int ev) noexcept nogil:
-    """The quad-precision top of event ev (computed once, when first needed); False if unavailable."""
+    """The double-double top of event ev (computed once, when first needed); False if unavailable."""
     cdef double tri[6]
     if (s.ev_fine_state[ev] & FINE_MASK) == FINE_UNKNOWN:
         s.n_fine_tops += 1
         event_sites(s, ev, tri)
-        if circle_top_fine(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5],
-                           &s.ev_fine[2 * ev], &s.ev_fine[2 * ev + 1]):
+        if circle_top_fine(tri[0], tri[1], tri[2], tri[3], tri[4], tri[5], &s.ev_fine[3 * ev]):
             s.ev_fine_state[ev] |= FINE_OK
         else:
             s.ev_fine_state[ev] |= FINE_NONE
@@ -104,7 +105,7 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     cdef double tj[6]
     cdef int c
     cdef double base_i, rise_i, err_i, base_j, rise_j, err_j
-    # near tie: the rises above the sites, the quad filter, then exact integers
+    # near tie: the rises above the sites, the double-double filter, then exact integers
     s.n_near += 1
     event_rise(s, i, &base_i, &rise_i, &err_i)
     event_rise(s, j, &base_j, &rise_j, &err_j)
@@ -113,7 +114,7 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
         return c
     s.n_fine_tests += 1
     if fine_top(s, i) and fine_top(s, j):
-        c = fine_sign(s.ev_fine[2 * i] - s.ev_fine[2 * j], s.ev_fine[2 * i + 1] + s.ev_fine[2 * j + 1])
+        c = fine_order(&s.ev_fine[3 * i], &s.ev_fine[3 * j])
         if c != 0:
             return c
     event_sites(s, i, ti)
@@ -141,7 +142,7 @@ cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
     cdef double tri[6]
     cdef double base, rise, err
     cdef int r
-    # near tie: the rise above the event's site, the quad filter, then exact integers
+    # near tie: the rise above the event's site, the double-double filter, then exact integers
     s.n_near += 1
     event_rise(s, ev, &base, &rise, &err)
     r = relative_sign(base, rise, err, yi, 0.0, 0.0)
@@ -149,7 +150,7 @@ cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
         return r > 0
     s.n_fine_tests += 1
     if fine_top(s, ev):
-        r = fine_sign(s.ev_fine[2 * ev] - <quad>yi, s.ev_fine[2 * ev + 1])
+        r = fine_site(&s.ev_fine[3 * ev], yi)
         if r != 0:
             return r > 0
     event_sites(s, ev, tri)
@@ -453,7 +454,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     (vertex n at infinity; only when the sweep finished without trouble and
     some triangle exists), ``dup`` (n,) int32, ``steps`` (events processed),
     ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
-    left to the rises, those left to the quad filter, events whose quad top
+    left to the rises, those left to the double-double filter, events whose fine top
     was computed), ``exact_tests`` (site and circle comparisons left to exact
     integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
@@ -507,7 +508,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.ev_span = &ev_span[0]
     s.ev_rise = &ev_rise[0]
     s.ev_fine_state = &ev_fine_state[0]
-    s.ev_fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
+    s.ev_fine = <double*>malloc(3 * cap_ev * sizeof(double))
     if s.ev_fine == NULL:
         raise MemoryError("Fortune's sweep: event buffers")
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
@@ -640,7 +641,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
     cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
-    cdef quad* fine = <quad*>malloc(2 * cap_ev * sizeof(quad))
+    cdef double* fine = <double*>malloc(3 * cap_ev * sizeof(double))
     cdef int32_t* p = ib
     cdef double* q = fb
     cdef Sweep s
@@ -722,16 +723,12 @@ def circle_event_top(double ax, double ay, double bx, double by, double cx, doub
 
 
 def circle_event_top_fine(double ax, double ay, double bx, double by, double cx, double cy):
-    """The quad-precision filter's top of the circle through a, b, c, for tests: None when it gives up,
-    else (head, tail, err): the exact top lies within err of head + tail (err rounded up to a double)."""
-    cdef quad top, err
-    cdef double head, tail
-    if not circle_top_fine(ax, ay, bx, by, cx, cy, &top, &err):
+    """The double-double filter's top of the circle through a, b, c, for tests: None when it gives up,
+    else (head, tail, err): the exact top lies within err of head + tail."""
+    cdef double fine[3]
+    if not circle_top_fine(ax, ay, bx, by, cx, cy, fine):
         return None
-    head = <double>top
-    tail = <double>(top - <quad>head)
-    # (head + tail holds 106 of the 113 bits: the tail's rounding joins the bound)
-    return head, tail, (np.nextafter(<double>err, np.inf) + abs(tail) * 2.0 ** -52) * (1 + 2.0 ** -50)
+    return fine[0], fine[1], fine[2]
 
 
 def site_before_event(double y, double ax, double ay, double bx, double by, double cx, double cy):

@@ -1,9 +1,8 @@
 # The state of Fortune's sweep (fortune.pyx): one struct of arrays, shared by the beach line, the event
-# queue and the events; the enums of event kinds, quad-filter states and status codes.
+# queue and the events; the enums of event kinds, double-double filter states and status codes.
 
 from libc.stdint cimport int8_t, int32_t
 
-from tvoronoi.kernels.circle_events cimport quad
 
 cdef enum:
     NONE = -1
@@ -14,7 +13,7 @@ cdef enum:
 cdef enum:
     FINE_UNKNOWN = 0
     FINE_OK = 1
-    FINE_NONE = 2         # the quad filter cannot bound this event's top
+    FINE_NONE = 2         # the double-double filter cannot bound this event's top
     FINE_MASK = 3
     RISE_KNOWN = 4        # flag: ev_rise holds this event's base, rise and rise error
 
@@ -50,7 +49,7 @@ cdef struct Sweep:
     double* ev_span         # lo, hi of each event (2 per event, side by side for the heap's comparisons)
     double* ev_x
     double* ev_cy
-    quad* ev_fine           # the top in quad precision and its bound (2 per event), for near ties
+    double* ev_fine         # the top in double-double and its bound (hi, lo, err: 3 per event), for near ties
     int8_t* ev_fine_state   # FINE_UNKNOWN, FINE_OK, FINE_NONE, | RISE_KNOWN
     double* ev_rise         # base, rise, rise error (3 per event), where RISE_KNOWN
     int32_t* ev_arc
