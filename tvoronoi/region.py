@@ -82,7 +82,7 @@ def as_region(clip, *, what: str = "clip"):
         raise TvoronoiError(
             f"{what} must be a shapely Polygon or MultiPolygon, got {type(clip).__name__}"
         )
-    if clip.is_empty or not clip.area > 0:
+    if clip.is_empty:
         raise TvoronoiError(f"{what} is an empty {clip.geom_type}: it has no area to clip to")
     if not np.isfinite(shapely.get_coordinates(clip)).all():
         raise TvoronoiError(f"{what} has a coordinate that is not finite")
@@ -91,6 +91,8 @@ def as_region(clip, *, what: str = "clip"):
             f"{what} is not a valid {clip.geom_type} ({shapely.is_valid_reason(clip)}); "
             f"repair it first, e.g. with shapely.make_valid"
         )
+    if not clip.area > 0:
+        raise TvoronoiError(f"{what} has no area to clip to")
     return clip
 
 
