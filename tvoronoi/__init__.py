@@ -16,7 +16,7 @@ def __getattr__(name):
 
         return voronoi
     if name == "lloyd":
-        from tvoronoi.lloyd import lloyd
+        from tvoronoi.relax import lloyd
 
         return lloyd
     if name == "Diagram":

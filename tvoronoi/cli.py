@@ -320,7 +320,7 @@ def _batch_run(args, phases: Phases) -> int:
             phases.show()
         xy = points.xy
         if args.lloyd:
-            from tvoronoi.lloyd import lloyd
+            from tvoronoi.relax import lloyd
 
             with phases.phase(f"lloyd x{args.lloyd}"):
                 try:

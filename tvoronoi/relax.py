@@ -1,4 +1,4 @@
-"""Lloyd relaxation: move each site to the centroid of its cell, a given number of times."""
+"""Lloyd relaxation (tvoronoi.lloyd): move each site to the centroid of its cell, a given number of times."""
 
 from __future__ import annotations
 
