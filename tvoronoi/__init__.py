@@ -2,7 +2,7 @@
 
 __version__ = "0.1.0"
 
-__all__ = ["voronoi", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "fortune_steps",
+__all__ = ["voronoi", "lloyd", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "fortune_steps",
            "incremental_steps"]
 
 from tvoronoi.errors import TvoronoiError
@@ -15,6 +15,10 @@ def __getattr__(name):
         from tvoronoi.api import voronoi
 
         return voronoi
+    if name == "lloyd":
+        from tvoronoi.relax import lloyd
+
+        return lloyd
     if name == "Diagram":
         from tvoronoi.diagram import Diagram
 

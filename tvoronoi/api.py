@@ -128,8 +128,8 @@ def as_bbox(bbox) -> tuple[float, float, float, float]:
 
 
 def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = "brio",
-            seed: int = 0) -> Diagram:
-    """The Voronoi diagram of a set of points, with its cells clipped to a box.
+            seed: int = 0, clip=None) -> Diagram:
+    """The Voronoi diagram of a set of points, with its cells clipped to a box or to a region.
 
     Parameters
     ----------
@@ -149,15 +149,22 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
         with conflict lists.
     seed : int
         Seed of the random insertion order.
+    clip : shapely Polygon or MultiPolygon, optional
+        A region (concave, with holes, in several parts): the diagram is
+        that of the points the region covers, each cell cut to the region,
+        so that the cells tile it. Points outside get no cell (None in
+        ``to_shapely``). The box defaults to the region's bounds grown by 1%;
+        a ``bbox`` that does not hold the region cuts it too.
 
     Returns
     -------
     Diagram
+        A :class:`tvoronoi.region.ClippedDiagram` (a Diagram) with ``clip``.
 
     Raises
     ------
     TvoronoiError
-        Bad points, box, engine or option.
+        Bad points, box, engine, option or region; no point inside the region.
 
     Examples
     --------
@@ -171,7 +178,15 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
         raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
     if insertion not in INSERTION_ORDERS:
         raise EngineError(f"unknown insertion order {insertion!r}: choose one of {', '.join(INSERTION_ORDERS)}")
-    box = default_bbox(pts) if bbox is None else as_bbox(bbox)
     from tvoronoi.build import build_diagram
 
+    if clip is not None:
+        from tvoronoi.region import as_region, clip_to_region, region_box
+
+        region = as_region(clip)
+        box = region_box(region) if bbox is None else as_bbox(bbox)
+        return clip_to_region(
+            pts, region, lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed)
+        )
+    box = default_bbox(pts) if bbox is None else as_bbox(bbox)
     return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed)

@@ -41,6 +41,13 @@ output:
   replaced. Character devices (/dev/null), named pipes, /dev/stdout and "-"
   are written directly, with or without --force, and never replaced.
 
+  --clip FILE cuts the cells to the union of the Polygons and MultiPolygons
+  of a GeoJSON file (in the coordinates of the points): only the sites the
+  region covers get cells, which tile the region; a site outside it is
+  written with "geometry": null (a warning gives their count). --lloyd N
+  first moves every site N times to the centroid of its cell (within the
+  box, or the clip region) and writes the cells of the moved sites.
+
   A progress display appears on stderr for inputs of 200,000 points or more
   when stderr is a terminal and -q is not given.
 
@@ -138,6 +145,10 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--bbox", metavar="XMIN,YMIN,XMAX,YMAX",
                        help="the box bounding the cells; default: the points' bounding box grown by 10%% "
                             "of its larger side on every side")
+    batch.add_argument("--clip", metavar="FILE",
+                       help="cut the cells to the (Multi)Polygons of a GeoJSON file; sites outside get no cell")
+    batch.add_argument("--lloyd", type=int, metavar="N",
+                       help="Lloyd relaxation: move each site to its cell's centroid N times, then write the cells")
     batch.add_argument("--delaunay", metavar="FILE",
                        help='also write the Delaunay triangles as GeoJSON ("-" for stdout)')
     batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
@@ -266,9 +277,18 @@ def _batch_run(args, phases: Phases) -> int:
         from tvoronoi.writers.geoparquet import require_pyarrow
 
         require_pyarrow()
+    if args.lloyd is not None and args.lloyd < 0:
+        raise TvoronoiError(f"--lloyd {args.lloyd}: give a number of iterations, 0 or more")
     options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
     # the engine and its options pass the API's own checks before a large file is read
     voronoi(np.empty((0, 2)), **options)
+    region = None
+    if args.clip is not None:
+        from tvoronoi.readers.clip_region import read_region
+        from tvoronoi.region import as_region
+
+        region = as_region(read_region(args.clip), what=f"--clip {args.clip}")
+        options["clip"] = region
 
     outputs = {}
     try:
@@ -293,14 +313,23 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{', '.join(geojson_out)}: RFC 7946 GeoJSON has no CRS and is read as lon/lat, but the "
                 f"coordinates are {crs_name(crs)}; write GeoParquet (.parquet) to keep the CRS"
             )
-        if bbox is None and lonlat:
+        if bbox is None and lonlat and region is None:
             # lon/lat: the default box stops at the antimeridian and the poles
             options["bbox"] = _lonlat_box(points.xy)
         if len(points) >= PROGRESS_MIN_POINTS:
             phases.show()
+        xy = points.xy
+        if args.lloyd:
+            from tvoronoi.relax import lloyd
+
+            with phases.phase(f"lloyd x{args.lloyd}"):
+                try:
+                    xy = lloyd(xy, args.lloyd, **options)
+                except CoordinateRangeError as e:
+                    raise TvoronoiError(f"{points.source}, {e.explain(points.place)}") from None
         with phases.phase("build") as done:
             try:
-                diagram = voronoi(points.xy, **options)
+                diagram = voronoi(xy, **options)
             except CoordinateRangeError as e:
                 raise TvoronoiError(f"{points.source}, {e.explain(points.place)}") from None
             done(f"{len(diagram.triangles):,} triangles")
@@ -311,7 +340,11 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{repeats} repeated point{'s share' if repeats > 1 else ' shares'} the cell of an earlier "
                 f'point (see "duplicates" in the output)'
             )
-        missing = len(missing_cells(diagram))
+        outside = diagram.n_outside if region is not None else 0
+        if outside and not args.quiet:
+            which = "sites lie" if outside > 1 else "site lies"
+            phases.warn(f'{outside} {which} outside the --clip region {args.clip}: written with "geometry": null')
+        missing = len(missing_cells(diagram)) - outside
         if missing and not args.quiet:
             which = "cells miss the box (their sites lie" if missing > 1 else "cell misses the box (its site lies"
             phases.warn(f'{missing} {which} outside --bbox): written with "geometry": null')

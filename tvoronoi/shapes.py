@@ -94,4 +94,4 @@ def cells_frame(diagram, properties=None, crs=None):
         raise TvoronoiError(f"properties may not have a column named {taken[0]!r}: tvoronoi writes it; rename it")
     columns = columns.reset_index(drop=True)
     columns.insert(0, "site", np.arange(n, dtype=np.int64))
-    return geopandas.GeoDataFrame(columns, geometry=geopandas.array.from_shapely(cell_polygons(diagram)), crs=crs)
+    return geopandas.GeoDataFrame(columns, geometry=geopandas.array.from_shapely(diagram.to_shapely()), crs=crs)

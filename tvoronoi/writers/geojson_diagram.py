@@ -28,6 +28,7 @@ _CLOSE_BRACKET = ord("]")
 # one feature per line; %b are the ring's positions "[x,y],...,[x,y]" and the properties object
 _POLYGON = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":%b}'
 _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
+_GEOMETRY = b'{"type":"Feature","geometry":%b,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
 # GeoJSON text sequences (RFC 8142): each feature opens with a record separator and ends a line
@@ -119,6 +120,43 @@ def closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray,
     return np.take(diagram.cell_points, index, axis=0), starts + shift, stops + shift
 
 
+def cut_geometries(diagram, rows: np.ndarray, precision: int | None = None) -> list[bytes]:
+    """GeoJSON geometries of the cells of ``rows`` that a clip region cut (see ClippedDiagram.reshaped).
+
+    A few cells per chunk cross the region's boundary, so each is written from its shapely geometry.
+    """
+    import shapely
+
+    geoms = diagram.clipped[rows]
+    if precision is not None:
+        geoms = shapely.transform(geoms, lambda xy: np.round(xy, precision))
+    return [orjson.dumps(g.__geo_interface__) for g in geoms]
+
+
+def ring_rows(diagram) -> tuple[np.ndarray, np.ndarray]:
+    """(ring, cut): rows of distinct sites written from their CSR ring, and rows written from a cut geometry.
+
+    Rows in neither are written with a null geometry.
+    """
+    distinct = diagram.site_of == np.arange(diagram.n_sites)
+    ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
+    reshaped = getattr(diagram, "reshaped", None)
+    if reshaped is None:
+        return ring, np.zeros(diagram.n_sites, bool)
+    cut = distinct & reshaped & (diagram.clipped != None)  # noqa: E711 (elementwise)
+    return ring & ~reshaped, cut
+
+
+def cells_extent(diagram) -> np.ndarray:
+    """(xmin, ymin, xmax, ymax) of the written cells: the box, or the bounds of the cells cut to a region."""
+    clipped = getattr(diagram, "clipped", None)
+    if clipped is None:
+        return np.asarray(diagram.bbox, np.float64)
+    import shapely
+
+    return shapely.total_bounds(clipped)
+
+
 def missing_cells(diagram) -> np.ndarray:
     """Rows of distinct sites whose cell misses the box (they are written with ``"geometry": null``).
 
@@ -206,6 +244,11 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     last key only where the site repeats. A site property named "site" or
     "duplicates" is kept as "site_2" / "duplicates_2".
 
+    A diagram clipped to a region (``voronoi(..., clip=...)``) writes its
+    cells cut to the region: a Polygon (with holes) or a MultiPolygon
+    where a cell crosses the region's boundary, ``"geometry": null`` for a
+    site outside the region.
+
     A cell that misses the box (only possible with a box that leaves its
     site outside) has ``"geometry": null``, which RFC 7946 (section 3.2)
     allows for an unlocated feature; see :func:`missing_cells`.
@@ -249,11 +292,11 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     n_sites = diagram.n_sites
     rows = np.arange(n_sites)
     distinct = diagram.site_of == rows
-    has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
+    has_ring, has_cut = ring_rows(diagram)
     total = int(distinct.sum())
     done = 0
     with open_output(out, overwrite=overwrite) as stream, gc_paused():
-        bbox = _bbox_member(_rounded(np.asarray(diagram.bbox, np.float64), precision)) if has_ring.any() else b""
+        bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
         frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)
@@ -264,12 +307,16 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
             xy, first, last = closed_rings(diagram, a, b, keep)
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
+            cut = iter(cut_geometries(diagram, rows[a:b][has_cut[a:b]], precision) if has_cut[a:b].any() else ())
             features = []
-            for i, ring in zip(rows[a:b][distinct[a:b]].tolist(), keep[distinct[a:b]].tolist()):
+            chunk = distinct[a:b]
+            for i, ring, is_cut in zip(rows[a:b][chunk].tolist(), keep[chunk].tolist(), has_cut[a:b][chunk].tolist()):
                 if ring:
                     start, stop = next(spans)
                     features.append(_POLYGON % (text[start:stop], properties(i)))
-                else:  # a cell that misses the box
+                elif is_cut:  # a cell cut by a clip region
+                    features.append(_GEOMETRY % (next(cut), properties(i)))
+                else:  # a cell that misses the box, or a site outside a clip region
                     features.append(_NULL % properties(i))
             if not features:
                 continue

@@ -184,6 +184,23 @@ def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray)
     return wkb, bbox, extent
 
 
+def _shapely_cells(pa, geoms: np.ndarray):
+    """WKB and bbox columns, the extent and the geometry types of shapely cells (None: a null row)."""
+    import shapely
+
+    present = geoms != None  # noqa: E711 (elementwise)
+    wkb = pa.array(shapely.to_wkb(geoms), pa.binary())
+    bounds = shapely.bounds(geoms)
+    mask = ~present
+    bbox = pa.StructArray.from_arrays(
+        [pa.array(bounds[:, k], pa.float64(), mask=mask) for k in range(4)], names=["xmin", "ymin", "xmax", "ymax"],
+    )
+    extent = [float(v) for v in shapely.total_bounds(geoms)] if present.any() else None
+    names = {shapely.GeometryType.POLYGON: "Polygon", shapely.GeometryType.MULTIPOLYGON: "MultiPolygon"}
+    types = sorted({names[int(t)] for t in np.unique(shapely.get_type_id(geoms[present]))})
+    return wkb, bbox, extent, types
+
+
 def _write(pa, table, out, overwrite: bool) -> None:
     import pyarrow.parquet as pq
 
@@ -221,9 +238,14 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     rows = np.arange(n_sites)
     distinct = diagram.site_of == rows
     has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
-    xy, first, last = closed_rings(diagram, 0, n_sites, has_ring)
-    ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
-    geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(xy), ring_offsets, has_ring[distinct])
+    types = ["Polygon"]
+    if getattr(diagram, "clipped", None) is not None:
+        # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
+        geometry, bbox, extent, types = _shapely_cells(pa, diagram.clipped[distinct])
+    else:
+        xy, first, last = closed_rings(diagram, 0, n_sites, has_ring)
+        ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
+        geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(xy), ring_offsets, has_ring[distinct])
     kept = rows[distinct]
     columns = {"site": pa.array(kept, pa.int64())}
     if points is not None:
@@ -244,7 +266,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     columns["duplicates"] = pa.array([repeats.get(i) for i in kept.tolist()], pa.list_(pa.int64()))
     columns["geometry"] = geometry
     columns["bbox"] = bbox
-    table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
+    table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, types, crs)})
     _write(pa, table, out, overwrite)
     return len(kept)
 
