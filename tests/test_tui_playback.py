@@ -376,13 +376,13 @@ def test_snapshot_fortune_step(snap_compare):
     """Fortune's sweep at step 352 of 882: the cells behind the beach line filled, the
     sweep line, the beach line's arcs below it, pending circle events, growing edges
     dashed, the new vertex highlighted, the sites not reached dimmed; the timeline
-    and the status line saying what the step did."""
+    and the status line saying what the step did. The view does not follow (f): the whole box."""
 
     async def to_step(pilot):
         pilot.app.query_one("#engine", Select).value = "fortune"
         await pilot.pause()
         pilot.app.canvas.focus()
-        await pilot.press("t", *["right_square_bracket"] * 4)
+        await pilot.press("t", "f", *["right_square_bracket"] * 4)
 
     assert snap_compare(make_app(), run_before=to_step, terminal_size=SIZE)
 
@@ -390,5 +390,130 @@ def test_snapshot_fortune_step(snap_compare):
 def test_snapshot_incremental_step(snap_compare):
     """The incremental engine after 150 insertions: the new site highlighted, its conflict
     region (the destroyed Delaunay triangles) outlined and filled, the cells it took
-    area from tinted, the sites still to come dimmed."""
-    assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)
+    area from tinted, the sites still to come dimmed. The view does not follow (f): the whole box."""
+    assert snap_compare(make_app(), press=["t", "f", *["right_square_bracket"] * 5], terminal_size=SIZE)
+
+
+# -- the view follows the events ---------------------------------------------
+
+
+def world_box(app):
+    """The world box the canvas shows now."""
+    width, height = app.canvas.content_size
+    x0, y1 = app.canvas.world_at(-0.5, -0.5)
+    x1, y0 = app.canvas.world_at(width - 0.5, height - 0.5)
+    return x0, y0, x1, y1
+
+
+def shows(app, x, y) -> bool:
+    x0, y0, x1, y1 = world_box(app)
+    return x0 <= x <= x1 and y0 <= y <= y1
+
+
+async def step_until(app, pilot, kind, limit=400):
+    """Step on until the step shown is of ``kind`` (Fortune)."""
+    for _ in range(limit):
+        await pilot.press("full_stop")
+        if app.player.step.kind == kind:
+            return app.player.step
+    raise AssertionError(f"no {kind} event")
+
+
+@pilot_test
+async def test_follow_zooms_to_a_site_event_and_its_arcs():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        assert app.follow and app.timeline.following
+        assert "follow" in app.timeline.render().plain
+        await pilot.press(*["full_stop"] * 40)
+        step = await step_until(app, pilot, "site")
+        assert app.canvas.zoom() > 1.5  # zoomed in on the event
+        assert shows(app, *step.position)
+        # the point where it splits the arc it hit is in view too
+        k = int(np.flatnonzero(step.beach == step.site)[0])
+        assert shows(app, step.position[0], step.breakpoints[k - 1][1])
+
+
+@pilot_test
+async def test_follow_shows_the_whole_circle_of_a_circle_event():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 40)
+        step = await step_until(app, pilot, "circle")
+        vx, vy = step.vertex
+        r = step.sweep_y - vy
+        for x, y in ((vx - r, vy), (vx + r, vy), (vx, vy - r), (vx, vy + r)):
+            assert shows(app, x, y)
+        assert app.canvas.zoom() > 1.5
+
+
+@pilot_test
+async def test_follow_shows_the_cavity_of_an_insertion():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press(*["full_stop"] * 150)
+        step = player.step
+        assert len(step.conflict)
+        for x, y in player.points[step.conflict.ravel()]:
+            assert shows(app, x, y)
+        assert app.canvas.zoom() > 1.5
+
+
+@pilot_test
+async def test_follow_never_zooms_to_a_point():
+    from tvoronoi.tui.follow import MIN_SPACINGS, focus_box
+
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        for k in range(1, player.n_steps, 37):
+            x0, y0, x1, y1 = focus_box(player.trace.step(k), player.points, player.bbox)
+            spacing = (1.0 / len(player.points)) ** 0.5  # the unit box, about
+            assert min(x1 - x0, y1 - y0) >= 0.9 * MIN_SPACINGS * spacing
+
+
+@pilot_test
+async def test_f_stops_following_and_the_view_stays():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        await pilot.press("f")
+        assert not app.follow and not app.timeline.following
+        assert "follow" not in app.timeline.render().plain
+        view = app.canvas.view
+        await pilot.press(*["full_stop"] * 60)
+        assert player.index == 60 and app.canvas.view == view
+        step = await step_until(app, pilot, "site")
+        assert app.canvas.view == view
+        await pilot.press("f")  # on again: straight to the current event
+        assert app.follow and app.canvas.zoom() > 1.5 and shows(app, *step.position)
+
+
+@pilot_test
+async def test_panning_during_follow_turns_it_off_and_the_view_stays():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 30)
+        await pilot.press("minus")
+        assert not app.follow
+        view = app.canvas.view
+        await pilot.press(*["full_stop"] * 30)
+        assert app.canvas.view == view
+
+
+@pilot_test
+async def test_leaving_playback_gives_back_the_view_before_it():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("plus")
+        view = app.canvas.view
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 50)
+        assert app.canvas.view != view
+        await pilot.press("t")
+        assert app.canvas.view == view

@@ -17,6 +17,7 @@ from textual.binding import Binding
 from textual.message import Message
 
 import tvoronoi
+from tvoronoi.tui.follow import focus_box
 from tvoronoi.tui.overlay import fortune_picture, incremental_picture
 from tvoronoi.tui.timeline import Timeline
 
@@ -43,6 +44,7 @@ BINDINGS = [
     Binding("end", "step_to('end')", "End", show=False),
     Binding("left_square_bracket,shift+left", "jump(-1)", "-10%", key_display="[", show=False),
     Binding("right_square_bracket,shift+right", "jump(1)", "+10%", key_display="]", show=False),
+    Binding("f", "toggle_follow", "Follow"),
     Binding("less_than_sign", "speed(-1)", "Slower", key_display="<", show=False),
     Binding("greater_than_sign", "speed(1)", "Faster", key_display=">", show=False),
 ]
@@ -58,11 +60,12 @@ HELP = {
     "jump(1)": "playback: on 10% of the steps",
     "speed(-1)": "playback: slower",
     "speed(1)": "playback: faster",
+    "toggle_follow": "playback: the view follows the events (on / off)",
 }
 
 # The actions that only make sense during playback, and those that wait until it ends
 # (which also leaves room in the footer for the playback keys).
-PLAYBACK_ACTIONS = {"play_pause", "step", "step_to", "jump", "speed"}
+PLAYBACK_ACTIONS = {"play_pause", "step", "step_to", "jump", "speed", "toggle_follow"}
 PAUSED_ACTIONS = {"generate", "open", "save"}
 
 
@@ -87,6 +90,7 @@ class Player:
         self.speed = DEFAULT_SPEED
         self.carry = 0.0        # steps due but not taken (a fraction)
         self.last_tick: float | None = None
+        self.view_before = None  # the canvas's view and whether it was fitted, before playback
 
     def picture(self, k: int):
         """The step k with its scene and overlay (any thread)."""
@@ -114,6 +118,8 @@ class PlaybackMixin:
     # the time source of playback (tests put a fake one here)
     playback_clock = staticmethod(time.monotonic)
     _play_timer = None
+    # whether the view follows the events (kept from one playback to the next)
+    follow = True
 
     @property
     def timeline(self) -> Timeline:
@@ -147,11 +153,13 @@ class PlaybackMixin:
             self.finish_editing()  # playback replays the sites as they are now
         built = self.built
         self.player = Player(built.points, built.diagram.engine, built.scene.colours, built.diagram.bbox)
+        self.player.view_before = (self.canvas.view, self.canvas.fitted)
         timeline = self.timeline
         timeline.n_steps = self.player.n_steps
         timeline.engine = self.player.engine
         timeline.speed = self.player.speed
         timeline.playing = False
+        timeline.following = self.follow
         timeline.display = True
         self.canvas.editable = False
         self._play_timer = self.set_interval(1 / TICK_HZ, self._playback_tick)
@@ -163,7 +171,10 @@ class PlaybackMixin:
         """Leave playback; the built diagram comes back with the view as it is."""
         if self.player is None:
             return
-        self.player = None
+        player, self.player = self.player, None
+        if self.follow:
+            # the view the user had, not the one that followed the last event
+            self.canvas.view, self.canvas.fitted = player.view_before
         if self._play_timer is not None:
             self._play_timer.stop()
             self._play_timer = None
@@ -206,7 +217,16 @@ class PlaybackMixin:
         step, scene, overlay = picture
         self.player.step = step
         self.canvas.show_scene(scene, fit=False, overlay=overlay)
+        if self.follow:
+            self._follow_step(step)
         self._set_status(step.describe())
+
+    def _follow_step(self, step) -> None:
+        """Move the view to the region of the step's event, unless it shows it well already."""
+        player = self.player
+        box = focus_box(step, player.points, player.bbox)
+        if box is not None:
+            self.canvas.follow(box)
 
     def _playback_tick(self) -> None:
         player = self.player
@@ -261,6 +281,23 @@ class PlaybackMixin:
         at = min(range(len(SPEEDS)), key=lambda i: abs(SPEEDS[i] - player.speed))
         player.speed = SPEEDS[min(max(at + direction, 0), len(SPEEDS) - 1)]
         self.timeline.speed = player.speed
+
+    def action_toggle_follow(self) -> None:
+        """Let the view follow the events, or stay where it is."""
+        self._set_follow(not self.follow)
+        if self.follow and self.player.step is not None:
+            self._follow_step(self.player.step)
+
+    def _set_follow(self, follow: bool) -> None:
+        self.follow = follow
+        self.timeline.following = follow
+
+    def on_diagram_canvas_view_changed(self) -> None:
+        # the user moved the view: it stays where they put it
+        if self.player is not None and self.follow:
+            self._set_follow(False)
+            self.notify("the view stays where you put it; f follows the events again",
+                        title="Follow off", timeout=4)
 
     def on_timeline_scrubbed(self, message: Timeline.Scrubbed) -> None:
         if self.player is not None:
