@@ -6,7 +6,7 @@ from textual.widgets import Select
 from textual.widgets._toast import Toast
 
 import tvoronoi
-from test_tui import SIZE, error_toasts, make_app, pilot_test, status_text
+from test_tui import SIZE, error_toasts, footer_keys, make_app, pilot_test, status_text
 from tvoronoi.generators import generate
 from tvoronoi.tui import playback
 from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
@@ -376,7 +376,8 @@ def test_snapshot_fortune_step(snap_compare):
     """Fortune's sweep at step 352 of 882: the cells behind the beach line filled, the
     sweep line, the beach line's arcs below it, pending circle events, growing edges
     dashed, the new vertex highlighted, the sites not reached dimmed; the timeline
-    and the status line saying what the step did. The view does not follow (f): the whole box."""
+    and the status line saying what the step did; the panel shows the engine's state. The view
+    does not follow (f; the timeline says "f: fixed"): the whole box."""
 
     async def to_step(pilot):
         pilot.app.query_one("#engine", Select).value = "fortune"
@@ -390,7 +391,8 @@ def test_snapshot_fortune_step(snap_compare):
 def test_snapshot_incremental_step(snap_compare):
     """The incremental engine after 150 insertions: the new site highlighted, its conflict
     region (the destroyed Delaunay triangles) outlined and filled, the cells it took
-    area from tinted, the sites still to come dimmed. The view does not follow (f): the whole box."""
+    area from tinted, the sites still to come dimmed; the panel shows the engine's state. The
+    view does not follow (f; the timeline says "f: fixed"): the whole box."""
     assert snap_compare(make_app(), press=["t", "f", *["right_square_bracket"] * 5], terminal_size=SIZE)
 
 
@@ -425,7 +427,7 @@ async def test_follow_zooms_to_a_site_event_and_its_arcs():
     async with app.run_test(size=SIZE) as pilot:
         await start_playback(app, pilot, "fortune")
         assert app.follow and app.timeline.following
-        assert "follow" in app.timeline.render().plain
+        assert "f: follow" in app.timeline.render().plain
         await pilot.press(*["full_stop"] * 40)
         step = await step_until(app, pilot, "site")
         assert app.canvas.zoom() > 1.5  # zoomed in on the event
@@ -482,7 +484,7 @@ async def test_f_stops_following_and_the_view_stays():
         player = await start_playback(app, pilot, "fortune")
         await pilot.press("f")
         assert not app.follow and not app.timeline.following
-        assert "follow" not in app.timeline.render().plain
+        assert "f: fixed" in app.timeline.render().plain
         view = app.canvas.view
         await pilot.press(*["full_stop"] * 60)
         assert player.index == 60 and app.canvas.view == view
@@ -517,3 +519,144 @@ async def test_leaving_playback_gives_back_the_view_before_it():
         assert app.canvas.view != view
         await pilot.press("t")
         assert app.canvas.view == view
+
+
+# -- the legend and the engine's state in the panel ---------------------------
+
+
+def legend_shown(app) -> str:
+    legend = app.query_one("#legend")
+    return str(legend.render()) if legend.display else ""
+
+
+@pilot_test
+async def test_L_shows_the_legend_of_what_is_drawn_and_hides_it():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert legend_shown(app) == ""
+        assert "L" in footer_keys(app)
+        await pilot.press("L")
+        for words in ("cells", "Voronoi edges", "sites", "vertices", "Delaunay", "cursor"):
+            assert words in legend_shown(app)
+        await pilot.press("L")
+        assert legend_shown(app) == ""
+
+
+@pilot_test
+async def test_the_legend_follows_playback_of_each_engine():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("L")
+        await start_playback(app, pilot)
+        for words in ("the new site", "conflict triangles", "new Delaunay edges", "lost area", "sites to come"):
+            assert words in legend_shown(app)
+        assert "L" not in footer_keys(app)  # the playback keys need the room; L still works
+        await pilot.press("t")
+        await start_playback(app, pilot, "fortune")
+        for words in ("sweep line", "beach line", "circle events", "growing edges", "finished edges",
+                      "sites to come"):
+            assert words in legend_shown(app)
+        await pilot.press("L")
+        assert legend_shown(app) == ""
+        await pilot.press("t", "L")
+        assert "Voronoi edges" in legend_shown(app) and "sweep" not in legend_shown(app)
+
+
+@pilot_test
+async def test_L_on_a_narrow_terminal_shows_the_panel_with_the_legend():
+    app = make_app()
+    async with app.run_test(size=(60, 20)) as pilot:
+        await pilot.pause()
+        assert not app.query_one("#panel").display
+        await pilot.press("L")
+        assert app.query_one("#panel").display and "sites" in legend_shown(app)
+        assert app.canvas.has_focus
+
+
+def engine_state(app) -> str:
+    state = app.query_one("#playstate")
+    return str(state.render()) if state.display else ""
+
+
+@pilot_test
+async def test_the_panel_shows_fortunes_queue_beach_line_and_counts():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        assert engine_state(app) == ""
+        player = await start_playback(app, pilot, "fortune")
+        assert not app.query_one("#points-section").display  # new points wait until playback ends
+        await pilot.press("right_square_bracket", "right_square_bracket", "right_square_bracket")
+        step = player.step
+        text = engine_state(app)
+        assert "Next events" in text
+        assert f"Beach line: {len(step.beach)} arcs" in text
+        assert (f"▶ site {step.site}" if step.kind == "site" else f"✕ site {step.site}") in text
+        assert f"{len(step.vertices)} vertices" in text
+        assert f"{len(step.finished_edges)} edges, {len(step.growing_edges)} growing" in text
+        await step_until(app, pilot, "circle")  # the vanished arc is marked where it was
+        assert f"✕ site {player.step.site}" in engine_state(app)
+        await step_until(app, pilot, "site")
+        assert f"▶ site {player.step.site}" in engine_state(app)
+        await pilot.press("t")
+        assert engine_state(app) == "" and app.query_one("#points-section").display
+
+
+def test_the_next_events_listed_are_the_events_that_come():
+    from tvoronoi.tui.state import next_events
+
+    points = generate("uniform", 200, seed=3)
+    trace = tvoronoi.fortune_steps(points)
+    for k in range(0, len(trace), 7):
+        now, then = trace.step(k), trace.step(k + 1)
+        kind, x, y = next_events(now, points)[0]
+        assert kind == then.kind
+        if kind == "site":
+            assert (x, y) == then.position
+        else:
+            assert x == pytest.approx(then.vertex[0]) and y == pytest.approx(then.sweep_y)
+
+
+@pilot_test
+async def test_the_panel_shows_the_cavity_and_the_cells_that_lost_area():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press(*["full_stop"] * 150)
+        step = player.step
+        text = engine_state(app)
+        assert f"Site {step.site} inserted" in text and "150 of 300" in text
+        assert f"{len(step.conflict)} triangles in conflict" in text
+        assert f"Cells that lost area: {len(step.stolen_from)}" in text
+        assert str(step.stolen_from[0]) in text
+
+
+def test_snapshot_legend_of_the_diagram(snap_compare):
+    """L pressed on the start view: the panel's Legend section names each colour and mark of the
+    diagram (cells, Voronoi edges and the box, sites, vertices, Delaunay edges, the keyboard
+    cursor), each beside a swatch in its own colour; the footer names L."""
+    assert snap_compare(make_app(), press=["L"], terminal_size=SIZE)
+
+
+def test_snapshot_fortune_panel_following(snap_compare):
+    """Fortune's sweep at step 353 with the view following (the default): zoomed on the
+    event's region; the panel's Engine state lists the next events of the queue (site or
+    circle, where), the beach line's arcs about the current one (marked ▶) and the vertices
+    and edges so far; the timeline says "f: follow"."""
+
+    async def to_step(pilot):
+        pilot.app.query_one("#engine", Select).value = "fortune"
+        await pilot.pause()
+        pilot.app.canvas.focus()
+        await pilot.press("t", *["right_square_bracket"] * 4, "full_stop")
+
+    assert snap_compare(make_app(), run_before=to_step, terminal_size=SIZE)
+
+
+def test_snapshot_incremental_panel_following(snap_compare):
+    """The incremental engine after 150 insertions with the view following: zoomed on the new
+    site's cavity (the conflict triangles outlined and filled, the cells that lost area
+    tinted); the panel's Engine state names the site, the cavity's size, the ids of the
+    cells that lost area and the counts so far."""
+    assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)

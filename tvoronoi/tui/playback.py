@@ -15,10 +15,12 @@ import numpy as np
 from textual import work
 from textual.binding import Binding
 from textual.message import Message
+from textual.widgets import Static
 
 import tvoronoi
 from tvoronoi.tui.follow import focus_box
 from tvoronoi.tui.overlay import fortune_picture, incremental_picture
+from tvoronoi.tui.state import fortune_state, incremental_state
 from tvoronoi.tui.timeline import Timeline
 
 # Playback refuses larger point sets: a step of Fortune's sweep costs ~2 ms per
@@ -44,7 +46,8 @@ BINDINGS = [
     Binding("end", "step_to('end')", "End", show=False),
     Binding("left_square_bracket,shift+left", "jump(-1)", "-10%", key_display="[", show=False),
     Binding("right_square_bracket,shift+right", "jump(1)", "+10%", key_display="]", show=False),
-    Binding("f", "toggle_follow", "Follow"),
+    # the timeline says whether the view follows, and names f: the footer has no room at 80 columns
+    Binding("f", "toggle_follow", "Follow", show=False),
     Binding("less_than_sign", "speed(-1)", "Slower", key_display="<", show=False),
     Binding("greater_than_sign", "speed(1)", "Faster", key_display=">", show=False),
 ]
@@ -165,6 +168,8 @@ class PlaybackMixin:
         self._play_timer = self.set_interval(1 / TICK_HZ, self._playback_tick)
         self.refresh_bindings()
         self.inspect()  # hidden during playback
+        self._show_engine_state(True)
+        self.update_legend()
         self._goto(0)
 
     def stop_playback(self) -> None:
@@ -179,6 +184,7 @@ class PlaybackMixin:
             self._play_timer.stop()
             self._play_timer = None
         self.timeline.display = False
+        self._show_engine_state(False)
         self.canvas.editable = True
         if self.built is not None:
             self.canvas.show_scene(self.built.scene, fit=False)
@@ -219,7 +225,19 @@ class PlaybackMixin:
         self.canvas.show_scene(scene, fit=False, overlay=overlay)
         if self.follow:
             self._follow_step(step)
+        state = self.query_one("#playstate", Static)
+        if self.player.engine == "fortune":
+            state.update(fortune_state(step, self.player.points))
+        else:
+            state.update(incremental_state(step))
         self._set_status(step.describe())
+
+    def _show_engine_state(self, shown: bool) -> None:
+        """During playback the panel shows the engine's state where the point controls were
+        (new points wait until playback ends)."""
+        self.query_one("#points-section").display = not shown
+        for widget in self.query(".playstate"):
+            widget.display = shown
 
     def _follow_step(self, step) -> None:
         """Move the view to the region of the step's event, unless it shows it well already."""

@@ -12,6 +12,8 @@ from textual.widget import Widget
 # Words rather than symbols: the play and pause symbols are wide in some terminals.
 PLAYING, PAUSED = "playing", "paused "
 DONE, TODO, KNOB = "━", "─", "●"
+# Whether the view follows the events, and the key that changes it.
+FOLLOWING, FIXED = "f: follow", "f: fixed "
 
 
 class Timeline(Widget):
@@ -48,7 +50,7 @@ class Timeline(Widget):
     def _labels(self) -> tuple[str, str]:
         digits = len(f"{self.n_steps:,}")
         left = f" {PLAYING if self.playing else PAUSED} {self.engine} {self.index:>{digits},}/{self.n_steps:,} "
-        right = f" {'follow · ' if self.following else ''}{self.speed:g} steps/s "
+        right = f" {FOLLOWING if self.following else FIXED} · {self.speed:g} steps/s "
         return left, right
 
     def bar_span(self) -> tuple[int, int]:
