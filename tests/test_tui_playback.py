@@ -660,3 +660,48 @@ def test_snapshot_incremental_panel_following(snap_compare):
     tinted); the panel's Engine state names the site, the cavity's size, the ids of the
     cells that lost area and the counts so far."""
     assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)
+
+
+# -- circles far larger than the view -----------------------------------------
+
+
+def test_a_huge_circle_is_the_arc_that_enters_the_view():
+    # the view is the unit square; the circle's top pokes into it from far below
+    window = (0.0, 0.0, 1.0, 1.0)
+    r = 1e4
+    segs = circle_segments([[0.5, 0.5 - r, r]], scale=0.005, window=window)
+    assert len(segs)
+    ends = np.vstack([segs[:, :2], segs[:, 2:]])
+    assert (ends[:, 0] >= -1e-9).all() and (ends[:, 0] <= 1 + 1e-9).all()
+    assert (ends[:, 1] >= -1e-9).all() and (ends[:, 1] <= 1 + 1e-9).all()
+    # finely divided: each side about a dot and a half, so the arc is not a chord across the view
+    assert np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]).max() <= 0.01
+    assert np.allclose(np.hypot(ends[:, 0] - 0.5, ends[:, 1] - (0.5 - r)), r, rtol=1e-12)
+    # it runs from the left side of the view to the right
+    assert ends[:, 0].min() < 0.01 and ends[:, 0].max() > 0.99
+
+
+def test_circles_outside_the_view_or_around_it_draw_nothing():
+    window = (0.0, 0.0, 1.0, 1.0)
+    around = [0.5, 0.5, 5.0]      # holds the whole view
+    beside = [3.0, 0.5, 1.0]      # wholly to the right
+    assert len(circle_segments([around, beside], scale=0.005, window=window)) == 0
+    inside = [0.5, 0.5, 0.2]      # drawn whole, as without a window
+    assert np.array_equal(circle_segments([inside], 0.005, window), circle_segments([inside], 0.005))
+
+
+def test_a_circle_event_far_outside_the_box_draws_only_what_the_view_shows():
+    from tvoronoi.tui.raster import Painter
+
+    # three sites almost on a line: their circle is huge, its centre far outside the box
+    points = np.array([[0.0, 0.0], [0.5, 1e-4], [1.0, 0.0], [0.5, 1.0]])
+    trace = tvoronoi.fortune_steps(points)
+    step = next(s for s in (trace.step(k) for k in range(len(trace) + 1)) if len(s.circles))
+    assert step.circles[:, 2].max() > 100
+    view = View.fit((0, 0, 1, 1), 60, 20)
+    paint = Painter(view, 60, 20)
+    segs = circle_segments(step.circles, view.scale, paint.world)
+    x0, y0, x1, y1 = paint.world
+    assert len(segs) < 2000
+    assert (segs[:, [0, 2]] >= x0 - 1e-9).all() and (segs[:, [0, 2]] <= x1 + 1e-9).all()
+    assert (segs[:, [1, 3]] >= y0 - 1e-9).all() and (segs[:, [1, 3]] <= y1 + 1e-9).all()
