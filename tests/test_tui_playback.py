@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from textual.widgets import Select
+from textual.widgets import Button, Select
 from textual.widgets._toast import Toast
 
 import tvoronoi
@@ -11,6 +11,7 @@ from tvoronoi.generators import generate
 from tvoronoi.tui import playback
 from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
+from tvoronoi.tui.screens import SampleDialog
 from tvoronoi.tui.raster import (
     BEACH,
     CIRCLE,
@@ -235,16 +236,73 @@ async def test_playing_advances_in_real_time():
 
 
 @pilot_test
-async def test_too_many_sites_is_a_warning(monkeypatch):
+async def test_too_many_sites_to_play_all_offers_only_the_sample(monkeypatch):
     monkeypatch.setattr(playback, "PLAYBACK_MAX_SITES", 100)
     app = make_app()
     async with app.run_test(size=SIZE, notifications=True) as pilot:
         await pilot.pause()
         await pilot.press("t")
         await pilot.pause()
-        assert app.player is None
-        assert any("fewer points" in text for text in warning_toasts(app))
+        dialog = app.screen
+        assert isinstance(dialog, SampleDialog)
+        assert dialog.query_one("#all", Button).disabled
+        assert "up to 100 sites" in str(dialog.query_one("#dialog-hint").render())
+        await pilot.press("a")  # not offered: nothing happens
+        assert app.screen is dialog and app.player is None
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.player is None and app.canvas.has_focus
         assert not error_toasts(app)
+
+
+def many_points():
+    return generate("uniform", 800, seed=4)
+
+
+@pilot_test
+async def test_many_sites_offer_a_teaching_sample_of_the_same_points():
+    app = make_app(points=many_points())
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        await pilot.pause()
+        assert isinstance(app.screen, SampleDialog) and app.player is None
+        await pilot.press("s")
+        await pilot.pause()
+        player = app.player
+        assert player is not None and player.sample and app.canvas.has_focus
+        assert len(player.points) == playback.SAMPLE_SITES == player.n_steps
+        # a random subset of the points on screen, so spread as they are
+        rows = {tuple(p) for p in app.built.points}
+        assert all(tuple(p) in rows for p in player.points)
+        assert player.points[:, 1].min() < 0.3 and player.points[:, 1].max() > 0.7
+        assert "sample" in app.timeline.render().plain
+        await pilot.press("end")
+        assert app.player.step.diagram.n_sites == playback.SAMPLE_SITES
+        await pilot.press("t")  # back to the whole diagram
+        assert app.player is None and len(app.canvas.scene.sites) == 800
+
+
+@pilot_test
+async def test_many_sites_can_still_be_played_all():
+    app = make_app(points=many_points())
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        await pilot.pause()
+        await pilot.click("#all")
+        await pilot.pause()
+        assert app.player is not None and not app.player.sample
+        assert app.player.n_steps == 800
+
+
+@pilot_test
+async def test_a_few_hundred_sites_play_at_once():
+    app = make_app()  # 300 sites: the follow view makes them readable
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        assert app.player is not None and app.player.n_steps == 300
 
 
 @pilot_test

@@ -18,14 +18,19 @@ from textual.message import Message
 from textual.widgets import Static
 
 import tvoronoi
+from tvoronoi.tui.colours import cell_colours
 from tvoronoi.tui.follow import focus_box
 from tvoronoi.tui.overlay import fortune_picture, incremental_picture
+from tvoronoi.tui.screens import SampleDialog
 from tvoronoi.tui.state import fortune_state, incremental_state
 from tvoronoi.tui.timeline import Timeline
 
 # Playback refuses larger point sets: a step of Fortune's sweep costs ~2 ms per
 # 1,000 sites, and the picture is drawn on every step.
 PLAYBACK_MAX_SITES = 20_000
+# Above this many sites, playback offers a teaching-size sample first (all the sites stay a choice).
+TEACHING_MAX_SITES = 500
+SAMPLE_SITES = 30
 # From this many sites on, steps are computed in a worker thread.
 STEP_THREAD_MIN_SITES = 2_000
 # Steps per second to choose from with < and >.
@@ -93,6 +98,7 @@ class Player:
         self.speed = DEFAULT_SPEED
         self.carry = 0.0        # steps due but not taken (a fraction)
         self.last_tick: float | None = None
+        self.sample = False  # the points are a sample of the diagram's
         self.view_before = None  # the canvas's view and whether it was fitted, before playback
 
     def picture(self, k: int):
@@ -103,6 +109,14 @@ class Player:
         else:
             scene, overlay = incremental_picture(step, self.points, self.colours)
         return step, scene, overlay
+
+
+def sample_of(points: np.ndarray, size: int) -> np.ndarray:
+    """``size`` of the points picked at random (the same ones for the same points), in their order:
+    they are spread as the points are."""
+    points = np.asarray(points, np.float64)
+    rng = np.random.default_rng(len(points))
+    return points[np.sort(rng.choice(len(points), size=min(size, len(points)), replace=False))]
 
 
 class StepReady(Message):
@@ -145,21 +159,36 @@ class PlaybackMixin:
         if self.built is None:
             return
         n = self.live.n_sites if self.live is not None else len(self.built.points)
-        if n > PLAYBACK_MAX_SITES:
-            self.notify(
-                f"playback takes up to {PLAYBACK_MAX_SITES:,} sites and this diagram has {n:,}: "
-                "generate fewer points to watch the engine work",
-                title="Too many sites", severity="warning", timeout=8,
-            )
+        if n > TEACHING_MAX_SITES or n > PLAYBACK_MAX_SITES:
+            allowed = n <= PLAYBACK_MAX_SITES
+            why = "" if allowed else (f"Playback takes up to {PLAYBACK_MAX_SITES:,} sites: "
+                                      "a sample, or generate fewer points · Esc to cancel")
+            self.push_screen(SampleDialog(n, SAMPLE_SITES, all_allowed=allowed, why=why), self._playback_chosen)
             return
+        self._start_playback()
+
+    def _playback_chosen(self, choice: str | None) -> None:
+        self.canvas.focus()
+        if choice is not None and self.player is None:
+            self._start_playback(sample=choice == "sample")
+
+    def _start_playback(self, *, sample: bool = False) -> None:
+        """Play the engine on the sites as they are now, or on a random sample of them."""
         if self.live is not None:
             self.finish_editing()  # playback replays the sites as they are now
         built = self.built
-        self.player = Player(built.points, built.diagram.engine, built.scene.colours, built.diagram.bbox)
+        engine, bbox = built.diagram.engine, built.diagram.bbox
+        if sample:
+            points = sample_of(built.points, SAMPLE_SITES)
+            colours = cell_colours(tvoronoi.voronoi(points, engine=engine, bbox=bbox))
+        else:
+            points, colours = built.points, built.scene.colours
+        self.player = Player(points, engine, colours, bbox)
+        self.player.sample = sample
         self.player.view_before = (self.canvas.view, self.canvas.fitted)
         timeline = self.timeline
         timeline.n_steps = self.player.n_steps
-        timeline.engine = self.player.engine
+        timeline.engine = f"{self.player.engine} sample" if sample else self.player.engine
         timeline.speed = self.player.speed
         timeline.playing = False
         timeline.following = self.follow
