@@ -2,15 +2,16 @@
 
 import numpy as np
 import pytest
-from textual.widgets import Select
+from textual.widgets import Button, Select
 from textual.widgets._toast import Toast
 
 import tvoronoi
-from test_tui import SIZE, error_toasts, make_app, pilot_test, status_text
+from test_tui import SIZE, error_toasts, footer_keys, make_app, pilot_test, status_text
 from tvoronoi.generators import generate
 from tvoronoi.tui import playback
 from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
+from tvoronoi.tui.screens import SampleDialog
 from tvoronoi.tui.raster import (
     BEACH,
     CIRCLE,
@@ -235,16 +236,73 @@ async def test_playing_advances_in_real_time():
 
 
 @pilot_test
-async def test_too_many_sites_is_a_warning(monkeypatch):
+async def test_too_many_sites_to_play_all_offers_only_the_sample(monkeypatch):
     monkeypatch.setattr(playback, "PLAYBACK_MAX_SITES", 100)
     app = make_app()
     async with app.run_test(size=SIZE, notifications=True) as pilot:
         await pilot.pause()
         await pilot.press("t")
         await pilot.pause()
-        assert app.player is None
-        assert any("fewer points" in text for text in warning_toasts(app))
+        dialog = app.screen
+        assert isinstance(dialog, SampleDialog)
+        assert dialog.query_one("#all", Button).disabled
+        assert "up to 100 sites" in str(dialog.query_one("#dialog-hint").render())
+        await pilot.press("a")  # not offered: nothing happens
+        assert app.screen is dialog and app.player is None
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.player is None and app.canvas.has_focus
         assert not error_toasts(app)
+
+
+def many_points():
+    return generate("uniform", 800, seed=4)
+
+
+@pilot_test
+async def test_many_sites_offer_a_teaching_sample_of_the_same_points():
+    app = make_app(points=many_points())
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        await pilot.pause()
+        assert isinstance(app.screen, SampleDialog) and app.player is None
+        await pilot.press("s")
+        await pilot.pause()
+        player = app.player
+        assert player is not None and player.sample and app.canvas.has_focus
+        assert len(player.points) == playback.SAMPLE_SITES == player.n_steps
+        # a random subset of the points on screen, so spread as they are
+        rows = {tuple(p) for p in app.built.points}
+        assert all(tuple(p) in rows for p in player.points)
+        assert player.points[:, 1].min() < 0.3 and player.points[:, 1].max() > 0.7
+        assert "sample" in app.timeline.render().plain
+        await pilot.press("end")
+        assert app.player.step.diagram.n_sites == playback.SAMPLE_SITES
+        await pilot.press("t")  # back to the whole diagram
+        assert app.player is None and len(app.canvas.scene.sites) == 800
+
+
+@pilot_test
+async def test_many_sites_can_still_be_played_all():
+    app = make_app(points=many_points())
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        await pilot.pause()
+        await pilot.click("#all")
+        await pilot.pause()
+        assert app.player is not None and not app.player.sample
+        assert app.player.n_steps == 800
+
+
+@pilot_test
+async def test_a_few_hundred_sites_play_at_once():
+    app = make_app()  # 300 sites: the follow view makes them readable
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("t")
+        assert app.player is not None and app.player.n_steps == 300
 
 
 @pilot_test
@@ -376,13 +434,14 @@ def test_snapshot_fortune_step(snap_compare):
     """Fortune's sweep at step 352 of 882: the cells behind the beach line filled, the
     sweep line, the beach line's arcs below it, pending circle events, growing edges
     dashed, the new vertex highlighted, the sites not reached dimmed; the timeline
-    and the status line saying what the step did."""
+    and the status line saying what the step did; the panel shows the engine's state. The view
+    does not follow (f; the timeline says "f: fixed"): the whole box."""
 
     async def to_step(pilot):
         pilot.app.query_one("#engine", Select).value = "fortune"
         await pilot.pause()
         pilot.app.canvas.focus()
-        await pilot.press("t", *["right_square_bracket"] * 4)
+        await pilot.press("t", "f", *["right_square_bracket"] * 4)
 
     assert snap_compare(make_app(), run_before=to_step, terminal_size=SIZE)
 
@@ -390,5 +449,317 @@ def test_snapshot_fortune_step(snap_compare):
 def test_snapshot_incremental_step(snap_compare):
     """The incremental engine after 150 insertions: the new site highlighted, its conflict
     region (the destroyed Delaunay triangles) outlined and filled, the cells it took
-    area from tinted, the sites still to come dimmed."""
+    area from tinted, the sites still to come dimmed; the panel shows the engine's state. The
+    view does not follow (f; the timeline says "f: fixed"): the whole box."""
+    assert snap_compare(make_app(), press=["t", "f", *["right_square_bracket"] * 5], terminal_size=SIZE)
+
+
+# -- the view follows the events ---------------------------------------------
+
+
+def world_box(app):
+    """The world box the canvas shows now."""
+    width, height = app.canvas.content_size
+    x0, y1 = app.canvas.world_at(-0.5, -0.5)
+    x1, y0 = app.canvas.world_at(width - 0.5, height - 0.5)
+    return x0, y0, x1, y1
+
+
+def shows(app, x, y) -> bool:
+    x0, y0, x1, y1 = world_box(app)
+    return x0 <= x <= x1 and y0 <= y <= y1
+
+
+async def step_until(app, pilot, kind, limit=400):
+    """Step on until the step shown is of ``kind`` (Fortune)."""
+    for _ in range(limit):
+        await pilot.press("full_stop")
+        if app.player.step.kind == kind:
+            return app.player.step
+    raise AssertionError(f"no {kind} event")
+
+
+@pilot_test
+async def test_follow_zooms_to_a_site_event_and_its_arcs():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        assert app.follow and app.timeline.following
+        assert "f: follow" in app.timeline.render().plain
+        await pilot.press(*["full_stop"] * 40)
+        step = await step_until(app, pilot, "site")
+        assert app.canvas.zoom() > 1.5  # zoomed in on the event
+        assert shows(app, *step.position)
+        # the point where it splits the arc it hit is in view too
+        k = int(np.flatnonzero(step.beach == step.site)[0])
+        assert shows(app, step.position[0], step.breakpoints[k - 1][1])
+
+
+@pilot_test
+async def test_follow_shows_the_whole_circle_of_a_circle_event():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 40)
+        step = await step_until(app, pilot, "circle")
+        vx, vy = step.vertex
+        r = step.sweep_y - vy
+        for x, y in ((vx - r, vy), (vx + r, vy), (vx, vy - r), (vx, vy + r)):
+            assert shows(app, x, y)
+        assert app.canvas.zoom() > 1.5
+
+
+@pilot_test
+async def test_follow_shows_the_cavity_of_an_insertion():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press(*["full_stop"] * 150)
+        step = player.step
+        assert len(step.conflict)
+        for x, y in player.points[step.conflict.ravel()]:
+            assert shows(app, x, y)
+        assert app.canvas.zoom() > 1.5
+
+
+@pilot_test
+async def test_follow_never_zooms_to_a_point():
+    from tvoronoi.tui.follow import MIN_SPACINGS, focus_box
+
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        for k in range(1, player.n_steps, 37):
+            x0, y0, x1, y1 = focus_box(player.trace.step(k), player.points, player.bbox)
+            spacing = (1.0 / len(player.points)) ** 0.5  # the unit box, about
+            assert min(x1 - x0, y1 - y0) >= 0.9 * MIN_SPACINGS * spacing
+
+
+@pilot_test
+async def test_f_stops_following_and_the_view_stays():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot, "fortune")
+        await pilot.press("f")
+        assert not app.follow and not app.timeline.following
+        assert "f: fixed" in app.timeline.render().plain
+        view = app.canvas.view
+        await pilot.press(*["full_stop"] * 60)
+        assert player.index == 60 and app.canvas.view == view
+        step = await step_until(app, pilot, "site")
+        assert app.canvas.view == view
+        await pilot.press("f")  # on again: straight to the current event
+        assert app.follow and app.canvas.zoom() > 1.5 and shows(app, *step.position)
+
+
+@pilot_test
+async def test_panning_during_follow_turns_it_off_and_the_view_stays():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 30)
+        await pilot.press("minus")
+        assert not app.follow
+        view = app.canvas.view
+        await pilot.press(*["full_stop"] * 30)
+        assert app.canvas.view == view
+
+
+@pilot_test
+async def test_leaving_playback_gives_back_the_view_before_it():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("plus")
+        view = app.canvas.view
+        await start_playback(app, pilot, "fortune")
+        await pilot.press(*["full_stop"] * 50)
+        assert app.canvas.view != view
+        await pilot.press("t")
+        assert app.canvas.view == view
+
+
+# -- the legend and the engine's state in the panel ---------------------------
+
+
+def legend_shown(app) -> str:
+    legend = app.query_one("#legend")
+    return str(legend.render()) if legend.display else ""
+
+
+@pilot_test
+async def test_L_shows_the_legend_of_what_is_drawn_and_hides_it():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert legend_shown(app) == ""
+        assert "L" in footer_keys(app)
+        await pilot.press("L")
+        for words in ("cells", "Voronoi edges", "sites", "vertices", "Delaunay", "cursor"):
+            assert words in legend_shown(app)
+        await pilot.press("L")
+        assert legend_shown(app) == ""
+
+
+@pilot_test
+async def test_the_legend_follows_playback_of_each_engine():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("L")
+        await start_playback(app, pilot)
+        for words in ("the new site", "conflict triangles", "new Delaunay edges", "lost area", "sites to come"):
+            assert words in legend_shown(app)
+        assert "L" not in footer_keys(app)  # the playback keys need the room; L still works
+        await pilot.press("t")
+        await start_playback(app, pilot, "fortune")
+        for words in ("sweep line", "beach line", "circle events", "growing edges", "finished edges",
+                      "sites to come"):
+            assert words in legend_shown(app)
+        await pilot.press("L")
+        assert legend_shown(app) == ""
+        await pilot.press("t", "L")
+        assert "Voronoi edges" in legend_shown(app) and "sweep" not in legend_shown(app)
+
+
+@pilot_test
+async def test_L_on_a_narrow_terminal_shows_the_panel_with_the_legend():
+    app = make_app()
+    async with app.run_test(size=(60, 20)) as pilot:
+        await pilot.pause()
+        assert not app.query_one("#panel").display
+        await pilot.press("L")
+        assert app.query_one("#panel").display and "sites" in legend_shown(app)
+        assert app.canvas.has_focus
+
+
+def engine_state(app) -> str:
+    state = app.query_one("#playstate")
+    return str(state.render()) if state.display else ""
+
+
+@pilot_test
+async def test_the_panel_shows_fortunes_queue_beach_line_and_counts():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        assert engine_state(app) == ""
+        player = await start_playback(app, pilot, "fortune")
+        assert not app.query_one("#points-section").display  # new points wait until playback ends
+        await pilot.press("right_square_bracket", "right_square_bracket", "right_square_bracket")
+        step = player.step
+        text = engine_state(app)
+        assert "Next events" in text
+        assert f"Beach line: {len(step.beach)} arcs" in text
+        assert (f"▶ site {step.site}" if step.kind == "site" else f"✕ site {step.site}") in text
+        assert f"{len(step.vertices)} vertices" in text
+        assert f"{len(step.finished_edges)} edges, {len(step.growing_edges)} growing" in text
+        await step_until(app, pilot, "circle")  # the vanished arc is marked where it was
+        assert f"✕ site {player.step.site}" in engine_state(app)
+        await step_until(app, pilot, "site")
+        assert f"▶ site {player.step.site}" in engine_state(app)
+        await pilot.press("t")
+        assert engine_state(app) == "" and app.query_one("#points-section").display
+
+
+def test_the_next_events_listed_are_the_events_that_come():
+    from tvoronoi.tui.state import next_events
+
+    points = generate("uniform", 200, seed=3)
+    trace = tvoronoi.fortune_steps(points)
+    for k in range(0, len(trace), 7):
+        now, then = trace.step(k), trace.step(k + 1)
+        kind, x, y = next_events(now, points)[0]
+        assert kind == then.kind
+        if kind == "site":
+            assert (x, y) == then.position
+        else:
+            assert x == pytest.approx(then.vertex[0]) and y == pytest.approx(then.sweep_y)
+
+
+@pilot_test
+async def test_the_panel_shows_the_cavity_and_the_cells_that_lost_area():
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press(*["full_stop"] * 150)
+        step = player.step
+        text = engine_state(app)
+        assert f"Site {step.site} inserted" in text and "150 of 300" in text
+        assert f"{len(step.conflict)} triangles in conflict" in text
+        assert f"Cells that lost area: {len(step.stolen_from)}" in text
+        assert str(step.stolen_from[0]) in text
+
+
+def test_snapshot_legend_of_the_diagram(snap_compare):
+    """L pressed on the start view: the panel's Legend section names each colour and mark of the
+    diagram (cells, Voronoi edges and the box, sites, vertices, Delaunay edges, the keyboard
+    cursor), each beside a swatch in its own colour; the footer names L."""
+    assert snap_compare(make_app(), press=["L"], terminal_size=SIZE)
+
+
+def test_snapshot_fortune_panel_following(snap_compare):
+    """Fortune's sweep at step 353 with the view following (the default): zoomed on the
+    event's region; the panel's Engine state lists the next events of the queue (site or
+    circle, where), the beach line's arcs about the current one (marked ▶) and the vertices
+    and edges so far; the timeline says "f: follow"."""
+
+    async def to_step(pilot):
+        pilot.app.query_one("#engine", Select).value = "fortune"
+        await pilot.pause()
+        pilot.app.canvas.focus()
+        await pilot.press("t", *["right_square_bracket"] * 4, "full_stop")
+
+    assert snap_compare(make_app(), run_before=to_step, terminal_size=SIZE)
+
+
+def test_snapshot_incremental_panel_following(snap_compare):
+    """The incremental engine after 150 insertions with the view following: zoomed on the new
+    site's cavity (the conflict triangles outlined and filled, the cells that lost area
+    tinted); the panel's Engine state names the site, the cavity's size, the ids of the
+    cells that lost area and the counts so far."""
     assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)
+
+
+# -- circles far larger than the view -----------------------------------------
+
+
+def test_a_huge_circle_is_the_arc_that_enters_the_view():
+    # the view is the unit square; the circle's top pokes into it from far below
+    window = (0.0, 0.0, 1.0, 1.0)
+    r = 1e4
+    segs = circle_segments([[0.5, 0.5 - r, r]], scale=0.005, window=window)
+    assert len(segs)
+    ends = np.vstack([segs[:, :2], segs[:, 2:]])
+    assert (ends[:, 0] >= -1e-9).all() and (ends[:, 0] <= 1 + 1e-9).all()
+    assert (ends[:, 1] >= -1e-9).all() and (ends[:, 1] <= 1 + 1e-9).all()
+    # finely divided: each side about a dot and a half, so the arc is not a chord across the view
+    assert np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]).max() <= 0.01
+    assert np.allclose(np.hypot(ends[:, 0] - 0.5, ends[:, 1] - (0.5 - r)), r, rtol=1e-12)
+    # it runs from the left side of the view to the right
+    assert ends[:, 0].min() < 0.01 and ends[:, 0].max() > 0.99
+
+
+def test_circles_outside_the_view_or_around_it_draw_nothing():
+    window = (0.0, 0.0, 1.0, 1.0)
+    around = [0.5, 0.5, 5.0]      # holds the whole view
+    beside = [3.0, 0.5, 1.0]      # wholly to the right
+    assert len(circle_segments([around, beside], scale=0.005, window=window)) == 0
+    inside = [0.5, 0.5, 0.2]      # drawn whole, as without a window
+    assert np.array_equal(circle_segments([inside], 0.005, window), circle_segments([inside], 0.005))
+
+
+def test_a_circle_event_far_outside_the_box_draws_only_what_the_view_shows():
+    from tvoronoi.tui.raster import Painter
+
+    # three sites almost on a line: their circle is huge, its centre far outside the box
+    points = np.array([[0.0, 0.0], [0.5, 1e-4], [1.0, 0.0], [0.5, 1.0]])
+    trace = tvoronoi.fortune_steps(points)
+    step = next(s for s in (trace.step(k) for k in range(len(trace) + 1)) if len(s.circles))
+    assert step.circles[:, 2].max() > 100
+    view = View.fit((0, 0, 1, 1), 60, 20)
+    paint = Painter(view, 60, 20)
+    segs = circle_segments(step.circles, view.scale, paint.world)
+    x0, y0, x1, y1 = paint.world
+    assert len(segs) < 2000
+    assert (segs[:, [0, 2]] >= x0 - 1e-9).all() and (segs[:, [0, 2]] <= x1 + 1e-9).all()
+    assert (segs[:, [1, 3]] >= y0 - 1e-9).all() and (segs[:, [1, 3]] <= y1 + 1e-9).all()

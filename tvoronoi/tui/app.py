@@ -16,7 +16,7 @@ from rich.text import Text
 from textual import on
 from textual.app import App, ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, VerticalScroll
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
 from textual.widgets import Button, Footer, Input, Label, ProgressBar, Select, Static
 from textual.widgets._select import SelectOverlay
@@ -30,6 +30,7 @@ from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
 from tvoronoi.tui.inspector import InspectorMixin
+from tvoronoi.tui.legend import legend_text
 from tvoronoi.tui.playback import PlaybackMixin
 from tvoronoi.tui.screens import HelpScreen, OpenRequest
 from tvoronoi.tui.timeline import Timeline
@@ -119,6 +120,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         Binding("p", "toggle_panel", "Panel", show=False),
         Binding("escape", "focus_canvas", "Back to the diagram", show=False),
         *playback.BINDINGS,
+        # the footer names L outside playback only: there the playback keys need the room
+        Binding("L", "toggle_legend", "Legend"),
+        Binding("L", "toggle_legend('playback')", "Legend", show=False),
         *editing.BINDINGS,
     ]
 
@@ -134,6 +138,8 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self._narrow: bool | None = None  # whether the panel was last laid out for a narrow terminal
         self._status_text = ""  # the left part of the status line
         self._view_text = ""  # its right part: where the view is
+        self.legend_shown = False
+        self._legend_seen: tuple | None = None
 
     # -- layout --------------------------------------------------------------
 
@@ -141,52 +147,53 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         with Workspace(id="main"):
             yield DiagramCanvas(id="canvas")
             with SidePanel(id="panel"):
-                yield Label("Points", classes="heading")
-                with Horizontal(classes="row"):
-                    yield Label("shape")
+                with Vertical(id="points-section"):
+                    yield Label("Points", classes="heading")
+                    with Horizontal(classes="row"):
+                        yield Label("shape")
+                        yield _tip(
+                            PanelSelect(
+                                [(name, name) for name in DISTRIBUTIONS],
+                                value=DEFAULT_DISTRIBUTION, allow_blank=False, compact=True, id="distribution",
+                            ),
+                            "How the points are spread: uniform in the unit square, one gaussian blob, "
+                            "or gaussian clusters",
+                        )
+                    with Horizontal(classes="row"):
+                        yield Label("count")
+                        yield _tip(
+                            Input(str(DEFAULT_COUNT), type="integer", compact=True, id="count"),
+                            f"Number of points (0 to {GENERATE_MAX_SITES:,}); {BUILD_THREAD_MIN_SITES:,} or more build "
+                            "in the background. Enter generates.",
+                        )
+                    with Horizontal(classes="row"):
+                        yield Label("seed")
+                        yield _tip(
+                            Input(str(DEFAULT_SEED), type="integer", compact=True, id="seed"),
+                            "Seed of the random generator: the same seed gives the same points",
+                        )
+                    with Horizontal(classes="row param gaussian"):
+                        yield Label("sigma")
+                        yield _tip(
+                            Input(DEFAULT_PARAMS["sigma"], type="number", compact=True, id="sigma"),
+                            "Standard deviation of the gaussian blob (> 0)",
+                        )
+                    with Horizontal(classes="row param clustered"):
+                        yield Label("clusters")
+                        yield _tip(
+                            Input(DEFAULT_PARAMS["clusters"], type="integer", compact=True, id="clusters"),
+                            "Number of cluster centres (>= 1)",
+                        )
+                    with Horizontal(classes="row param clustered"):
+                        yield Label("spread")
+                        yield _tip(
+                            Input(DEFAULT_PARAMS["spread"], type="number", compact=True, id="spread"),
+                            "Standard deviation of each cluster (> 0)",
+                        )
                     yield _tip(
-                        PanelSelect(
-                            [(name, name) for name in DISTRIBUTIONS],
-                            value=DEFAULT_DISTRIBUTION, allow_blank=False, compact=True, id="distribution",
-                        ),
-                        "How the points are spread: uniform in the unit square, one gaussian blob, "
-                        "or gaussian clusters",
+                        Button("Generate", variant="primary", compact=True, id="generate"),
+                        "Make new points with these settings and build their diagram (g)",
                     )
-                with Horizontal(classes="row"):
-                    yield Label("count")
-                    yield _tip(
-                        Input(str(DEFAULT_COUNT), type="integer", compact=True, id="count"),
-                        f"Number of points (0 to {GENERATE_MAX_SITES:,}); {BUILD_THREAD_MIN_SITES:,} or more build "
-                        "in the background. Enter generates.",
-                    )
-                with Horizontal(classes="row"):
-                    yield Label("seed")
-                    yield _tip(
-                        Input(str(DEFAULT_SEED), type="integer", compact=True, id="seed"),
-                        "Seed of the random generator: the same seed gives the same points",
-                    )
-                with Horizontal(classes="row param gaussian"):
-                    yield Label("sigma")
-                    yield _tip(
-                        Input(DEFAULT_PARAMS["sigma"], type="number", compact=True, id="sigma"),
-                        "Standard deviation of the gaussian blob (> 0)",
-                    )
-                with Horizontal(classes="row param clustered"):
-                    yield Label("clusters")
-                    yield _tip(
-                        Input(DEFAULT_PARAMS["clusters"], type="integer", compact=True, id="clusters"),
-                        "Number of cluster centres (>= 1)",
-                    )
-                with Horizontal(classes="row param clustered"):
-                    yield Label("spread")
-                    yield _tip(
-                        Input(DEFAULT_PARAMS["spread"], type="number", compact=True, id="spread"),
-                        "Standard deviation of each cluster (> 0)",
-                    )
-                yield _tip(
-                    Button("Generate", variant="primary", compact=True, id="generate"),
-                    "Make new points with these settings and build their diagram (g)",
-                )
                 yield Label("Diagram", classes="heading")
                 with Horizontal(classes="row"):
                     yield Label("engine")
@@ -203,8 +210,12 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                     "Watch the engine build this diagram step by step (t)",
                 )
                 yield ProgressBar(id="progress", show_eta=False)
+                yield Label("Engine state", classes="heading playstate")
+                yield Static(id="playstate", classes="playstate")
                 yield Label("Cell", classes="heading inspector")
                 yield Static(id="inspector", classes="inspector")
+                yield Label("Legend", classes="heading legend")
+                yield Static(id="legend", classes="legend")
         yield Timeline(id="timeline")
         yield Static(id="inspect-line")
         yield _tip(
@@ -218,6 +229,8 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self._show_parameters(DEFAULT_DISTRIBUTION)
         self.query_one("#progress").display = False
         self.timeline.display = False
+        for widget in self.query(".playstate, .legend"):
+            widget.display = False
         self.canvas.focus()
         self.watch(self.canvas, "view", self._show_view, init=False)
         if self.initial_points is not None:
@@ -386,6 +399,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
     def _update_status(self) -> None:
         """Say what is shown: in the status line, and the inspected cell (which may have changed)."""
         self.inspect()
+        self.update_legend()
         self._show_view()
         if self.building is not None:
             self._set_status(self.building)  # the old diagram's status would hide the running build
@@ -438,6 +452,35 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         if not panel.display:
             self.canvas.focus()
 
+    def action_toggle_legend(self, during: str = "") -> None:
+        """Show or hide the legend of what the canvas draws (in the side panel, shown with it)."""
+        self.legend_shown = not self.legend_shown
+        panel = self.query_one("#panel")
+        if self.legend_shown and not panel.display:
+            self._panel_wanted = True
+            self._layout_panel()
+        self.update_legend()
+        if self.legend_shown:
+            self.query_one("#legend").scroll_visible(animate=False)
+
+    def check_action(self, action: str, parameters: tuple) -> bool | None:
+        if action == "toggle_legend":
+            return (self.player is not None) == bool(parameters)
+        return super().check_action(action, parameters)
+
+    def update_legend(self) -> None:
+        """The legend of what is drawn now: the diagram, or the playback of its engine."""
+        mode = "normal" if self.player is None else self.player.engine
+        palette = self.canvas.palette()
+        seen = (self.legend_shown, mode, palette)
+        if seen == self._legend_seen:
+            return
+        self._legend_seen = seen
+        for widget in self.query(".legend"):
+            widget.display = self.legend_shown
+        if self.legend_shown:
+            self.query_one("#legend", Static).update(legend_text(mode, palette))
+
     def action_focus_canvas(self) -> None:
         self.canvas.focus()
 
@@ -459,7 +502,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         rows: list[tuple[str, str]] = []
         seen: dict[str, int] = {}
         for binding in (*DiagramCanvas.BINDINGS, *self.BINDINGS):
-            if binding.action in editing.HELP_HIDDEN:
+            if binding.action in editing.HELP_HIDDEN or binding.action in HELP_HIDDEN:
                 continue
             # each key by its own name (the footer shows only the first one's)
             keys = editing.HELP_KEYS.get(binding.action) or " ".join(
@@ -476,6 +519,9 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         rows.append(("ctrl+p", "command palette (themes, screenshot, quit)"))
         return rows
 
+
+# Second bindings of a key, already in the help under the first.
+HELP_HIDDEN = {"toggle_legend('playback')"}
 
 # What the help says for an action, where the footer's short label is not enough.
 HELP_TEXT = {
@@ -494,6 +540,7 @@ HELP_TEXT = {
     "open": "open a point file",
     "save": "save the cells as GeoJSON",
     "toggle_panel": "show / hide the side panel",
+    "toggle_legend": "show / hide the legend of the colours and marks (in the panel)",
     "focus_canvas": "leave a text field, back to the diagram",
     **playback.HELP,
     **editing.HELP,

@@ -16,6 +16,7 @@ from textual.widget import Widget
 
 from tvoronoi.tui.colours import Palette, palette_for
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+from tvoronoi.tui.follow import follow_view
 from tvoronoi.tui.raster import (
     CURSOR_ARM,
     Frame,
@@ -167,6 +168,17 @@ class DiagramCanvas(Widget, can_focus=True):
         self._frame_key = (self._base_key, version, self._frame_key[2])
         self._frame_version = version
         self.refresh()
+
+    def follow(self, box) -> None:
+        """Show the world box (x0, y0, x1, y1) as the program's own move: no ``ViewChanged``.
+
+        The view moves only if it does not show the box well already (see ``follow.follow_view``).
+        """
+        width, height = self._canvas_size()
+        view = follow_view(self.view, box, width, height)
+        if view != self.view:
+            self.fitted = False
+            self.view = view
 
     def set_cursor(self, cursor: tuple[float, float] | None) -> None:
         self.cursor = cursor

@@ -78,10 +78,32 @@ def _inside_triangles(xs: np.ndarray, ys: np.ndarray, corners: np.ndarray) -> np
     return inside
 
 
-def circle_segments(circles: np.ndarray, scale: float) -> np.ndarray:
-    """Outlines of circles (m, 3: cx, cy, r) as polygon sides (k, 4), fine enough for dots of ``scale``."""
+def circle_segments(circles: np.ndarray, scale: float, window=None) -> np.ndarray:
+    """Outlines of circles (m, 3: cx, cy, r) as polygon sides (k, 4), fine enough for dots of ``scale``.
+
+    With a ``window`` (x0, y0, x1, y1), the world box the canvas shows, only what lies in it is
+    drawn: a circle far larger than the view, or far outside the box, becomes the arc that enters
+    the view (finely divided, however large the circle), one wholly outside it or holding the
+    whole view inside it draws nothing.
+    """
     circles = np.asarray(circles, np.float64).reshape(-1, 3)
     circles = circles[np.isfinite(circles).all(axis=1)]
+    if window is None or not len(circles):
+        return _full_circles(circles, scale)
+    x0, y0, x1, y1 = (float(c) for c in window)
+    cx, cy, r = circles.T
+    # the nearest and farthest points of the window from each centre
+    near = np.hypot(np.clip(cx, x0, x1) - cx, np.clip(cy, y0, y1) - cy)
+    far = np.hypot(np.maximum(np.abs(cx - x0), np.abs(cx - x1)), np.maximum(np.abs(cy - y0), np.abs(cy - y1)))
+    meets = (near <= r) & (far >= r)
+    inside = (cx - r >= x0) & (cx + r <= x1) & (cy - r >= y0) & (cy + r <= y1)
+    parts = [_full_circles(circles[meets & inside], scale)]
+    for c in circles[meets & ~inside]:
+        parts.append(_arcs_in_window(c, scale, (x0, y0, x1, y1)))
+    return np.concatenate(parts)
+
+
+def _full_circles(circles: np.ndarray, scale: float) -> np.ndarray:
     if not len(circles):
         return _empty_segments()
     around = 2 * np.pi * circles[:, 2] / scale / CIRCLE_DOTS_PER_SIDE
@@ -93,6 +115,35 @@ def circle_segments(circles: np.ndarray, scale: float) -> np.ndarray:
     t1 = 2 * np.pi * (k + 1) / sides[owner]
     cx, cy, r = circles[owner, 0], circles[owner, 1], circles[owner, 2]
     return np.column_stack([cx + r * np.cos(t0), cy + r * np.sin(t0), cx + r * np.cos(t1), cy + r * np.sin(t1)])
+
+
+def _arcs_in_window(circle: np.ndarray, scale: float, window) -> np.ndarray:
+    """The arcs of one circle inside the window, as polygon sides of about CIRCLE_DOTS_PER_SIDE dots."""
+    cx, cy, r = (float(c) for c in circle)
+    x0, y0, x1, y1 = window
+    # the angles where the circle crosses the window's four lines cut it into arcs, each wholly
+    # inside or wholly outside
+    cuts = [0.0, 2 * math.pi]
+    for x in (x0, x1):
+        if abs(x - cx) <= r:
+            a = math.acos(min(max((x - cx) / r, -1.0), 1.0))
+            cuts += [a, 2 * math.pi - a]
+    for y in (y0, y1):
+        if abs(y - cy) <= r:
+            a = math.asin(min(max((y - cy) / r, -1.0), 1.0))
+            cuts += [a % (2 * math.pi), (math.pi - a) % (2 * math.pi)]
+    cuts = np.unique(cuts)
+    parts = []
+    for t0, t1 in zip(cuts[:-1], cuts[1:]):
+        mid = (t0 + t1) / 2
+        mx, my = cx + r * math.cos(mid), cy + r * math.sin(mid)
+        if not (x0 <= mx <= x1 and y0 <= my <= y1) or t1 <= t0:
+            continue
+        sides = int(min(max(math.ceil((t1 - t0) * r / scale / CIRCLE_DOTS_PER_SIDE), 1), CIRCLE_MAX_SIDES))
+        t = np.linspace(t0, t1, sides + 1)
+        xs, ys = cx + r * np.cos(t), cy + r * np.sin(t)
+        parts.append(np.column_stack([xs[:-1], ys[:-1], xs[1:], ys[1:]]))
+    return np.concatenate(parts) if parts else _empty_segments()
 
 
 def beach_heights(step, points: np.ndarray, xs: np.ndarray) -> np.ndarray:
@@ -129,7 +180,7 @@ class FortuneOverlay:
             # the first row's edges start at -inf: from below the box
             grow[:, [1, 3]] = np.maximum(grow[:, [1, 3]], self.bbox[1] - 1.0)
             paint.segments(GROWING, clip_segments(grow, self.bbox), dash=DASH)
-        paint.segments(CIRCLE, circle_segments(step.circles, view.scale))
+        paint.segments(CIRCLE, circle_segments(step.circles, view.scale, paint.world))
         paint.segments(BEACH, self.beach_segments(view, cols, rows))
         if math.isfinite(step.sweep_y):
             x0, _ = view.to_world(-1.0, 0.0, cols, rows)
@@ -138,7 +189,8 @@ class FortuneOverlay:
         if step.kind == "circle":
             vx, vy = step.vertex
             # the circle that just emptied, and its centre: the new vertex
-            paint.segments(EVENT, circle_segments([[vx, vy, step.sweep_y - vy]], view.scale), dash=DASH)
+            paint.segments(EVENT, circle_segments([[vx, vy, step.sweep_y - vy]], view.scale, paint.world),
+                           dash=DASH)
             paint.points(EVENT, [[vx, vy]], block=True)
         elif step.kind in ("site", "repeat"):
             paint.points(EVENT, [step.position], block=True)

@@ -1,4 +1,5 @@
-"""The modal screens of the terminal UI: the key help and the path dialog for open and save."""
+"""The modal screens of the terminal UI: the key help, the path dialog for open and save, and the choice
+between a sample and all the sites for playback."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
-from textual.widgets import Input, Label, Static
+from textual.widgets import Button, Input, Label, Static
 
 # Mouse gestures, listed in the help beside the keys.
 MOUSE_HELP = (
@@ -142,3 +143,51 @@ class OpenDialog(PathDialog):
         x = self.query_one("#x-column", Input).value.strip() or None
         y = self.query_one("#y-column", Input).value.strip() or None
         return OpenRequest(path, x, y)
+
+
+class SampleDialog(ModalScreen[str | None]):
+    """Playback of many sites: offer a teaching-size sample, or all the sites.
+
+    Dismissed with "sample", "all" or None (cancelled). ``all_allowed`` False: too many sites
+    to play them all (``why`` says so).
+    """
+
+    BINDINGS = [
+        Binding("s", "choose('sample')", "Sample"),
+        Binding("a", "choose('all')", "All"),
+        Binding("escape", "choose('')", "Cancel"),
+    ]
+
+    def __init__(self, n_sites: int, sample_size: int, *, all_allowed: bool = True, why: str = "") -> None:
+        super().__init__()
+        self.n_sites = n_sites
+        self.sample_size = sample_size
+        self.all_allowed = all_allowed
+        self.why = why
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="dialog") as box:
+            box.border_title = "Playback"
+            yield Static(
+                f"{self.n_sites:,} sites are more than the eye can follow. A sample of "
+                f"{self.sample_size} of them (picked at random, so spread as they are) shows "
+                "each step of the engine clearly.",
+                id="sample-text",
+            )
+            with Horizontal(id="sample-buttons"):
+                yield Button(f"Sample of {self.sample_size} (s)", variant="primary", compact=True, id="sample")
+                yield Button(f"All {self.n_sites:,} (a)", compact=True, id="all", disabled=not self.all_allowed)
+            hint = self.why if not self.all_allowed else "Esc to cancel"
+            yield Label(hint, id="dialog-hint")
+
+    def on_mount(self) -> None:
+        self.query_one("#sample", Button).focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.action_choose(event.button.id)
+
+    def action_choose(self, choice: str) -> None:
+        if choice == "all" and not self.all_allowed:
+            return
+        self.dismiss(choice or None)

@@ -1,4 +1,5 @@
-"""The playback timeline: a one-line bar of the steps, with the play state and speed; click or drag to scrub."""
+"""The playback timeline: a one-line bar of the steps, with the play state, whether the view follows, and
+the speed; click or drag to scrub."""
 
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ from textual.widget import Widget
 # Words rather than symbols: the play and pause symbols are wide in some terminals.
 PLAYING, PAUSED = "playing", "paused "
 DONE, TODO, KNOB = "━", "─", "●"
+# Whether the view follows the events, and the key that changes it.
+FOLLOWING, FIXED = "f: follow", "f: fixed "
 
 
 class Timeline(Widget):
@@ -29,6 +32,7 @@ class Timeline(Widget):
     playing: reactive[bool] = reactive(False)
     speed: reactive[float] = reactive(20.0)
     engine: reactive[str] = reactive("")
+    following: reactive[bool] = reactive(False)
 
     class Scrubbed(Message):
         """The user clicked or dragged on the bar: show ``step``."""
@@ -46,7 +50,7 @@ class Timeline(Widget):
     def _labels(self) -> tuple[str, str]:
         digits = len(f"{self.n_steps:,}")
         left = f" {PLAYING if self.playing else PAUSED} {self.engine} {self.index:>{digits},}/{self.n_steps:,} "
-        right = f" {self.speed:g} steps/s "
+        right = f" {FOLLOWING if self.following else FIXED} · {self.speed:g} steps/s "
         return left, right
 
     def bar_span(self) -> tuple[int, int]:
