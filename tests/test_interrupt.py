@@ -122,8 +122,11 @@ def test_batch_stops_on_signal_and_leaves_no_file(tmp_path, sig, code):
     src = tmp_path / "points.npy"
     np.save(src, np.random.default_rng(3).random((2_000_000, 2)))
     out = tmp_path / "cells.geojson"
+    # a child of a background job inherits SIGINT ignored, and Python then leaves it ignored: give the
+    # child the default disposition, as a terminal would
     proc = subprocess.Popen([sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(2.5)                          # start-up and reading done; the engine is running
     proc.send_signal(sig)
     try:
