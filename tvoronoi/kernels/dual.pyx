@@ -19,14 +19,14 @@ from tvoronoi.kernels.mesh cimport nxt, prv
 # An edge lies on the bisector of he_face[h] and he_face[he_twin[h]].
 
 
-cdef int find(int32_t* parent, int t) noexcept nogil:
-    cdef int root = t, up
+cdef int find(int32_t* parent, int v) noexcept nogil:
+    cdef int root = v, up
     while parent[root] != root:
         root = parent[root]
-    while parent[t] != root:     # path compression
-        up = parent[t]
-        parent[t] = root
-        t = up
+    while parent[v] != root:     # path compression
+        up = parent[v]
+        parent[v] = root
+        v = up
     return root
 
 
@@ -36,6 +36,12 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
     Triangles whose circumcircles coincide (cocircular sites) share one
     Voronoi vertex, and the zero-length edges between them are not emitted.
+
+    One walk around each site, in the sites' order, makes the DCEL cell by cell: the half-edges of a
+    cell are consecutive, in he_next order, from face_edge (an unbounded cell's first half-edge comes
+    from infinity, its last runs off to infinity), and vertices are numbered as the walk first meets
+    them. The sites come in a spatial order (BRIO or the sweep's), so a cell's vertices and
+    half-edges lie near its neighbours' in memory for the phases that follow.
 
     Parameters
     ----------
@@ -48,132 +54,160 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     Returns
     -------
     dict of arrays: vertices (m, 2) float64; he_origin, he_twin, he_next,
-    he_prev, he_face (h,) int32; face_edge (n,) int32 (one half-edge of each
-    cell); triangles (k, 3) int32, the finite Delaunay triangles.
+    he_prev, he_face (h,) int32; face_edge (n,) int32 (the first half-edge of each
+    cell, -1 for a site without one); triangles (k, 3) int32, the finite Delaunay triangles.
     """
     cdef int n = xs.shape[0], inf = n
     cdef int n_he_d = tv.shape[0], n_tri = n_he_d // 3
-    cdef int32_t[::1] parent = np.empty(n_tri, np.int32)
-    cdef int32_t[::1] tri_vertex = np.full(n_tri, -1, np.int32)
-    cdef int32_t[::1] group_tri = np.full(n_tri, -1, np.int32)
-    cdef int32_t[::1] vor = np.full(n_he_d, -1, np.int32)      # Delaunay half-edge -> Voronoi half-edge
+    cdef int32_t[::1] first_e = np.full(n, -1, np.int32)     # where each site's walk starts
+    cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # triangle -> vertex; -2 infinite, -1 not yet
+    cdef int32_t[::1] vor = np.full(n_he_d, -1, np.int32)     # Delaunay half-edge -> Voronoi half-edge
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_next = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_prev = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] dual_of = np.empty(n_he_d, np.int32)     # Voronoi half-edge -> Delaunay half-edge
     cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
-    cdef int32_t[::1] finite = np.empty(n_tri, np.int32)
-    cdef int32_t[::1] slot = np.full(n_tri, -1, np.int32)      # finite triangle -> its index in finite
-    cdef double[:, ::1] centre = np.empty((n_tri, 2), np.float64)
-    cdef double[:, ::1] vertices
-    cdef int t, t2, e, o, a, b, c, d, r, m = 0, h = 0, n_finite = 0, f, f2, g, merges = 0
+    cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
+    cdef double[:, ::1] centre
+    cdef int32_t[:, ::1] tri
+    cdef int t, e, e0, o, a, b, c, d, h = 0, h0, m = 0, n_finite = 0, vr, vl, g, merges = 0, k
 
     with nogil:
+        # which triangles are finite, and where each site's walk starts: any half-edge out of it, or
+        # for a hull site the one whose dual comes from infinity (the twin of a hull edge p->q of an
+        # infinite triangle starts at q)
         for t in range(n_tri):
-            parent[t] = t
-            if tv[3 * t] != inf and tv[3 * t + 1] != inf and tv[3 * t + 2] != inf:
-                slot[t] = n_finite
-                finite[n_finite] = t
-                n_finite += 1
-        # every finite triangle's circumcentre, correctly rounded (construct.circumcentre)
-        for f in range(n_finite):
-            if (f & POLL_MASK) == 0:
-                poll_signals()
-            t = finite[f]
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &centre[f, 0], &centre[f, 1])
-        # merge the triangles of each cocircular group into one Voronoi vertex. Equal exact centres round
-        # to equal doubles, so only neighbours whose rounded centres agree can be cocircular: the exact
-        # in-circle test runs on those alone
-        for f in range(n_finite):
-            if (f & POLL_MASK) == 0:
-                poll_signals()
-            t = finite[f]
-            for e in range(3 * t, 3 * t + 3):
-                o = opp[e]
-                t2 = o // 3
-                f2 = slot[t2]
-                if t2 < t or f2 < 0:
-                    continue
-                if centre[f, 0] != centre[f2, 0] or centre[f, 1] != centre[f2, 1]:
-                    continue
-                a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-                d = tv[prv(o)]
-                # degenerate case: four cocircular sites, a zero-length Voronoi edge
-                if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0:
-                    r = find(&parent[0], t)
-                    g = find(&parent[0], t2)
-                    if r != g:
-                        parent[g] = r
-                        merges += 1
-        # each group's vertex: the centre of one of its triangles (all have the same exact centre, hence
-        # the same rounded one); with no cocircular sites, one vertex per finite triangle, in order
-        if merges == 0:
-            m = n_finite
-            for f in range(n_finite):
-                tri_vertex[finite[f]] = f
-        else:
-            for f in range(n_finite):
-                t = finite[f]
-                r = find(&parent[0], t)
-                if tri_vertex[r] == -1:
-                    tri_vertex[r] = m
-                    m += 1
-                    group_tri[r] = t
-                tri_vertex[t] = tri_vertex[r]
-    if merges == 0:
-        vertices = centre[:n_finite]
-    else:
-        vertices = np.empty((m, 2), np.float64)
-        with nogil:
-            for f in range(n_finite):
-                t = finite[f]
-                r = find(&parent[0], t)
-                if group_tri[r] == t:
-                    vertices[tri_vertex[t], 0] = centre[f, 0]
-                    vertices[tri_vertex[t], 1] = centre[f, 1]
+            if a == inf or b == inf or c == inf:
+                vid[t] = -2
+                for e in range(3 * t, 3 * t + 3):
+                    if tv[e] != inf and tv[nxt(e)] != inf:
+                        first_e[tv[nxt(e)]] = opp[e]
+            else:
+                vid[t] = -1
+                n_finite += 1
+                for e in range(3 * t, 3 * t + 3):
+                    if first_e[tv[e]] < 0:
+                        first_e[tv[e]] = e
+    centre = np.empty((n_finite, 2), np.float64)
+    tri = np.empty((n_finite, 3), np.int32)
+    parent = np.empty(n_finite, np.int32)
+    cdef const int32_t* tvp = &tv[0] if n_he_d > 0 else NULL
+    cdef const double* xp = &xs[0] if n > 0 else NULL
+    cdef const double* yp = &ys[0] if n > 0 else NULL
+    cdef int32_t* vidp = &vid[0]
+    cdef double* cp = &centre[0, 0] if n_finite > 0 else NULL
+    cdef int32_t* trip = &tri[0, 0] if n_finite > 0 else NULL
+    cdef int32_t* pp = &parent[0] if n_finite > 0 else NULL
 
     with nogil:
-        # one Voronoi half-edge per Delaunay half-edge between two sites,
-        # unless both sides share a vertex (a zero-length edge)
-        for e in range(n_he_d):
-            a = tv[e]
-            b = tv[nxt(e)]
-            if a == inf or b == inf:
-                continue
-            if tri_vertex[e // 3] != -1 and tri_vertex[e // 3] == tri_vertex[opp[e] // 3]:
-                continue
-            vor[e] = h
-            dual_of[h] = e
-            # the cell of a is on the left of a->b's dual: it runs from the
-            # triangle right of a->b to the triangle left of it
-            he_origin[h] = tri_vertex[opp[e] // 3]
-            he_face[h] = a
-            face_edge[a] = h
-            h += 1
-        for g in range(h):
-            e = dual_of[g]
-            he_twin[g] = vor[opp[e]]
-            # the next edge counter-clockwise around site tv[e]
-            e = opp[prv(e)]
-            while vor[e] == -1:
+        for a in range(n):
+            if (a & POLL_MASK) == 0:
+                poll_signals()
+            e0 = first_e[a]
+            if e0 < 0:
+                continue                # a repeated site, or none of the triangles (no cell)
+            h0 = h
+            e = e0
+            while True:
+                b = tv[nxt(e)]
+                if b != inf:
+                    # the dual of a->b runs from the triangle on its right to the one on its left
+                    o = opp[e]
+                    vr = vid[o // 3]
+                    if vr == -1:
+                        vr = new_vertex(o // 3, m, tvp, xp, yp, exponent, vidp, cp, trip, pp)
+                        m += 1
+                    vl = vid[e // 3]
+                    if vl == -1:
+                        vl = new_vertex(e // 3, m, tvp, xp, yp, exponent, vidp, cp, trip, pp)
+                        m += 1
+                    if vr >= 0 and vl >= 0:
+                        if merges > 0:
+                            vr = find(&parent[0], vr)
+                            vl = find(&parent[0], vl)
+                        if vr == vl:
+                            e = opp[prv(e)]
+                            if e == e0:
+                                break
+                            continue            # the two triangles already share their vertex
+                        # equal exact centres round to equal doubles, so only these can be cocircular
+                        if centre[vr, 0] == centre[vl, 0] and centre[vr, 1] == centre[vl, 1]:
+                            c = tv[prv(e)]
+                            d = tv[prv(o)]
+                            # degenerate case: four cocircular sites, a zero-length Voronoi edge
+                            if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0:
+                                if vr < vl:
+                                    parent[vl] = vr
+                                else:
+                                    parent[vr] = vl
+                                merges += 1
+                                e = opp[prv(e)]
+                                if e == e0:
+                                    break
+                                continue
+                    vor[e] = h
+                    he_origin[h] = vr if vr >= 0 else -1
+                    he_face[h] = a
+                    g = vor[o]
+                    if g >= 0:
+                        he_twin[h] = g
+                        he_twin[g] = h
+                    h += 1
                 e = opp[prv(e)]
-            he_next[g] = vor[e]
-            he_prev[vor[e]] = g
+                if e == e0:
+                    break
+            if h == h0:
+                continue
+            face_edge[a] = h0
+            for g in range(h0, h):
+                he_next[g] = g + 1
+                he_prev[g] = g - 1
+            he_next[h - 1] = h0
+            he_prev[h0] = h - 1
 
-    tri = np.asarray(tv).reshape(-1, 3)[np.asarray(finite)[:n_finite]]
+        if merges > 0:
+            # each group of cocircular triangles is one vertex: renumber the groups' first vertices in
+            # order (the walk met a group's smallest number first), keeping their centres
+            k = 0
+            for g in range(m):
+                if find(&parent[0], g) == g:
+                    vid[g] = k                  # vid is free now: vertex -> new number
+                    centre[k, 0] = centre[g, 0]
+                    centre[k, 1] = centre[g, 1]
+                    k += 1
+            for g in range(m):
+                if parent[g] != g:
+                    vid[g] = vid[parent[g]]     # parent[g] is a root after find, and smaller than g
+            for g in range(h):
+                if he_origin[g] >= 0:
+                    he_origin[g] = vid[he_origin[g]]
+            m = k
+
     return {
-        "vertices": np.asarray(vertices) if merges else np.asarray(centre)[:n_finite],
-        "he_origin": np.asarray(he_origin)[:h].copy(),
-        "he_twin": np.asarray(he_twin)[:h].copy(),
-        "he_next": np.asarray(he_next)[:h].copy(),
-        "he_prev": np.asarray(he_prev)[:h].copy(),
-        "he_face": np.asarray(he_face)[:h].copy(),
+        "vertices": np.asarray(centre)[:m],
+        "he_origin": np.asarray(he_origin)[:h],
+        "he_twin": np.asarray(he_twin)[:h],
+        "he_next": np.asarray(he_next)[:h],
+        "he_prev": np.asarray(he_prev)[:h],
+        "he_face": np.asarray(he_face)[:h],
         "face_edge": np.asarray(face_edge),
-        "triangles": np.ascontiguousarray(tri, dtype=np.int32),
+        "triangles": np.asarray(tri),
     }
+
+
+cdef inline int new_vertex(int t, int m, const int32_t* tv, const double* xs, const double* ys, int exponent,
+                           int32_t* vid, double* centre, int32_t* tri, int32_t* parent) noexcept nogil:
+    # vertex m: the correctly rounded circumcentre of finite triangle t (construct.circumcentre)
+    cdef int a = tv[3 * t], b = tv[3 * t + 1], c = tv[3 * t + 2]
+    vid[t] = m
+    circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &centre[2 * m], &centre[2 * m + 1])
+    tri[3 * m] = a
+    tri[3 * m + 1] = b
+    tri[3 * m + 2] = c
+    parent[m] = m
+    return m
 
 
 def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0):
