@@ -54,16 +54,10 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     site_of[perm] = owner[root]
 
     # cells to input rows (CSR gather)
-    lengths = np.diff(offsets)
     cell_of_row = np.full(n, -1, np.int64)           # engine site whose cell row r shows
     firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
-    row_len = np.where(cell_of_row >= 0, lengths[np.maximum(cell_of_row, 0)], 0)
-    cell_offsets = np.zeros(n + 1, np.int64)
-    np.cumsum(row_len, out=cell_offsets[1:])
-    src_start = np.where(cell_of_row >= 0, offsets[:-1][np.maximum(cell_of_row, 0)], 0)
-    gather = np.repeat(src_start - cell_offsets[:-1], row_len) + np.arange(cell_offsets[-1])
-    cell_vertices = ring[gather]
+    cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row)
 
     face_edge = np.full(n, -1, np.int32)
     face_edge[owner[firsts]] = out["face_edge"][firsts]
@@ -77,7 +71,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
         he_prev=out["he_prev"],
         he_face=owner[out["he_face"]],
         face_edge=face_edge,
-        triangles=owner[out["triangles"]].astype(np.int32).reshape(-1, 3),
+        triangles=np.take(owner, out["triangles"]).astype(np.int32, copy=False).reshape(-1, 3),
         bbox=tuple(float(v) for v in box),
         cell_points=points,
         cell_offsets=cell_offsets,

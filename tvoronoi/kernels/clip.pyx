@@ -3,6 +3,8 @@
 import numpy as np
 
 from libc.math cimport hypot
+from libc.stdlib cimport malloc, free
+from libc.string cimport memcpy
 from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -43,47 +45,38 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         points[ring[offsets[i]:offsets[i + 1]]], counter-clockwise, not
         closed, starting at its lowest point; empty when the cell misses the box.
     status : int, 0, or 1 if the edges of some cell did not chain (never on a valid DCEL).
+
+    points and ring are views of the kernel's buffers (ring's has room for every cell's worst case).
     """
     xmin, ymin, xmax, ymax = [float(side) for side in box_tuple]
     cdef Box box = make_box(xmin, ymin, xmax, ymax, e)
     cdef int n = xs.shape[0], m = vertices.shape[0], n_he = he_origin.shape[0]
-    cdef int cap = m + 2 * n_he + 4
-    cdef double[:, ::1] pts = np.empty((cap, 2), np.float64)
-    cdef signed char[::1] pt_side = np.empty(cap, np.int8)     # read only at exits and entries
-    cdef int32_t[::1] pt_a = np.empty(cap, np.int32)           # how a boundary point was made (Points)
-    cdef int32_t[::1] pt_b = np.empty(cap, np.int32)
-    cdef int32_t[::1] pt_c = np.empty(cap, np.int32)
     cdef signed char[::1] vcx = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] vcy = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] tie = np.zeros(max(m, 1), np.int8)
-    cdef int32_t[::1] seg_start = np.empty(n_he, np.int32)    # read only where flags say HAS
+    cdef int32_t[::1] seg_start = np.empty(n_he, np.int32)    # written and read only for edges not WHOLE
     cdef int32_t[::1] seg_end = np.empty(n_he, np.int32)
     cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
-    cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n + 4, np.int32)
-    counts = np.bincount(np.asarray(he_face), minlength=n) if n_he else np.zeros(max(n, 1), np.int64)
-    cdef int max_deg = int(counts.max()) if len(counts) else 0
-    cdef int32_t[::1] c_start = np.empty(max_deg + 1, np.int32)
-    cdef int32_t[::1] c_end = np.empty(max_deg + 1, np.int32)
-    cdef signed char[::1] c_entry = np.empty(max_deg + 1, np.int8)
-    cdef signed char[::1] c_exit = np.empty(max_deg + 1, np.int8)
-    cdef signed char[::1] c_has = np.empty(max_deg + 1, np.int8)
-    cdef double[::1] nbx = np.empty(max_deg + 1, np.float64)
-    cdef double[::1] nby = np.empty(max_deg + 1, np.float64)
+    cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n + 4, np.int32)     # 2 deg + 4 for each cell
+    cdef double[:, ::1] pts
+    cdef signed char[::1] pt_side
+    cdef int32_t[::1] pt_a, pt_b, pt_c                         # how a boundary point was made (Points)
     cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0, n_bent = 0
+    cdef int n_cross = 0
     cdef int64_t n_ring = 0
     cdef double x, y
     cdef EdgePart part
     cdef Points P
+    cdef CellEdges C
     cdef bint has_o, has_d
+    C.cap = 0
 
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
         for v in range(m):
             x = vertices[v, 0]
             y = vertices[v, 1]
-            pts[v, 0] = x
-            pts[v, 1] = y
             if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
                 tie[v] = 1
                 n_ties += 1
@@ -94,9 +87,9 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
         for h in range(n_he if n_ties > 0 else 0):
             v = he_origin[h]
-            if v < 0 or not tie[v]:
+            if v < 0 or tie[v] != 1:
                 continue
-            tie[v] = 0
+            tie[v] = 2
             # the vertex is the circumcentre of the three cells around it
             a = he_face[h]
             b = he_face[he_twin[h]]
@@ -105,29 +98,50 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], False)
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
-            pt_a[v] = a; pt_b[v] = b; pt_c[v] = c
-        for v in range(m):
-            if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
-                pt_side[v] = code_side(vcx[v], vcy[v])
-
-        # clip each edge once, along the half-edge of smaller index; its twin runs the other way
+        # the edges with both ends vertices in the box are whole; count the others (each makes at most
+        # two new points)
         for h in range(n_he):
             tw = he_twin[h]
             if tw < h:
                 continue
             o = he_origin[h]
             d = he_origin[tw]
-            has_o = o >= 0
-            has_d = d >= 0
-            if has_o and has_d and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
-                # both ends in the box: the whole edge (clip_edge's first case, without reading the sites)
-                seg_start[h] = o
-                seg_end[h] = d
-                seg_start[tw] = d
-                seg_end[tw] = o
+            if o >= 0 and d >= 0 and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
                 flags[h] = HAS | WHOLE
                 flags[tw] = HAS | WHOLE
+            else:
+                n_cross += 1
+    pts = np.empty((m + 2 * n_cross + 4, 2), np.float64)
+    pt_side = np.empty(m + 2 * n_cross + 4, np.int8)            # read only at exits and entries
+    pt_a = np.empty(m + 2 * n_cross + 4, np.int32)
+    pt_b = np.empty(m + 2 * n_cross + 4, np.int32)
+    pt_c = np.empty(m + 2 * n_cross + 4, np.int32)
+
+    with nogil:
+        if m > 0:
+            memcpy(&pts[0, 0], &vertices[0, 0], 2 * m * sizeof(double))
+        for h in range(n_he if n_ties > 0 else 0):
+            v = he_origin[h]
+            if v < 0 or tie[v] != 2:
                 continue
+            tie[v] = 1
+            pt_a[v] = he_face[h]
+            pt_b[v] = he_face[he_twin[h]]
+            pt_c[v] = he_face[he_twin[he_prev[h]]]
+        for v in range(m):
+            if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
+                pt_side[v] = code_side(vcx[v], vcy[v])
+
+        # clip each edge that is not whole once, along the half-edge of smaller index; its twin runs the
+        # other way
+        for h in range(n_he if n_cross > 0 else 0):
+            tw = he_twin[h]
+            if tw < h or flags[h] != 0:
+                continue
+            o = he_origin[h]
+            d = he_origin[tw]
+            has_o = o >= 0
+            has_d = d >= 0
             a = he_face[h]
             b = he_face[tw]
             clip_edge(&box, xs[a], ys[a], xs[b], ys[b],
@@ -196,24 +210,38 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                         n_bent += 1
                 n_ring += k
                 continue
-            # a cell that meets the box boundary
+            # a cell that meets the box boundary: its edges' parts, then the walk
             h = face_edge[i]
             cnt = 0
             while h >= 0:
-                c_start[cnt] = seg_start[h]
-                c_end[cnt] = seg_end[h]
-                c_has[cnt] = (flags[h] & HAS) != 0
-                c_entry[cnt] = (flags[h] & ENTRY) != 0
-                c_exit[cnt] = (flags[h] & EXIT) != 0
-                b = he_face[he_twin[h]]
-                nbx[cnt] = xs[b]
-                nby[cnt] = ys[b]
                 cnt += 1
                 h = he_next[h]
                 if h == face_edge[i]:
                     break
-            k = walk_cell(&box, cnt, &c_start[0], &c_end[0], &c_entry[0], &c_exit[0], &c_has[0],
-                          &P, xs[i], ys[i], &nbx[0], &nby[0], &ring[n_ring])
+            if not room_for(&C, cnt + 1):
+                status = 2
+                break
+            h = face_edge[i]
+            cnt = 0
+            while h >= 0:
+                if flags[h] & WHOLE:
+                    C.start[cnt] = he_origin[h]
+                    C.end[cnt] = he_origin[he_twin[h]]
+                else:
+                    C.start[cnt] = seg_start[h]
+                    C.end[cnt] = seg_end[h]
+                C.has[cnt] = (flags[h] & HAS) != 0
+                C.entry[cnt] = (flags[h] & ENTRY) != 0
+                C.exit_[cnt] = (flags[h] & EXIT) != 0
+                b = he_face[he_twin[h]]
+                C.nbx[cnt] = xs[b]
+                C.nby[cnt] = ys[b]
+                cnt += 1
+                h = he_next[h]
+                if h == face_edge[i]:
+                    break
+            k = walk_cell(&box, cnt, C.start, C.end, C.entry, C.exit_, C.has,
+                          &P, xs[i], ys[i], C.nbx, C.nby, &ring[n_ring])
             if k < 0:
                 status = 1
                 continue
@@ -222,9 +250,14 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 n_bent += 1
             n_ring += k
         offsets[n] = n_ring
+        release(&C)
+    if status == 2:
+        raise MemoryError("no memory for the edges of a cell")
 
-    points = np.asarray(pts)[:n_pts].copy()
-    rings = np.asarray(ring)[:n_ring].copy()
+    # views, not copies: the caller gathers the rings into input order, and pts has room for exactly
+    # the crossings counted
+    points = np.asarray(pts)[:n_pts]
+    rings = np.asarray(ring)[:n_ring]
     offs = np.asarray(offsets)
     if n_bent:
         kind = np.full(n_pts, 2, np.int8)               # an interior vertex
@@ -234,6 +267,71 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         kind[corner0:] = 0                               # a corner
         offs, rings = straighten(points, offs, rings, kind)
     return points, offs, rings, status
+
+
+cdef struct CellEdges:
+    # the edges of one cell that meets the box boundary, for walk_cell (grown as cells need)
+    int cap
+    int32_t* start
+    int32_t* end
+    signed char* entry
+    signed char* exit_
+    signed char* has
+    double* nbx
+    double* nby
+
+
+cdef bint room_for(CellEdges* C, int k) noexcept nogil:
+    # make room for k edges; False when memory runs out (C is then released)
+    if k <= C.cap:
+        return True
+    k = max(k, 2 * C.cap, 64)
+    release(C)
+    C.start = <int32_t*> malloc(k * sizeof(int32_t))
+    C.end = <int32_t*> malloc(k * sizeof(int32_t))
+    C.entry = <signed char*> malloc(k)
+    C.exit_ = <signed char*> malloc(k)
+    C.has = <signed char*> malloc(k)
+    C.nbx = <double*> malloc(k * sizeof(double))
+    C.nby = <double*> malloc(k * sizeof(double))
+    C.cap = k
+    if (C.start == NULL or C.end == NULL or C.entry == NULL or C.exit_ == NULL or C.has == NULL
+            or C.nbx == NULL or C.nby == NULL):
+        release(C)
+        return False
+    return True
+
+
+cdef void release(CellEdges* C) noexcept nogil:
+    if C.cap > 0:
+        free(C.start); free(C.end); free(C.entry); free(C.exit_); free(C.has); free(C.nbx); free(C.nby)
+    C.cap = 0
+
+
+def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int64_t[::1] cell_of_row):
+    """Rings gathered into input-row order: row r shows cell cell_of_row[r] (-1: no cell).
+
+    Returns (cell_offsets (rows + 1,) int64, cell_vertices (K,) int32), the CSR of Diagram.
+    """
+    cdef Py_ssize_t rows = cell_of_row.shape[0], r
+    cdef int64_t c, total = 0
+    cell_offsets_arr = np.empty(rows + 1, np.int64)
+    cdef int64_t[::1] cell_offsets = cell_offsets_arr
+    with nogil:
+        for r in range(rows):
+            cell_offsets[r] = total
+            c = cell_of_row[r]
+            if c >= 0:
+                total += offsets[c + 1] - offsets[c]
+        cell_offsets[rows] = total
+    vertices_arr = np.empty(total, np.int32)
+    cdef int32_t[::1] out = vertices_arr
+    with nogil:
+        for r in range(rows):
+            c = cell_of_row[r]
+            if c >= 0 and offsets[c + 1] > offsets[c]:
+                memcpy(&out[cell_offsets[r]], &ring[offsets[c]], (offsets[c + 1] - offsets[c]) * sizeof(int32_t))
+    return cell_offsets_arr, vertices_arr
 
 
 def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind):

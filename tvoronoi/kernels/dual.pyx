@@ -9,6 +9,15 @@ from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 
+cdef extern from *:
+    """
+    #define TV_PREFETCH(p) __builtin_prefetch((const void*)(p))
+    """
+    void prefetch "TV_PREFETCH"(const void* p) noexcept nogil
+
+cdef enum:
+    AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
+
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
 #   he_twin[h]    the same edge seen from the neighbouring cell
@@ -105,6 +114,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         for a in range(n):
             if (a & POLL_MASK) == 0:
                 poll_signals()
+            if a + AHEAD < n and first_e[a + AHEAD] >= 0:
+                e = first_e[a + AHEAD]
+                prefetch(&tv[e])
+                prefetch(&opp[e])
+                prefetch(&vid[e // 3])
             e0 = first_e[a]
             if e0 < 0:
                 continue                # a repeated site, or none of the triangles (no cell)
