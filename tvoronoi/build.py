@@ -15,8 +15,9 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
-    s = t.sites
-    return assemble(pts, box, e, s.perm, s.xs, s.ys, t.voronoi(), engine=engine)
+    s, out = t.sites, t.voronoi()
+    del t                                            # the triangulation is not needed to clip
+    return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine)
 
 
 def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True) -> Diagram:
@@ -47,7 +48,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
 
     # the cell of a repeated point belongs to the first input row at that place
     root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
-    owner = perm.copy()                              # engine site -> input row owning its cell
+    owner = perm.astype(np.int32)                    # engine site -> input row owning its cell (a copy)
     if first_row_holds and (dup >= 0).any():
         np.minimum.at(owner, root, perm)
     site_of = np.empty(n, np.int32)
@@ -61,17 +62,21 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
 
     face_edge = np.full(n, -1, np.int32)
     face_edge[owner[firsts]] = out["face_edge"][firsts]
+    # engine sites to input rows in place (out is this build's own), and the vertices are the first
+    # rows of the clipper's points (the same doubles): no second copy of either
+    he_face = np.take(owner, out["he_face"], out=out["he_face"], mode="clip")
+    triangles = np.take(owner, out["triangles"], out=out["triangles"], mode="clip")
     return Diagram(
         sites=pts,
         site_of=site_of,
-        vertices=out["vertices"],
+        vertices=points[:len(out["vertices"])],
         he_origin=out["he_origin"],
         he_twin=out["he_twin"],
         he_next=out["he_next"],
         he_prev=out["he_prev"],
-        he_face=owner[out["he_face"]],
+        he_face=he_face,
         face_edge=face_edge,
-        triangles=np.take(owner, out["triangles"]).astype(np.int32, copy=False).reshape(-1, 3),
+        triangles=triangles.reshape(-1, 3),
         bbox=tuple(float(v) for v in box),
         cell_points=points,
         cell_offsets=cell_offsets,
