@@ -16,6 +16,8 @@ from setuptools import Extension, setup
 # rounded on its own; a fused multiply-add would silently break them.
 COMPILE_ARGS = ["-O3", "-ffp-contract=off", "-fno-math-errno"]
 LINK_ARGS: list[str] = []
+# OpenMP runs the independent loops of a phase (prange) on the threads a build is given
+OPENMP = ["-fopenmp"]
 DIRECTIVES = {
     "boundscheck": False,
     "wraparound": False,
@@ -39,8 +41,8 @@ extensions = [
     Extension(
         f"tvoronoi.kernels.{path.stem}",
         [str(path)],
-        extra_compile_args=COMPILE_ARGS,
-        extra_link_args=LINK_ARGS,
+        extra_compile_args=COMPILE_ARGS + OPENMP,
+        extra_link_args=LINK_ARGS + OPENMP,
     )
     for path in sorted(Path("tvoronoi/kernels").glob("*.pyx"))
 ]

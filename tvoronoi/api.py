@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -128,7 +129,7 @@ def as_bbox(bbox) -> tuple[float, float, float, float]:
 
 
 def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = "brio",
-            seed: int = 0, clip=None) -> Diagram:
+            seed: int = 0, clip=None, threads: int | None = None) -> Diagram:
     """The Voronoi diagram of a set of points, with its cells clipped to a box or to a region.
 
     Parameters
@@ -155,6 +156,9 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
         so that the cells tile it. Points outside get no cell (None in
         ``to_shapely``). The box defaults to the region's bounds grown by 1%;
         a ``bbox`` that does not hold the region cuts it too.
+    threads : int, optional
+        Threads for the phases that split (the Voronoi vertices, the cells' clipping); by default
+        every core this process may use. The Diagram is the same, bit for bit, for any count.
 
     Returns
     -------
@@ -178,6 +182,7 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
         raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
     if insertion not in INSERTION_ORDERS:
         raise EngineError(f"unknown insertion order {insertion!r}: choose one of {', '.join(INSERTION_ORDERS)}")
+    threads = as_threads(threads)
     from tvoronoi.build import build_diagram
 
     if clip is not None:
@@ -186,7 +191,20 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
         region = as_region(clip)
         box = region_box(region) if bbox is None else as_bbox(bbox)
         return clip_to_region(
-            pts, region, lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed)
+            pts, region,
+            lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed, threads=threads),
         )
     box = default_bbox(pts) if bbox is None else as_bbox(bbox)
-    return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed)
+    return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
+
+
+def as_threads(threads) -> int:
+    """The thread count of a build: a positive integer, or None for every core this process may use."""
+    if threads is None:
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:                       # no affinity on this platform
+            return max(1, os.cpu_count() or 1)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise TvoronoiError(f"threads must be a positive integer, got {threads!r}")
+    return int(threads)

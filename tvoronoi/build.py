@@ -10,17 +10,18 @@ from tvoronoi.errors import EngineError
 from tvoronoi.kernels import clip
 
 
-def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int) -> Diagram:
-    """Build the Diagram of checked points (n, 2) in the checked box."""
+def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int, threads: int = 1) -> Diagram:
+    """Build the Diagram of checked points (n, 2) in the checked box (threads: see api.voronoi)."""
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
-    s, out = t.sites, t.voronoi()
+    s, out = t.sites, t.voronoi(threads)
     del t                                            # the triangulation is not needed to clip
-    return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine)
+    return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 
 
-def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True) -> Diagram:
+def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True,
+             threads: int = 1) -> Diagram:
     """Clip an engine's DCEL and map it back to input rows.
 
     Parameters
@@ -35,13 +36,14 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
         A place shared by repeated points gets its cell under the first input
         row there (batch); False keeps it with the site the engine holds it by
         (dynamic diagrams, where the oldest copy at a place holds it).
+    threads : int, threads for clipping the cells (the same cells for any count)
     """
     n = len(pts)
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
     points, offsets, ring, status = clip.clip_cells(
         exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
-        out["he_face"], out["face_edge"], first.astype(np.int8), box, e,
+        out["he_face"], out["face_edge"], first.astype(np.int8), box, e, threads,
     )
     if status != 0:
         raise EngineError("the clipper found a cell whose edges do not chain: please report this input")

@@ -4,7 +4,8 @@ import numpy as np
 
 from libc.math cimport hypot
 from libc.stdlib cimport malloc, free
-from libc.string cimport memcpy
+from libc.string cimport memcpy, memmove
+from cython.parallel cimport prange
 from libc.stdint cimport int32_t, int64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -18,12 +19,14 @@ cdef enum:
     ENTRY = 2
     EXIT = 4
     WHOLE = 8       # the whole edge, both ends vertices in the closed box (the interior walk reads only flags)
+    PARALLEL_MIN_CELLS = 1 << 15    # fewer cells are clipped on one thread
 
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
                const int32_t[::1] he_origin, const int32_t[::1] he_twin,
                const int32_t[::1] he_next, const int32_t[::1] he_prev, const int32_t[::1] he_face,
-               const int32_t[::1] face_edge, const signed char[::1] active, box_tuple, int e):
+               const int32_t[::1] face_edge, const signed char[::1] active, box_tuple, int e, int threads=1,
+               int parallel_min=PARALLEL_MIN_CELLS):
     """Clip every cell to the box (xmin, ymin, xmax, ymax), exactly.
 
     Each edge is clipped once, so neighbouring cells share their points;
@@ -36,6 +39,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     he_* : (h,) int32, the Voronoi DCEL; face_edge : (n,) int32
     active : (n,) int8, 0 for a site without a cell of its own (a repeat)
     box_tuple : the box, user unit; e : the scale exponent
+    threads : cells are clipped on this many threads (the same result for any count), when there are
+        at least parallel_min of them
 
     Returns
     -------
@@ -58,20 +63,18 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int32_t[::1] seg_end = np.empty(n_he, np.int32)
     cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
-    cdef int32_t[::1] ring = np.empty(2 * n_he + 4 * n + 4, np.int32)     # 2 deg + 4 for each cell
     cdef double[:, ::1] pts
     cdef signed char[::1] pt_side
     cdef int32_t[::1] pt_a, pt_b, pt_c                         # how a boundary point was made (Points)
     cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0, n_bent = 0
-    cdef int n_cross = 0
+    cdef int n_cross = 0, lo, hi
     cdef int64_t n_ring = 0
     cdef double x, y
     cdef EdgePart part
     cdef Points P
-    cdef CellEdges C
     cdef bint has_o, has_d
-    C.cap = 0
 
+    cdef int T = threads if n >= parallel_min and threads > 1 else 1
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
         for v in range(m):
@@ -100,16 +103,14 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
         # the edges with both ends vertices in the box are whole; count the others (each makes at most
         # two new points)
+        # (each half-edge on its own: its end is where the next one of its cell starts, and the twin
+        # reaches the same verdict)
         for h in range(n_he):
-            tw = he_twin[h]
-            if tw < h:
-                continue
             o = he_origin[h]
-            d = he_origin[tw]
+            d = he_origin[he_next[h]]
             if o >= 0 and d >= 0 and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
                 flags[h] = HAS | WHOLE
-                flags[tw] = HAS | WHOLE
-            else:
+            elif he_twin[h] > h:
                 n_cross += 1
     pts = np.empty((m + 2 * n_cross + 4, 2), np.float64)
     pt_side = np.empty(m + 2 * n_cross + 4, np.int8)            # read only at exits and entries
@@ -186,71 +187,49 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         P.sy = &ys[0] if n > 0 else NULL
         P.corner0 = corner0
 
-        # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries
-        for i in range(n):
-            if (i & POLL_MASK) == 0:
-                poll_signals()
-            offsets[i] = n_ring
-            if not active[i]:
-                continue
-            # an interior cell: its vertices, already in order
-            h = face_edge[i]
-            cnt = 0
-            while h >= 0 and ((flags[h] & WHOLE) or (flags[h] == HAS and seg_start[h] == he_origin[h])):
-                ring[n_ring + cnt] = he_origin[h]
-                cnt += 1
-                h = he_next[h]
-                if h == face_edge[i]:
-                    break
-            if h == face_edge[i] and cnt > 0:
-                k = convex_ring(&ring[n_ring], cnt, &pts[0, 0])
-                if k < 0:
-                    k = finish_ring(&ring[n_ring], cnt, &pts[0, 0])
-                    if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
-                        n_bent += 1
-                n_ring += k
-                continue
-            # a cell that meets the box boundary: its edges' parts, then the walk
-            h = face_edge[i]
-            cnt = 0
-            while h >= 0:
-                cnt += 1
-                h = he_next[h]
-                if h == face_edge[i]:
-                    break
-            if not room_for(&C, cnt + 1):
-                status = 2
-                break
-            h = face_edge[i]
-            cnt = 0
-            while h >= 0:
-                if flags[h] & WHOLE:
-                    C.start[cnt] = he_origin[h]
-                    C.end[cnt] = he_origin[he_twin[h]]
-                else:
-                    C.start[cnt] = seg_start[h]
-                    C.end[cnt] = seg_end[h]
-                C.has[cnt] = (flags[h] & HAS) != 0
-                C.entry[cnt] = (flags[h] & ENTRY) != 0
-                C.exit_[cnt] = (flags[h] & EXIT) != 0
-                b = he_face[he_twin[h]]
-                C.nbx[cnt] = xs[b]
-                C.nby[cnt] = ys[b]
-                cnt += 1
-                h = he_next[h]
-                if h == face_edge[i]:
-                    break
-            k = walk_cell(&box, cnt, C.start, C.end, C.entry, C.exit_, C.has,
-                          &P, xs[i], ys[i], C.nbx, C.nby, &ring[n_ring])
-            if k < 0:
-                status = 1
-                continue
-            k = finish_ring(&ring[n_ring], k, &pts[0, 0])
-            if k > 0 and first_right_turn(&ring[n_ring], k, &pts[0, 0]) >= 0:
-                n_bent += 1
-            n_ring += k
+    # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries; the
+    # cells are split into one run per thread, each writing its rings into its own part of the buffer
+    # (room for the worst case of every cell), the parts then moved together
+    cdef int64_t cap = 2 * n_he + 4 * n + 4
+    cdef int32_t[::1] ring = np.empty(T * cap, np.int32)
+    cdef int64_t[::1] ends = np.zeros(T, np.int64)
+    cdef int[::1] bent = np.zeros(T, np.intc)
+    cdef int[::1] stat = np.zeros(T, np.intc)
+    cdef CellPass S
+    cdef int64_t shift
+    S.he_origin = &he_origin[0] if n_he > 0 else NULL
+    S.he_twin = &he_twin[0] if n_he > 0 else NULL
+    S.he_next = &he_next[0] if n_he > 0 else NULL
+    S.he_face = &he_face[0] if n_he > 0 else NULL
+    S.face_edge = &face_edge[0] if n > 0 else NULL
+    S.active = &active[0] if n > 0 else NULL
+    S.flags = &flags[0] if n_he > 0 else NULL
+    S.seg_start = &seg_start[0] if n_he > 0 else NULL
+    S.seg_end = &seg_end[0] if n_he > 0 else NULL
+    S.box = &box
+    S.P = &P
+    with nogil:
+        if T == 1:
+            ends[0] = clip_range(&S, 0, n, &ring[0], &offsets[0], 0, &bent[0], &stat[0])
+        else:
+            for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+                ends[k] = clip_range(&S, <int> (<int64_t> k * n // T), <int> (<int64_t> (k + 1) * n // T),
+                                     &ring[0], &offsets[0], k * cap, &bent[k], &stat[k])
+            n_ring = ends[0]
+            for k in range(1, T):
+                shift = k * cap - n_ring
+                lo = <int> (<int64_t> k * n // T)
+                hi = <int> (<int64_t> (k + 1) * n // T)
+                memmove(&ring[n_ring], &ring[k * cap], (ends[k] - k * cap) * sizeof(int32_t))
+                for i in range(lo, hi):
+                    offsets[i] -= shift
+                n_ring += ends[k] - k * cap
+            ends[0] = n_ring
+        n_ring = ends[0]
         offsets[n] = n_ring
-        release(&C)
+        for k in range(T):
+            n_bent += bent[k]
+            status = max(status, stat[k])
     if status == 2:
         raise MemoryError("no memory for the edges of a cell")
 
@@ -267,6 +246,104 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         kind[corner0:] = 0                               # a corner
         offs, rings = straighten(points, offs, rings, kind)
     return points, offs, rings, status
+
+
+cdef struct CellPass:
+    # what the walk over a run of cells reads
+    const int32_t* he_origin
+    const int32_t* he_twin
+    const int32_t* he_next
+    const int32_t* he_face
+    const int32_t* face_edge
+    const signed char* active
+    const signed char* flags
+    const int32_t* seg_start
+    const int32_t* seg_end
+    Box* box
+    Points* P
+
+
+cdef int64_t clip_range(CellPass* S, int lo, int hi, int32_t* ring, int64_t* offsets, int64_t n_ring,
+                        int* n_bent, int* status) except -1 nogil:
+    """The rings of cells lo..hi-1, written from ring[n_ring] on (offsets[i] is where cell i starts);
+    returns the end. status: 1 if the edges of some cell did not chain, 2 if memory ran out. A signal
+    handler's exception (interrupt.pxd, seen on the main thread) stops the run."""
+    cdef CellEdges C
+    C.cap = 0
+    try:
+        n_ring = clip_cells_of(S, lo, hi, ring, offsets, n_ring, n_bent, status, &C)
+    finally:
+        release(&C)
+    return n_ring
+
+
+cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* offsets, int64_t n_ring,
+                           int* n_bent, int* status, CellEdges* C) except -1 nogil:
+    cdef int i, h, cnt, k, b
+    cdef const double* pts = S.P.xy
+    for i in range(lo, hi):
+        if ((i - lo) & POLL_MASK) == 0:
+            poll_signals()
+        offsets[i] = n_ring
+        if not S.active[i]:
+            continue
+        # an interior cell: its vertices, already in order
+        h = S.face_edge[i]
+        cnt = 0
+        while h >= 0 and ((S.flags[h] & WHOLE) or (S.flags[h] == HAS and S.seg_start[h] == S.he_origin[h])):
+            ring[n_ring + cnt] = S.he_origin[h]
+            cnt += 1
+            h = S.he_next[h]
+            if h == S.face_edge[i]:
+                break
+        if h == S.face_edge[i] and cnt > 0:
+            k = convex_ring(&ring[n_ring], cnt, pts)
+            if k < 0:
+                k = finish_ring(&ring[n_ring], cnt, pts)
+                if k > 0 and first_right_turn(&ring[n_ring], k, pts) >= 0:
+                    n_bent[0] += 1
+            n_ring += k
+            continue
+        # a cell that meets the box boundary: its edges' parts, then the walk
+        h = S.face_edge[i]
+        cnt = 0
+        while h >= 0:
+            cnt += 1
+            h = S.he_next[h]
+            if h == S.face_edge[i]:
+                break
+        if not room_for(C, cnt + 1):
+            status[0] = 2
+            break
+        h = S.face_edge[i]
+        cnt = 0
+        while h >= 0:
+            if S.flags[h] & WHOLE:
+                C.start[cnt] = S.he_origin[h]
+                C.end[cnt] = S.he_origin[S.he_twin[h]]
+            else:
+                C.start[cnt] = S.seg_start[h]
+                C.end[cnt] = S.seg_end[h]
+            C.has[cnt] = (S.flags[h] & HAS) != 0
+            C.entry[cnt] = (S.flags[h] & ENTRY) != 0
+            C.exit_[cnt] = (S.flags[h] & EXIT) != 0
+            b = S.he_face[S.he_twin[h]]
+            C.nbx[cnt] = S.P.sx[b]
+            C.nby[cnt] = S.P.sy[b]
+            cnt += 1
+            h = S.he_next[h]
+            if h == S.face_edge[i]:
+                break
+        k = walk_cell(S.box, cnt, C.start, C.end, C.entry, C.exit_, C.has,
+                      S.P, S.P.sx[i], S.P.sy[i], C.nbx, C.nby, &ring[n_ring])
+        if k < 0:
+            status[0] = max(status[0], 1)
+            continue
+        k = finish_ring(&ring[n_ring], k, pts)
+        if k > 0 and first_right_turn(&ring[n_ring], k, pts) >= 0:
+            n_bent[0] += 1
+        n_ring += k
+    return n_ring
 
 
 cdef struct CellEdges:
@@ -305,7 +382,6 @@ cdef bint room_for(CellEdges* C, int k) noexcept nogil:
 cdef void release(CellEdges* C) noexcept nogil:
     if C.cap > 0:
         free(C.start); free(C.end); free(C.entry); free(C.exit_); free(C.has); free(C.nbx); free(C.nby)
-    C.cap = 0
 
 
 def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int64_t[::1] cell_of_row):

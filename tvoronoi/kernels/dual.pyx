@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from cython.parallel cimport prange
 from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.construct cimport circumcentre
@@ -17,6 +18,7 @@ cdef extern from *:
 
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
+    BLOCK = 1 << 16     # parallel loops run in blocks of this many, signals polled between
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
@@ -40,7 +42,7 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 
 
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
-                          const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0):
+                          const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -59,6 +61,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         (vertex n is the vertex at infinity).
     exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
         returned in the user's unit, each coordinate correctly rounded.
+    threads : int, threads for the circumcentres and the cocircular test (the result is the same
+        for any count).
 
     Returns
     -------
@@ -101,16 +105,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         first_e[tv[e]] = e
     centre = np.empty((n_finite, 2), np.float64)
     tri = np.empty((n_finite, 3), np.int32)
-    parent = np.empty(n_finite, np.int32)
-    cdef const int32_t* tvp = &tv[0] if n_he_d > 0 else NULL
-    cdef const double* xp = &xs[0] if n > 0 else NULL
-    cdef const double* yp = &ys[0] if n > 0 else NULL
-    cdef int32_t* vidp = &vid[0]
-    cdef double* cp = &centre[0, 0] if n_finite > 0 else NULL
-    cdef int32_t* trip = &tri[0, 0] if n_finite > 0 else NULL
-    cdef int32_t* pp = &parent[0] if n_finite > 0 else NULL
+    cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
+    cdef int n_zero = 0, lo, hi
 
     with nogil:
+        # the walk: half-edges cell by cell, each triangle's vertex numbered when first met
         for a in range(n):
             if (a & POLL_MASK) == 0:
                 poll_signals()
@@ -129,38 +128,13 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 if b != inf:
                     # the dual of a->b runs from the triangle on its right to the one on its left
                     o = opp[e]
-                    vr = vid[o // 3]
+                    t = o // 3
+                    vr = vid[t]
                     if vr == -1:
-                        vr = new_vertex(o // 3, m, tvp, xp, yp, exponent, vidp, cp, trip, pp)
+                        vr = m
+                        vid[t] = m
+                        tri[m, 0] = tv[3 * t]; tri[m, 1] = tv[3 * t + 1]; tri[m, 2] = tv[3 * t + 2]
                         m += 1
-                    vl = vid[e // 3]
-                    if vl == -1:
-                        vl = new_vertex(e // 3, m, tvp, xp, yp, exponent, vidp, cp, trip, pp)
-                        m += 1
-                    if vr >= 0 and vl >= 0:
-                        if merges > 0:
-                            vr = find(&parent[0], vr)
-                            vl = find(&parent[0], vl)
-                        if vr == vl:
-                            e = opp[prv(e)]
-                            if e == e0:
-                                break
-                            continue            # the two triangles already share their vertex
-                        # equal exact centres round to equal doubles, so only these can be cocircular
-                        if centre[vr, 0] == centre[vl, 0] and centre[vr, 1] == centre[vl, 1]:
-                            c = tv[prv(e)]
-                            d = tv[prv(o)]
-                            # degenerate case: four cocircular sites, a zero-length Voronoi edge
-                            if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0:
-                                if vr < vl:
-                                    parent[vl] = vr
-                                else:
-                                    parent[vr] = vl
-                                merges += 1
-                                e = opp[prv(e)]
-                                if e == e0:
-                                    break
-                                continue
                     vor[e] = h
                     he_origin[h] = vr if vr >= 0 else -1
                     he_face[h] = a
@@ -181,23 +155,33 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             he_next[h - 1] = h0
             he_prev[h0] = h - 1
 
-        if merges > 0:
-            # each group of cocircular triangles is one vertex: renumber the groups' first vertices in
-            # order (the walk met a group's smallest number first), keeping their centres
-            k = 0
-            for g in range(m):
-                if find(&parent[0], g) == g:
-                    vid[g] = k                  # vid is free now: vertex -> new number
-                    centre[k, 0] = centre[g, 0]
-                    centre[k, 1] = centre[g, 1]
-                    k += 1
-            for g in range(m):
-                if parent[g] != g:
-                    vid[g] = vid[parent[g]]     # parent[g] is a root after find, and smaller than g
-            for g in range(h):
-                if he_origin[g] >= 0:
-                    he_origin[g] = vid[he_origin[g]]
-            m = k
+        # every vertex: the correctly rounded circumcentre of its triangle (construct.circumcentre);
+        # in blocks, so that signals are seen between them
+        lo = 0
+        while lo < m:
+            poll_signals()
+            hi = lo + BLOCK if lo + BLOCK < m else m
+            for g in prange(lo, hi, num_threads=threads, schedule="static"):
+                circumcentre(xs[tri[g, 0]], ys[tri[g, 0]], xs[tri[g, 1]], ys[tri[g, 1]],
+                             xs[tri[g, 2]], ys[tri[g, 2]], exponent, &centre[g, 0], &centre[g, 1])
+            lo = hi
+
+        # zero-length edges: equal exact centres round to equal doubles, so only edges whose ends
+        # have equal rounded centres can join cocircular triangles; the exact in-circle test decides
+        lo = 0
+        while lo < h:
+            poll_signals()
+            hi = lo + BLOCK if lo + BLOCK < h else h
+            for g in prange(lo, hi, num_threads=threads, schedule="static"):
+                n_zero += zero_length(g, &he_origin[0], &he_next[0], &he_twin[0], &he_face[0],
+                                      &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0])
+            lo = hi
+    if n_zero > 0:
+        parent = np.arange(max(m, 1), dtype=np.int32)
+        with nogil:
+            m, h = drop_zero_edges(h, m, n, &he_origin[0], &he_twin[0], &he_next[0], &he_prev[0],
+                                   &he_face[0], &face_edge[0], &zero[0], &parent[0], &vid[0], &vor[0],
+                                   &centre[0, 0])
 
     return {
         "vertices": np.asarray(centre)[:m],
@@ -211,17 +195,91 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     }
 
 
-cdef inline int new_vertex(int t, int m, const int32_t* tv, const double* xs, const double* ys, int exponent,
-                           int32_t* vid, double* centre, int32_t* tri, int32_t* parent) noexcept nogil:
-    # vertex m: the correctly rounded circumcentre of finite triangle t (construct.circumcentre)
-    cdef int a = tv[3 * t], b = tv[3 * t + 1], c = tv[3 * t + 2]
-    vid[t] = m
-    circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], exponent, &centre[2 * m], &centre[2 * m + 1])
-    tri[3 * m] = a
-    tri[3 * m + 1] = b
-    tri[3 * m + 2] = c
-    parent[m] = m
-    return m
+cdef inline int zero_length(int g, const int32_t* he_origin, const int32_t* he_next, const int32_t* he_twin,
+                            const int32_t* he_face, const double* centre, const int32_t* tri,
+                            const double* xs, const double* ys, signed char* zero) noexcept nogil:
+    # is half-edge g (and its twin) of length zero, between cocircular triangles? Marks both; returns
+    # the count marked. Each edge is tested once, from its half-edge of smaller index.
+    cdef int vr = he_origin[g], vl = he_origin[he_next[g]], a, b, c, d
+    if vr < 0 or vl < 0 or he_twin[g] < g:
+        return 0
+    if centre[2 * vr] != centre[2 * vl] or centre[2 * vr + 1] != centre[2 * vl + 1]:
+        return 0
+    a = he_face[g]
+    b = he_face[he_twin[g]]
+    c = third(&tri[3 * vr], a, b)
+    d = third(&tri[3 * vl], a, b)
+    # degenerate case: four cocircular sites
+    if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) != 0:
+        return 0
+    zero[g] = 1
+    zero[he_twin[g]] = 1
+    return 2
+
+
+cdef inline int third(const int32_t* t, int a, int b) noexcept nogil:
+    # the site of triangle t that is neither a nor b
+    if t[0] != a and t[0] != b:
+        return t[0]
+    if t[1] != a and t[1] != b:
+        return t[1]
+    return t[2]
+
+
+cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t* he_twin, int32_t* he_next,
+                                int32_t* he_prev, int32_t* he_face, int32_t* face_edge,
+                                const signed char* zero, int32_t* parent, int32_t* vmap, int32_t* newh,
+                                double* centre) noexcept nogil:
+    """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
+    group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
+    each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts."""
+    cdef int g, k, u, w, a
+    for g in range(h):
+        if zero[g]:
+            u = find(parent, he_origin[g])
+            w = find(parent, he_origin[he_next[g]])
+            if u < w:
+                parent[w] = u
+            elif w < u:
+                parent[u] = w
+    k = 0
+    for g in range(m):
+        if find(parent, g) == g:
+            vmap[g] = k
+            centre[2 * k] = centre[2 * g]
+            centre[2 * k + 1] = centre[2 * g + 1]
+            k += 1
+    for g in range(m):
+        if parent[g] != g:
+            vmap[g] = vmap[parent[g]]     # parent[g] is its root after find, and smaller than g
+    m = k
+    k = 0
+    for g in range(h):
+        newh[g] = k
+        if not zero[g]:
+            k += 1
+    for g in range(h):
+        if zero[g]:
+            continue
+        he_origin[newh[g]] = vmap[he_origin[g]] if he_origin[g] >= 0 else -1
+        he_twin[newh[g]] = newh[he_twin[g]]
+        he_face[newh[g]] = he_face[g]
+    h = k
+    # the cells again: each is one run of equal faces
+    for g in range(n):
+        face_edge[g] = -1
+    g = 0
+    while g < h:
+        a = he_face[g]
+        k = g
+        while g < h and he_face[g] == a:
+            he_next[g] = g + 1
+            he_prev[g] = g - 1
+            g += 1
+        face_edge[a] = k
+        he_next[g - 1] = k
+        he_prev[k] = g - 1
+    return m, h
 
 
 def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0):
