@@ -18,7 +18,7 @@ cdef extern from *:
 
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
-    BLOCK = 1 << 16     # parallel loops run in blocks of this many, signals polled between
+    BLOCK = 1 << 18     # parallel loops run in blocks of this many, signals polled between
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
