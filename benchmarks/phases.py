@@ -1,0 +1,211 @@
+"""Where a build's time goes: each phase of tvoronoi.voronoi() in ns per site, next to other tools.
+
+For each distribution and size, and each engine and thread count, the phases of a build to bounded
+cells are timed one after the other, in interleaved repeats (the median is reported):
+
+  order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
+  tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep)
+  dual      the Voronoi half-edge structure and its correctly rounded vertices
+  cells     clipping every cell to the box and gathering the cells into input order
+
+and, on the same points, whole calls of other tools: Shewchuk's Triangle (`triangle.voronoi`: vertices
+and edges, no cells), Qhull (`scipy.spatial.Delaunay`, the triangulation alone), CGAL's
+`Delaunay_triangulation_2` through its Python bindings (the `cgal` package, if installed: the points
+made as CGAL objects, then inserted; both timed) and, up to --geos-max sites, GEOS
+(`shapely.voronoi_polygons`, cells). The peak memory of a whole `tvoronoi.voronoi()` build is measured
+in a fresh process for each engine (its maximum resident set, less that of the same process before the
+build).
+
+    python benchmarks/phases.py --sizes 1M --out benchmarks/results/phases
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.common import atomic_write, describe_machine, machine, parse_sizes, subprocess_env  # noqa: E402
+from tvoronoi import build, engines  # noqa: E402
+from tvoronoi.api import default_bbox  # noqa: E402
+from tvoronoi.generators import generate  # noqa: E402
+
+PHASES = ("order", "tri", "dual", "cells")
+DISTS = ("uniform", "gaussian", "clustered", "cluster_1e-9", "grid")
+
+
+def points(dist: str, n: int) -> np.ndarray:
+    """The benchmark's points: seeded, the same for every tool."""
+    if dist == "grid":
+        side = int(round(n ** 0.5))
+        g = np.arange(float(side))
+        x, y = np.meshgrid(g, g)
+        return np.c_[x.ravel(), y.ravel()]
+    if dist == "cluster_1e-9":
+        return 0.5 + 1e-9 * generate("uniform", n, seed=11)
+    return generate(dist, n, seed=11)
+
+
+def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
+    """One build to bounded cells, phase by phase (seconds)."""
+    box = default_bbox(pts)
+    t0 = time.perf_counter()
+    e = engines.scale_exponent(pts)
+    s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e)
+    t1 = time.perf_counter()
+    t = engines.triangulate(s, engine=engine)
+    t2 = time.perf_counter()
+    out = t.voronoi(threads)
+    del t
+    t3 = time.perf_counter()
+    d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+    t4 = time.perf_counter()
+    assert d.cell_offsets[-1] > 0
+    return {"order": t1 - t0, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3}
+
+
+def others(pts: np.ndarray, geos_max: int) -> dict:
+    """Whole calls of the other tools on the same points (seconds), where they are installed."""
+    out = {}
+    try:
+        import triangle
+
+        t0 = time.perf_counter()
+        triangle.voronoi(pts)
+        out["Triangle voronoi"] = time.perf_counter() - t0
+    except ImportError:
+        pass
+    from scipy.spatial import Delaunay
+
+    t0 = time.perf_counter()
+    Delaunay(pts)
+    out["Qhull Delaunay"] = time.perf_counter() - t0
+    try:
+        from CGAL.CGAL_Kernel import Point_2
+        from CGAL.CGAL_Triangulation_2 import Delaunay_triangulation_2
+
+        t0 = time.perf_counter()
+        cgal_points = [Point_2(float(x), float(y)) for x, y in pts]
+        t1 = time.perf_counter()
+        dt = Delaunay_triangulation_2()
+        dt.insert(cgal_points)
+        t2 = time.perf_counter()
+        out["CGAL points"] = t1 - t0
+        out["CGAL Delaunay insert"] = t2 - t1
+        del dt, cgal_points
+    except ImportError:
+        pass
+    if len(pts) <= geos_max:
+        import shapely
+
+        t0 = time.perf_counter()
+        shapely.voronoi_polygons(shapely.multipoints(pts), extend_to=shapely.box(*default_bbox(pts)),
+                                 ordered=True)
+        out["GEOS voronoi_polygons"] = time.perf_counter() - t0
+    gc.collect()
+    return out
+
+
+PEAK = """
+import resource, sys
+import numpy as np
+sys.path.insert(0, {repo!r})
+from benchmarks.phases import points
+import tvoronoi
+pts = points({dist!r}, {n})
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+tvoronoi.voronoi(pts, engine={engine!r}, threads={threads})
+print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024)
+"""
+
+
+def build_peak(dist: str, n: int, engine: str, threads: int) -> float:
+    """MiB a whole build adds to a fresh process's peak."""
+    code = PEAK.format(repo=str(Path(__file__).resolve().parent.parent), dist=dist, n=n, engine=engine,
+                       threads=threads)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=subprocess_env(),
+                         check=True)
+    return float(res.stdout.strip())
+
+
+def fmt_ns(seconds: float, n: int) -> str:
+    return f"{seconds / n * 1e9:,.0f}"
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--sizes", default="1M")
+    ap.add_argument("--dists", default=",".join(DISTS))
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--threads", default="1,2")
+    ap.add_argument("--geos-max", type=int, default=1_000_000)
+    ap.add_argument("--out", default="benchmarks/results/phases")
+    args = ap.parse_args(argv)
+    out_dir = Path(args.out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    info = machine()
+    thread_counts = [int(t) for t in args.threads.split(",")]
+    rows = []
+    for n in parse_sizes(args.sizes):
+        for dist in args.dists.split(","):
+            pts = points(dist, n)
+            n_pts = len(pts)
+            runs = {}
+            for _ in range(args.repeats):            # interleaved: every configuration once per round
+                for engine in ("incremental", "fortune"):
+                    for threads in thread_counts:
+                        gc.collect()
+                        runs.setdefault((engine, threads), []).append(time_phases(pts, engine, threads))
+            for (engine, threads), reps in runs.items():
+                med = {p: statistics.median(r[p] for r in reps) for p in PHASES}
+                med["total"] = statistics.median(sum(r[p] for p in PHASES) for r in reps)
+                rows.append({"n": n_pts, "dist": dist, "tool": f"tvoronoi {engine}", "threads": threads,
+                             **{p: med[p] for p in (*PHASES, "total")},
+                             "peak_mib": build_peak(dist, n, engine, threads)})
+                print(f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
+                      + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total")), flush=True)
+            for tool, seconds in others(pts, args.geos_max).items():
+                rows.append({"n": n_pts, "dist": dist, "tool": tool, "threads": 1, "total": seconds})
+                print(f"{dist:>13} n={n_pts:>9,} {tool}: {seconds * 1e3:.0f}ms", flush=True)
+    atomic_write(out_dir / "phases.json", json.dumps({"machine": info, "rows": rows}, indent=1))
+    atomic_write(out_dir / "phases.md", report(rows, info))
+    print(f"# wrote {out_dir / 'phases.md'}")
+
+
+def report(rows: list[dict], info: dict) -> str:
+    lines = ["# Where a build's time goes", "",
+             f"Machine: {describe_machine(info)}", "",
+             "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
+             "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells. The other tools are "
+             "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
+             "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
+             "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process.", ""]
+    for n in sorted({r["n"] for r in rows}):
+        for dist in dict.fromkeys(r["dist"] for r in rows if r["n"] == n):
+            sub = [r for r in rows if r["n"] == n and r["dist"] == dist]
+            lines += [f"## {dist}, n = {n:,}", "",
+                      "| build | threads | order | tri | dual | cells | total | peak MiB |",
+                      "|---|---:|---:|---:|---:|---:|---:|---:|"]
+            for r in sub:
+                if "order" in r:
+                    lines.append(f"| {r['tool']} | {r['threads']} | "
+                                 + " | ".join(fmt_ns(r[p], n) for p in PHASES)
+                                 + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | {r['peak_mib']:.0f} |")
+            for r in sub:
+                if "order" not in r:
+                    lines.append(f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | |")
+            lines.append("")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    main()
