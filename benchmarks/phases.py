@@ -160,6 +160,8 @@ def main(argv=None) -> None:
             pts = points(dist, n)
             n_pts = len(pts)
             runs = {}
+            for engine in ("incremental", "fortune"):   # warm-up, not timed: the process's memory, the caches
+                time_phases(pts, engine, 1)
             for _ in range(args.repeats):            # interleaved: every configuration once per round
                 for engine in ("incremental", "fortune"):
                     for threads in thread_counts:
