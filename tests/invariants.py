@@ -19,6 +19,11 @@ def check_dcel(d):
     assert np.all(d.he_face[d.he_twin] != d.he_face), "twins bound different cells"
     # the end of h is the start of next[h] (both may be at infinity)
     assert np.all(d.he_origin[d.he_next] == d.he_origin[d.he_twin])
+    # the layout: each cell's half-edges are one run, starting at face_edge
+    if len(h):
+        starts = np.flatnonzero(np.r_[True, d.he_face[1:] != d.he_face[:-1]])
+        assert len(np.unique(d.he_face[starts])) == len(starts), "a cell's half-edges are not consecutive"
+        assert np.array_equal(np.sort(d.face_edge[d.face_edge >= 0]), starts), "face_edge is not a run's start"
     # each cell's cycle holds exactly the half-edges of that cell
     counts = np.bincount(d.he_face, minlength=d.n_sites) if len(h) else np.zeros(d.n_sites, int)
     for i in range(d.n_sites):

@@ -100,7 +100,7 @@ def test_dual_and_clip_answer_signals(points, alarm):
     first = (out["dup"] < 0).astype(np.int8)
     box = default_bbox(points)
     assert stopped_in_kernel(alarm, lambda: clip.clip_cells(
-        s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
+        s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"],
         out["he_face"], out["face_edge"], first, box, s.exponent,
     )).endswith("clip.pyx")
 

@@ -87,9 +87,8 @@ def test_kernels_split_on_every_family(name):
     out = outs[0]
     active = (t.dup < 0).astype(np.int8)
     cells = [
-        clip.clip_cells(s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"],
-                        out["he_prev"], out["he_face"], out["face_edge"], active, box, e, threads,
-                        parallel_min=1)
+        clip.clip_cells(s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"],
+                        out["face_edge"], active, box, e, threads, parallel_min=1)
         for threads in (1, 2, 3)
     ]
     for got in cells[1:]:

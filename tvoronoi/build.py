@@ -42,8 +42,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
     points, offsets, ring, status = clip.clip_cells(
-        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_next"], out["he_prev"],
-        out["he_face"], out["face_edge"], first.astype(np.int8), box, e, threads,
+        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"], out["face_edge"], first.astype(np.int8), box, e, threads,
     )
     if status != 0:
         raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
@@ -74,8 +73,6 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
         vertices=points[:len(out["vertices"])],
         he_origin=out["he_origin"],
         he_twin=out["he_twin"],
-        he_next=out["he_next"],
-        he_prev=out["he_prev"],
         he_face=he_face,
         face_edge=face_edge,
         triangles=triangles.reshape(-1, 3),

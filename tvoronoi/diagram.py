@@ -23,15 +23,16 @@ class Diagram:
         The first input row with the same coordinates (itself if unique).
     vertices : (m, 2) float64
         Voronoi vertices (unclipped), one per distinct circumcircle.
-    he_origin, he_twin, he_next, he_prev, he_face : (h,) int32
+    he_origin, he_twin, he_face : (h,) int32
         The half-edge structure (DCEL). ``he_origin`` is -1 for a half-edge
-        coming from infinity; ``he_next`` cycles counter-clockwise around
-        the cell ``he_face`` (an input row), through infinity for an
-        unbounded cell. Half-edge h lies on the bisector of ``he_face[h]``
-        and ``he_face[he_twin[h]]``.
+        coming from infinity. Half-edge h lies on the bisector of
+        ``he_face[h]`` and ``he_face[he_twin[h]]``. The half-edges of a
+        cell are consecutive, counter-clockwise from ``face_edge`` (through
+        infinity for an unbounded cell): ``he_next`` and ``he_prev``,
+        derived on first use, follow that order.
     face_edge : (n,) int32
-        One half-edge of each cell, -1 where the cell has none (a lone site,
-        a repeated point).
+        The first half-edge of each cell, -1 where the cell has none (a lone
+        site, a repeated point).
     triangles : (k, 3) int32
         Delaunay triangles (input rows, counter-clockwise).
     bbox : (xmin, ymin, xmax, ymax)
@@ -51,8 +52,6 @@ class Diagram:
     vertices: np.ndarray
     he_origin: np.ndarray
     he_twin: np.ndarray
-    he_next: np.ndarray
-    he_prev: np.ndarray
     he_face: np.ndarray
     face_edge: np.ndarray
     triangles: np.ndarray
@@ -61,6 +60,23 @@ class Diagram:
     cell_offsets: np.ndarray
     cell_vertices: np.ndarray
     engine: str = "incremental"
+
+    @cached_property
+    def he_next(self) -> np.ndarray:
+        """(h,) int32: the next half-edge counter-clockwise around the same cell."""
+        f = self.he_face
+        nxt = np.arange(1, len(f) + 1, dtype=np.int32)
+        last = np.ones(len(f), bool)                  # the last half-edge of its cell
+        last[:-1] = f[1:] != f[:-1]
+        nxt[last] = self.face_edge[f[last]]
+        return nxt
+
+    @cached_property
+    def he_prev(self) -> np.ndarray:
+        """(h,) int32: the previous half-edge around the same cell."""
+        prev = np.empty(len(self.he_next), np.int32)
+        prev[self.he_next] = np.arange(len(self.he_next), dtype=np.int32)
+        return prev
 
     @property
     def n_sites(self) -> int:

@@ -24,7 +24,7 @@ cdef enum:
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
                const int32_t[::1] he_origin, const int32_t[::1] he_twin,
-               const int32_t[::1] he_next, const int32_t[::1] he_prev, const int32_t[::1] he_face,
+               const int32_t[::1] he_face,
                const int32_t[::1] face_edge, const signed char[::1] active, box_tuple, int e, int threads=1,
                int parallel_min=PARALLEL_MIN_CELLS):
     """Clip every cell to the box (xmin, ymin, xmax, ymax), exactly.
@@ -36,7 +36,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     ----------
     xs, ys : (n,) float64, the sites in the scaled unit (user = 2^e * scaled)
     vertices : (m, 2) float64, the Voronoi vertices, correctly rounded, user unit
-    he_* : (h,) int32, the Voronoi DCEL; face_edge : (n,) int32
+    he_* : (h,) int32, the Voronoi DCEL, laid out cell by cell; face_edge : (n,) int32, each cell's first
+        half-edge (its next ones follow while the face stays the same: dual.pyx)
     active : (n,) int8, 0 for a site without a cell of its own (a repeat)
     box_tuple : the box, user unit; e : the scale exponent
     threads : cells are clipped on this many threads (the same result for any count), when there are
@@ -96,7 +97,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             # the vertex is the circumcentre of the three cells around it
             a = he_face[h]
             b = he_face[he_twin[h]]
-            c = he_face[he_twin[he_prev[h]]]
+            c = he_face[he_twin[prev_in_cell(h, n_he, &he_face[0], &face_edge[0])]]
             vcx[v] = axis_code(vertices[v, 0], box.xmin, box.xmax, box.sxmin, box.sxmax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], False)
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
@@ -107,7 +108,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         # reaches the same verdict)
         for h in range(n_he):
             o = he_origin[h]
-            d = he_origin[he_next[h]]
+            d = he_origin[next_in_cell(h, n_he, &he_face[0], &face_edge[0])]
             if o >= 0 and d >= 0 and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
                 flags[h] = HAS | WHOLE
             elif he_twin[h] > h:
@@ -128,7 +129,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             tie[v] = 1
             pt_a[v] = he_face[h]
             pt_b[v] = he_face[he_twin[h]]
-            pt_c[v] = he_face[he_twin[he_prev[h]]]
+            pt_c[v] = he_face[he_twin[prev_in_cell(h, n_he, &he_face[0], &face_edge[0])]]
         for v in range(m):
             if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
                 pt_side[v] = code_side(vcx[v], vcy[v])
@@ -199,7 +200,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int64_t shift
     S.he_origin = &he_origin[0] if n_he > 0 else NULL
     S.he_twin = &he_twin[0] if n_he > 0 else NULL
-    S.he_next = &he_next[0] if n_he > 0 else NULL
+    S.n_he = n_he
     S.he_face = &he_face[0] if n_he > 0 else NULL
     S.face_edge = &face_edge[0] if n > 0 else NULL
     S.active = &active[0] if n > 0 else NULL
@@ -248,11 +249,28 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     return points, offs, rings, status
 
 
+cdef inline int next_in_cell(int h, int n_he, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
+    # the half-edge after h around its cell: the following one while the face is the same, else the first
+    if h + 1 < n_he and he_face[h + 1] == he_face[h]:
+        return h + 1
+    return face_edge[he_face[h]]
+
+
+cdef inline int prev_in_cell(int h, int n_he, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
+    # the half-edge before h around its cell (from the first, the cell's last)
+    cdef int a = he_face[h]
+    if h > face_edge[a]:
+        return h - 1
+    while h + 1 < n_he and he_face[h + 1] == a:
+        h += 1
+    return h
+
+
 cdef struct CellPass:
     # what the walk over a run of cells reads
     const int32_t* he_origin
     const int32_t* he_twin
-    const int32_t* he_next
+    int n_he
     const int32_t* he_face
     const int32_t* face_edge
     const signed char* active
@@ -293,7 +311,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
         while h >= 0 and ((S.flags[h] & WHOLE) or (S.flags[h] == HAS and S.seg_start[h] == S.he_origin[h])):
             ring[n_ring + cnt] = S.he_origin[h]
             cnt += 1
-            h = S.he_next[h]
+            h = next_in_cell(h, S.n_he, S.he_face, S.face_edge)
             if h == S.face_edge[i]:
                 break
         if h == S.face_edge[i] and cnt > 0:
@@ -309,7 +327,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
         cnt = 0
         while h >= 0:
             cnt += 1
-            h = S.he_next[h]
+            h = next_in_cell(h, S.n_he, S.he_face, S.face_edge)
             if h == S.face_edge[i]:
                 break
         if not room_for(C, cnt + 1):
@@ -331,7 +349,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
             C.nbx[cnt] = S.P.sx[b]
             C.nby[cnt] = S.P.sy[b]
             cnt += 1
-            h = S.he_next[h]
+            h = next_in_cell(h, S.n_he, S.he_face, S.face_edge)
             if h == S.face_edge[i]:
                 break
         k = walk_cell(S.box, cnt, C.start, C.end, C.entry, C.exit_, C.has,

@@ -23,7 +23,7 @@ cdef enum:
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
 #   he_twin[h]    the same edge seen from the neighbouring cell
-#   he_next[h], he_prev[h]  the cycle around the cell, counter-clockwise;
+#   the cycle around a cell, counter-clockwise: its half-edges, consecutive from face_edge (next_in_cell);
 #                 an unbounded cell's cycle closes through infinity: the edge
 #                 that runs off to infinity is followed by the one coming back
 #   he_face[h]    the site whose cell h bounds
@@ -66,9 +66,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
     Returns
     -------
-    dict of arrays: vertices (m, 2) float64; he_origin, he_twin, he_next,
-    he_prev, he_face (h,) int32; face_edge (n,) int32 (the first half-edge of each
-    cell, -1 for a site without one); triangles (k, 3) int32, the finite Delaunay triangles.
+    dict of arrays: vertices (m, 2) float64; he_origin, he_twin, he_face (h,) int32;
+    face_edge (n,) int32 (the first half-edge of each cell, -1 for a site without one); triangles
+    (k, 3) int32, the finite Delaunay triangles. The next half-edge of a cell is the following one
+    while the face stays the same, then the first again (next_in_cell).
     """
     cdef int n = xs.shape[0], inf = n
     cdef int n_he_d = tv.shape[0], n_tri = n_he_d // 3
@@ -77,8 +78,6 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] vor = np.full(n_he_d, -1, np.int32)     # Delaunay half-edge -> Voronoi half-edge
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] he_next = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] he_prev = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
@@ -146,14 +145,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 e = opp[prv(e)]
                 if e == e0:
                     break
-            if h == h0:
-                continue
-            face_edge[a] = h0
-            for g in range(h0, h):
-                he_next[g] = g + 1
-                he_prev[g] = g - 1
-            he_next[h - 1] = h0
-            he_prev[h0] = h - 1
+            if h > h0:
+                face_edge[a] = h0
 
         # every vertex: the correctly rounded circumcentre of its triangle (construct.circumcentre);
         # in blocks, so that signals are seen between them
@@ -173,34 +166,39 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             poll_signals()
             hi = lo + BLOCK if lo + BLOCK < h else h
             for g in prange(lo, hi, num_threads=threads, schedule="static"):
-                n_zero += zero_length(g, &he_origin[0], &he_next[0], &he_twin[0], &he_face[0],
+                n_zero += zero_length(g, h, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
                                       &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0])
             lo = hi
     if n_zero > 0:
         parent = np.arange(max(m, 1), dtype=np.int32)
         with nogil:
-            m, h = drop_zero_edges(h, m, n, &he_origin[0], &he_twin[0], &he_next[0], &he_prev[0],
-                                   &he_face[0], &face_edge[0], &zero[0], &parent[0], &vid[0], &vor[0],
-                                   &centre[0, 0])
+            m, h = drop_zero_edges(h, m, n, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
+                                   &zero[0], &parent[0], &vid[0], &vor[0], &centre[0, 0])
 
     return {
         "vertices": np.asarray(centre)[:m],
         "he_origin": np.asarray(he_origin)[:h],
         "he_twin": np.asarray(he_twin)[:h],
-        "he_next": np.asarray(he_next)[:h],
-        "he_prev": np.asarray(he_prev)[:h],
         "he_face": np.asarray(he_face)[:h],
         "face_edge": np.asarray(face_edge),
         "triangles": np.asarray(tri),
     }
 
 
-cdef inline int zero_length(int g, const int32_t* he_origin, const int32_t* he_next, const int32_t* he_twin,
-                            const int32_t* he_face, const double* centre, const int32_t* tri,
-                            const double* xs, const double* ys, signed char* zero) noexcept nogil:
+cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
+    # the half-edge after g around its cell: the following one while the face is the same, else the first
+    if g + 1 < h and he_face[g + 1] == he_face[g]:
+        return g + 1
+    return face_edge[he_face[g]]
+
+
+cdef inline int zero_length(int g, int h, const int32_t* he_origin, const int32_t* he_twin,
+                            const int32_t* he_face, const int32_t* face_edge, const double* centre,
+                            const int32_t* tri, const double* xs, const double* ys,
+                            signed char* zero) noexcept nogil:
     # is half-edge g (and its twin) of length zero, between cocircular triangles? Marks both; returns
     # the count marked. Each edge is tested once, from its half-edge of smaller index.
-    cdef int vr = he_origin[g], vl = he_origin[he_next[g]], a, b, c, d
+    cdef int vr = he_origin[g], vl = he_origin[next_in_cell(g, h, he_face, face_edge)], a, b, c, d
     if vr < 0 or vl < 0 or he_twin[g] < g:
         return 0
     if centre[2 * vr] != centre[2 * vl] or centre[2 * vr + 1] != centre[2 * vl + 1]:
@@ -226,10 +224,9 @@ cdef inline int third(const int32_t* t, int a, int b) noexcept nogil:
     return t[2]
 
 
-cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t* he_twin, int32_t* he_next,
-                                int32_t* he_prev, int32_t* he_face, int32_t* face_edge,
-                                const signed char* zero, int32_t* parent, int32_t* vmap, int32_t* newh,
-                                double* centre) noexcept nogil:
+cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t* he_twin, int32_t* he_face,
+                                int32_t* face_edge, const signed char* zero, int32_t* parent, int32_t* vmap,
+                                int32_t* newh, double* centre) noexcept nogil:
     """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
     group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
     each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts."""
@@ -237,7 +234,7 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     for g in range(h):
         if zero[g]:
             u = find(parent, he_origin[g])
-            w = find(parent, he_origin[he_next[g]])
+            w = find(parent, he_origin[next_in_cell(g, h, he_face, face_edge)])
             if u < w:
                 parent[w] = u
             elif w < u:
@@ -268,17 +265,9 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     # the cells again: each is one run of equal faces
     for g in range(n):
         face_edge[g] = -1
-    g = 0
-    while g < h:
-        a = he_face[g]
-        k = g
-        while g < h and he_face[g] == a:
-            he_next[g] = g + 1
-            he_prev[g] = g - 1
-            g += 1
-        face_edge[a] = k
-        he_next[g - 1] = k
-        he_prev[k] = g - 1
+    for g in range(h):
+        if g == 0 or he_face[g] != he_face[g - 1]:
+            face_edge[he_face[g]] = g
     return m, h
 
 
@@ -306,37 +295,21 @@ def voronoi_collinear(const double[::1] xs, const double[::1] ys):
     cdef int n = xs.shape[0], k, n_he = 2 * max(n - 1, 0)
     cdef int32_t[::1] he_origin = np.full(n_he, -1, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he, np.int32)
-    cdef int32_t[::1] he_next = np.empty(n_he, np.int32)
-    cdef int32_t[::1] he_prev = np.empty(n_he, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he, np.int32)
     cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
-    # half-edge 2k bounds site k (bisector of k, k+1); half-edge 2k+1 bounds site k+1
+    # half-edge 2k bounds site k (bisector of k, k+1); half-edge 2k+1 bounds site k+1: the cell of site
+    # k is half-edges 2k-1 and 2k, consecutive (one of them at either end)
     for k in range(n - 1):
         he_twin[2 * k] = 2 * k + 1
         he_twin[2 * k + 1] = 2 * k
         he_face[2 * k] = k
         he_face[2 * k + 1] = k + 1
-        face_edge[k] = 2 * k
-        face_edge[k + 1] = 2 * k + 1
-    for k in range(n):
-        # a middle strip: its two bounding lines follow each other through infinity
-        if 0 < k < n - 1:
-            he_next[2 * k] = 2 * k - 1
-            he_prev[2 * k] = 2 * k - 1
-            he_next[2 * k - 1] = 2 * k
-            he_prev[2 * k - 1] = 2 * k
-        elif n > 1 and k == 0:
-            he_next[0] = 0
-            he_prev[0] = 0
-        elif n > 1:
-            he_next[2 * k - 1] = 2 * k - 1
-            he_prev[2 * k - 1] = 2 * k - 1
+    for k in range(n if n > 1 else 0):
+        face_edge[k] = 2 * k - 1 if k > 0 else 0
     return {
         "vertices": np.empty((0, 2), np.float64),
         "he_origin": np.asarray(he_origin),
         "he_twin": np.asarray(he_twin),
-        "he_next": np.asarray(he_next),
-        "he_prev": np.asarray(he_prev),
         "he_face": np.asarray(he_face),
         "face_edge": np.asarray(face_edge),
         "triangles": np.empty((0, 3), np.int32),
