@@ -1,5 +1,7 @@
 """A Delaunay triangulation that changes locally: insert, remove and relabel sites; read one cell."""
 
+import math
+
 import numpy as np
 
 from libc.stdint cimport int8_t, int32_t, int64_t, uint64_t
@@ -7,7 +9,7 @@ from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between
-from tvoronoi.kernels.location cimport locate
+from tvoronoi.kernels.location cimport jump_note, jump_start, locate
 from tvoronoi.kernels.cavity cimport find_cavity
 from tvoronoi.kernels.fill cimport insert_site, fill_cavity
 from libc.stdlib cimport malloc, free
@@ -63,6 +65,7 @@ cdef class DynamicMesh:
     cdef int32_t mark_epoch
     cdef int32_t* nextb             # scratch: the boundary edge leaving each site
     cdef int cap_v, cap_t
+    cdef object jump_cells          # the jump grid's array (location.jump_start), made by load
     cdef Scratch scratch            # scratch of one update, grown to the largest hole or region met
 
     def __cinit__(self):
@@ -88,6 +91,9 @@ cdef class DynamicMesh:
         self.m.n_tri = 0
         self.m.n_free = 0
         self.m.last = -1
+        self.m.jump_g = 0
+        self.m.jump_grid = NULL
+        self.m.walk_steps = 0
         self.m.epoch = 0
         self.m.inf = INF_VERTEX
         self.m.n = 0
@@ -169,6 +175,31 @@ cdef class DynamicMesh:
             if not is_infinite(&self.m, k):
                 self.m.n_finite += 1
                 self.m.last = k
+        self._grid(xs, ys, ids)
+
+    def _grid(self, const double[::1] xs, const double[::1] ys, const int32_t[::1] ids):
+        """The jump grid over the loaded sites: about four sites a cell, each cell holding one of them."""
+        cdef int n = xs.shape[0], k, g
+        cdef int32_t[::1] cells
+        if n == 0:
+            return
+        x0, x1, y0, y1 = float(np.min(xs)), float(np.max(xs)), float(np.min(ys)), float(np.max(ys))
+        g = max(1, min(4096, int((n / 4) ** 0.5)))
+        self.jump_cells = np.full(g * g, -1, np.int32)
+        cells = self.jump_cells
+        self.m.jump_grid = &cells[0]
+        self.m.jump_g = g
+        self.m.jump_x0 = x0
+        self.m.jump_y0 = y0
+        self.m.jump_sx = g / (x1 - x0) if x1 > x0 and math.isfinite(g / (x1 - x0)) else 0.0
+        self.m.jump_sy = g / (y1 - y0) if y1 > y0 and math.isfinite(g / (y1 - y0)) else 0.0
+        for k in range(n):
+            jump_note(&self.m, ids[k])
+
+    @property
+    def walk_steps(self):
+        """Triangles the last point location visited (for tests)."""
+        return self.m.walk_steps
 
     @property
     def n_finite(self):
@@ -190,11 +221,12 @@ cdef class DynamicMesh:
         self.m.dup[site] = -1
         self.m.n_changed = 0
         with nogil:
-            t0 = locate(&self.m, self.m.last, x, y)
+            t0 = locate(&self.m, jump_start(&self.m, x, y), x, y)
             before = self.m.n_tri - self.m.n_free
             insert_site(&self.m, site, t0)
         if self.m.dup[site] >= 0:
             return self.m.dup[site]
+        jump_note(&self.m, site)
         self.m.changed[self.m.n_changed] = site
         self.m.n_changed += 1
         return -1
@@ -233,6 +265,7 @@ cdef class DynamicMesh:
             status = insert_by_sweep(&self.m, site, self.vmark, self.mark_epoch, self.nextb, &self.scratch)
         if status == -2:
             return self.m.dup[site]
+        jump_note(&self.m, site)
         self.swept_ok = status == 1
         self.m.changed[self.m.n_changed] = site
         self.m.n_changed += 1
@@ -833,7 +866,7 @@ cdef int insert_by_sweep(Mesh* m, int site, int32_t* mark, int32_t epoch, int32_
     cdef double* ys
     cdef int n = 0, q, a, b, e0, e, nt, k, j, lp = -1, matched = 0, nextb_inf = -1, bound = 1
     cdef bint ok = True
-    cdef int t0 = locate(m, m.last, m.x[site], m.y[site])
+    cdef int t0 = locate(m, jump_start(m, m.x[site], m.y[site]), m.x[site], m.y[site])
     if not find_cavity(m, site, t0):
         return -2
     # the region's size, at most: the new site, each boundary site and its neighbours

@@ -2,7 +2,44 @@
 # conflict lists (the textbook random order); inline, compiled where cimported.
 
 from tvoronoi.kernels.predicates cimport orient2d
-from tvoronoi.kernels.mesh cimport Mesh, is_infinite, nxt
+from tvoronoi.kernels.mesh cimport Mesh, is_infinite, nxt, prv
+
+cdef inline int jump_cell(Mesh* m, double px, double py) noexcept nogil:
+    # the cell of the jump grid holding p (points outside it: the nearest border cell)
+    cdef double fx = (px - m.jump_x0) * m.jump_sx, fy = (py - m.jump_y0) * m.jump_sy
+    cdef int i, j, g = m.jump_g
+    i = 0 if not fx > 0.0 else (g - 1 if fx >= g else <int> fx)
+    j = 0 if not fy > 0.0 else (g - 1 if fy >= g else <int> fy)
+    return j * g + i
+
+
+cdef inline void jump_note(Mesh* m, int site) noexcept nogil:
+    # a site just placed in the mesh becomes its grid cell's start
+    if m.jump_g > 0:
+        m.jump_grid[jump_cell(m, m.x[site], m.y[site])] = site
+
+
+cdef inline int jump_start(Mesh* m, double px, double py) noexcept nogil:
+    """Where a dynamic diagram's walk to p starts (jump and walk): a finite triangle around the site
+    last placed in p's cell of a coarse grid over the sites (about four sites a cell), or the last
+    triangle when that site has left the mesh. The walk from there is exact; the grid only shortens
+    it, to a few triangles where the walk from the last triangle crosses O(sqrt n) of them."""
+    cdef int s, e, e0
+    if m.jump_g <= 0:
+        return m.last
+    s = m.jump_grid[jump_cell(m, px, py)]
+    if s < 0:
+        return m.last
+    e0 = m.vedge[s]
+    if e0 < 0 or m.tv[e0] != s:
+        return m.last               # removed since, or its place taken by a repeat
+    e = e0
+    while True:
+        if not is_infinite(m, e // 3):
+            return e // 3
+        e = m.opp[prv(e)]
+        if e == e0:
+            return m.last
 
 
 cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
@@ -12,10 +49,12 @@ cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
     edge that p sees strictly: either way p is strictly inside its circle.
     The visibility walk terminates in a Delaunay triangulation.
     """
-    cdef int k, e, a, b, came = -1
+    cdef int k, e, a, b, came = -1, steps = 0
     cdef bint moved
     while True:
+        steps += 1
         if is_infinite(m, t):
+            m.walk_steps = steps
             return t
         moved = False
         for k in range(3):
@@ -30,6 +69,7 @@ cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
                 moved = True
                 break
         if not moved:
+            m.walk_steps = steps
             return t
 
 

@@ -51,6 +51,13 @@ cdef struct Mesh:
     int32_t* vedge
     int32_t* changed
     int n_changed
+    int32_t* jump_grid  # dynamic diagrams: a recent site in each cell of a g x g grid over the sites
+    int jump_g          #   (location.jump_start), its size, origin and cells per unit
+    double jump_x0
+    double jump_y0
+    double jump_sx
+    double jump_sy
+    int walk_steps      # triangles the last walk visited (for tests)
     int n_finite        # finite triangles (kept up to date only where vedge is kept)
     int n
     int inf
