@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import re
 import signal
@@ -12,7 +11,7 @@ import warnings
 from contextlib import contextmanager
 
 from tvoronoi import __version__
-from tvoronoi.api import ENGINES, INSERTION_ORDERS
+from tvoronoi.api import ENGINES, INSERTION_ORDERS, as_bbox, check_engine
 from tvoronoi.errors import CoordinateRangeError, TvoronoiError
 from tvoronoi.fileio import STDIO
 from tvoronoi.readers import FORMATS
@@ -79,29 +78,13 @@ class OutputError(Exception):
 
 
 def parse_bbox(text: str) -> tuple[float, float, float, float]:
-    """Parse ``--bbox XMIN,YMIN,XMAX,YMAX``; errors name the value given.
+    """Parse ``--bbox XMIN,YMIN,XMAX,YMAX`` with the API's box check; errors name the value given.
 
     >>> parse_bbox("-1,0,2.5,1e3")
     (-1.0, 0.0, 2.5, 1000.0)
     """
-    parts = [part.strip() for part in text.split(",")]
-    if len(parts) != 4:
-        raise TvoronoiError(
-            f"--bbox {text!r}: expected four numbers XMIN,YMIN,XMAX,YMAX separated by commas, got {len(parts)}"
-        )
-    values = []
-    for part in parts:
-        try:
-            value = float(part)
-        except ValueError:
-            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a number; expected XMIN,YMIN,XMAX,YMAX") from None
-        if not math.isfinite(value):
-            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a finite number")
-        values.append(value)
-    xmin, ymin, xmax, ymax = values
-    if not (xmin < xmax and ymin < ymax):
-        raise TvoronoiError(f"--bbox {text!r}: the box is empty; it needs XMIN < XMAX and YMIN < YMAX")
-    return xmin, ymin, xmax, ymax
+    return as_bbox([part.strip() for part in text.split(",")], what=f"--bbox {text!r}",
+                   names=("XMIN", "YMIN", "XMAX", "YMAX"), sep=",")
 
 
 def parse_delimiter(text: str) -> str:
@@ -279,9 +262,10 @@ def _batch_run(args, phases: Phases) -> int:
         require_pyarrow()
     if args.lloyd is not None and args.lloyd < 0:
         raise TvoronoiError(f"--lloyd {args.lloyd}: give a number of iterations, 0 or more")
+    # the engine and its options pass the API's own checks before a large file is read (the box's
+    # range against the sites' scale waits for the sites)
+    check_engine(args.engine, args.insertion)
     options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
-    # the engine and its options pass the API's own checks before a large file is read
-    voronoi(np.empty((0, 2)), **options)
     region = None
     if args.clip is not None:
         from tvoronoi.readers.clip_region import read_region

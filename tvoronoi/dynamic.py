@@ -7,10 +7,10 @@ import math
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox
+from tvoronoi.api import as_bbox, as_points, check_engine, check_range, default_bbox
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
-from tvoronoi.errors import EngineError, TvoronoiError
+from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import dual, dynamic
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
@@ -57,8 +57,7 @@ class DynamicVoronoi:
 
     def __init__(self, points=(), *, engine: str = "incremental", bbox=None):
         pts = as_points(points)
-        if engine not in ENGINES:
-            raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
+        check_engine(engine)
         self.engine = engine
         self.bbox = default_bbox(pts) if bbox is None else as_bbox(bbox)
         # the one range rule (tvoronoi.api): the mesh holds sites scaled by 2^-e, e fixed by the box and
