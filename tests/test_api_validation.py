@@ -1,6 +1,6 @@
 """Bad input to the API: every check happens once, in tvoronoi.api, and its message names the culprit.
 
-voronoi, DynamicVoronoi and lloyd share the checks of points, box and engine; the CLI's
+voronoi, DynamicVoronoi, lloyd and steps share the checks of points, box and engine; the CLI's
 --bbox and --engine use the same ones (their CLI spelling: tests/test_cli.py).
 """
 
@@ -52,7 +52,9 @@ def test_bad_boxes_name_the_value(bbox, message):
     assert str(caught.value) == message
     # the same check, the same words, everywhere a box is taken
     for call in (lambda: tvoronoi.DynamicVoronoi([[0.5, 0.5]], bbox=bbox),
-                 lambda: tvoronoi.lloyd([[0.5, 0.5]], 1, bbox=bbox)):
+                 lambda: tvoronoi.lloyd([[0.5, 0.5]], 1, bbox=bbox),
+                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="fortune", bbox=bbox),
+                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="incremental", bbox=bbox)):
         with pytest.raises(tvoronoi.TvoronoiError) as again:
             call()
         assert str(again.value) == message
@@ -110,6 +112,7 @@ def test_unknown_engine_and_order():
     with pytest.raises(tvoronoi.TvoronoiError, match="unknown insertion order 'sorted': choose one of brio, random"):
         tvoronoi.voronoi([[0, 0]], insertion="sorted")
     for call in (lambda: tvoronoi.DynamicVoronoi([[0, 0]], engine="qhull"),
+                 lambda: tvoronoi.steps([[0, 0]], engine="qhull"),
                  lambda: check_engine("qhull")):
         with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull'"):
             call()

@@ -48,10 +48,7 @@ async def start_playback(app, pilot, engine="incremental"):
 def expected_describe(app, k: int) -> str:
     """What the step k of a fresh trace of the same points and engine says."""
     built = app.built
-    if built.diagram.engine == "fortune":
-        trace = tvoronoi.fortune_steps(built.points)
-    else:
-        trace = tvoronoi.incremental_steps(built.points, bbox=built.diagram.bbox)
+    trace = tvoronoi.steps(built.points, engine=built.diagram.engine, bbox=built.diagram.bbox)
     return trace.step(k).describe()
 
 
