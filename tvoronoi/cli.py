@@ -9,12 +9,16 @@ import signal
 import sys
 import warnings
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from tvoronoi import __version__
 from tvoronoi.api import ENGINES, INSERTION_ORDERS, as_bbox, check_engine
 from tvoronoi.errors import CoordinateRangeError, TvoronoiError
 from tvoronoi.fileio import STDIO
 from tvoronoi.readers import FORMATS
+
+if TYPE_CHECKING:
+    from rich.progress import Progress
 
 PROG = "tvoronoi"
 # inputs this large show a progress display (on a terminal, without -q)
@@ -324,7 +328,12 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{repeats} repeated point{'s share' if repeats > 1 else ' shares'} the cell of an earlier "
                 f'point (see "duplicates" in the output)'
             )
-        outside = diagram.n_outside if region is not None else 0
+        outside = 0
+        if region is not None:
+            from tvoronoi.region import ClippedDiagram
+
+            assert isinstance(diagram, ClippedDiagram), "voronoi(clip=...) returns a ClippedDiagram"
+            outside = diagram.n_outside
         if outside and not args.quiet:
             which = "sites lie" if outside > 1 else "site lies"
             phases.warn(f'{outside} {which} outside the --clip region {args.clip}: written with "geometry": null')
@@ -441,7 +450,7 @@ class Phases:
 
     def __init__(self, *, enabled: bool):
         self.enabled = enabled
-        self.progress = None
+        self.progress: Progress | None = None
 
     def __enter__(self) -> Phases:
         return self
@@ -479,16 +488,17 @@ class Phases:
     @contextmanager
     def counter(self, label: str):
         """A phase that counts; the block passes the yielded function as a progress(done, total) callback."""
-        if self.progress is None:
+        bar = self.progress
+        if bar is None:
             yield None
             return
-        task = self.progress.add_task(label, total=None, detail="")
+        task = bar.add_task(label, total=None, detail="")
 
         def progress(done: int, total: int) -> None:
-            self.progress.update(task, completed=done, total=total, detail=f"{done:,}/{total:,}")
+            bar.update(task, completed=done, total=total, detail=f"{done:,}/{total:,}")
 
         yield progress
-        self.progress.update(task, total=1, completed=1)
+        bar.update(task, total=1, completed=1)
 
     def note(self, message: str) -> None:
         """Tell what was chosen for the user (e.g. the x and y columns)."""

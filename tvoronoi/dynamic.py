@@ -117,7 +117,7 @@ class DynamicVoronoi:
             return
         # the batch engine's order (a biased randomized insertion order, or the sweep's)
         t = engines.run(self._xy[ids, 0], self._xy[ids, 1], engine=self.engine, exponent=self._e)
-        sx, sy, dup, ok = t.sites.xs, t.sites.ys, t.dup, not t.flat
+        sx, sy, dup = t.sites.xs, t.sites.ys, t.dup
         order_ids = ids[t.sites.perm]
         # repeats: the smallest id at a place holds it
         groups: dict[int, list[int]] = {}
@@ -130,8 +130,8 @@ class DynamicVoronoi:
             self._copies[everyone[0]] = everyone[1:]
             for c in everyone[1:]:
                 self._primary[c] = everyone[0]
-        if not ok:
-            return
+        if t.tv is None or t.opp is None:
+            return      # the distinct sites are collinear (t.flat): no mesh until a site leaves the line
         mesh = dynamic.DynamicMesh(max(len(self._xy), 16))
         mesh.load(sx, sy, order_ids.astype(np.int32), t.tv, t.opp, len(sx))
         for k, holder in holder_of_vertex.items():

@@ -100,6 +100,7 @@ class FortuneStep:
             return f"site event at ({x:.4g}, {y:.4g}): site {self.site} splits an arc"
         if self.kind == "repeat":
             return f"site {self.site} repeats an earlier site at ({x:.4g}, {y:.4g}): no new arc"
+        assert self.vertex is not None, "a circle event creates a vertex"
         vx, vy = self.vertex
         return (f"circle event at ({vx:.4g}, {vy:.4g}): vertex {len(self.vertices) - 1} created, "
                 f"arc of site {self.site} vanishes")
