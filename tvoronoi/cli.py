@@ -244,8 +244,8 @@ def _batch_run(args, phases: Phases) -> int:
 
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
-    from tvoronoi.writers.geoparquet import crs_name, projjson
     from tvoronoi.writers.geojson_diagram import missing_cells, write_cells, write_delaunay
+    from tvoronoi.writers.geoparquet import crs_name, projjson
     from tvoronoi.writers.targets import descriptor_of, is_direct, output_file
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)

@@ -13,6 +13,7 @@ from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import dual, dynamic
 
+
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
     """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
     try:

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tvoronoi.api import as_bbox, as_points, check_engine, default_bbox
 from tvoronoi import engines
+from tvoronoi.api import as_bbox, as_points, check_engine, default_bbox
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
 from tvoronoi.kernels import dual, fortune, incremental
