@@ -1,4 +1,4 @@
-# tvoronoi: `make run` starts the terminal UI, `make test` lints (ruff) and runs every test.
+# tvoronoi: `make run` starts the terminal UI, `make test` lints (ruff), type-checks (mypy) and runs every test.
 # Each target does its own set-up: a .venv, the package installed editable
 # with its extras, and the Cython kernels rebuilt when their sources change.
 PYTHON ?= python3
@@ -44,6 +44,7 @@ run: setup
 
 test: setup checked
 	$(BIN)/ruff check tvoronoi tests benchmarks
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
 
 bench-quick: setup

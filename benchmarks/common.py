@@ -141,9 +141,8 @@ def machine() -> dict:
     info["versions"] = versions
     info["thread_env"] = {v: os.environ.get(v, "unset") for v in THREAD_VARS}
     try:
-        from threadpoolctl import threadpool_info
-
         import scipy.spatial  # noqa: F401  (loads the BLAS that scipy links, if any)
+        from threadpoolctl import threadpool_info
 
         info["threadpools"] = [
             {k: p.get(k) for k in ("internal_api", "prefix", "version", "num_threads", "threading_layer")}

@@ -164,13 +164,12 @@ def pick_fortune_steps(trace, panels: int) -> list[int]:
 def make_figures(out: Path, n: int = N_SITES, seed: int = SEED) -> list[Path]:
     """Write fortune_steps.png and incremental_steps.png into out."""
     import tvoronoi
-    from tvoronoi.api import default_bbox
 
     pts = tvoronoi.generate("uniform", n, seed=seed)
-    box = default_bbox(pts)
     paths = []
 
-    trace = tvoronoi.fortune_steps(pts)
+    trace = tvoronoi.steps(pts, engine="fortune")
+    box = trace.bbox
     plt, fig, axes = _figure(2, PANELS // 2)
     for ax, k in zip(axes, pick_fortune_steps(trace, PANELS)):
         fortune_panel(ax, pts, trace.step(k), box)
@@ -179,7 +178,7 @@ def make_figures(out: Path, n: int = N_SITES, seed: int = SEED) -> list[Path]:
     paths.append(out / "fortune_steps.png")
     _save(plt, fig, paths[-1])
 
-    trace = tvoronoi.incremental_steps(pts)
+    trace = tvoronoi.steps(pts, engine="incremental")
     plt, fig, axes = _figure(2, PANELS // 2)
     ks = np.linspace(5, n, PANELS).round().astype(int)
     for ax, k in zip(axes, ks.tolist()):

@@ -36,8 +36,20 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import (CHECK_COLUMNS, RESULTS, atomic_write, machine, maxrss_mib, parse_sizes,  # noqa: E402
-                    release_free_memory, reset_peak, rss_mib, send, subprocess_env, write_csv)
+from common import (  # noqa: E402
+    CHECK_COLUMNS,
+    RESULTS,
+    atomic_write,
+    machine,
+    maxrss_mib,
+    parse_sizes,
+    release_free_memory,
+    reset_peak,
+    rss_mib,
+    send,
+    subprocess_env,
+    write_csv,
+)
 from tools import TOOLS, CheckFailed  # noqa: E402
 
 FULL = {

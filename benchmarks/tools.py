@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+
 from tvoronoi.trace import circumcentres
 
 # Relative tolerances of the checks: distances against the box size, areas against the box area.

@@ -20,8 +20,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import adversarial  # noqa: E402
-from checked_build import build_only, checked_worker  # noqa: E402
 import exact_checks  # noqa: E402
+from checked_build import build_only, checked_worker  # noqa: E402
 from fixtures_io import FIXTURES, load_fixture  # noqa: E402
 from hunt_worker import CHECK_NAMES, Worker, load_cells, uninit_result  # noqa: E402
 

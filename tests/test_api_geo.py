@@ -9,10 +9,9 @@ import pytest
 import shapely
 
 import tvoronoi
+from conftest import DATASETS, SEED
 from tvoronoi import TvoronoiError
 from tvoronoi.api import as_points
-
-from conftest import DATASETS, SEED
 
 gpd = pytest.importorskip("geopandas")
 pd = pytest.importorskip("pandas")

@@ -224,12 +224,35 @@ def test_nan_coordinate(capsys, tmp_path):
 
 @pytest.mark.parametrize(
     "value, why",
-    [("1,2,3", "four numbers"), ("0,0,a,1", "'a' is not a number"), ("0,0,inf,1", "finite"),
-     ("1,0,0,1", "empty"), ("", "four numbers")],
+    [("1,2,3", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 3"),
+     ("0,0,a,1", "'a' is not a number; expected XMIN,YMIN,XMAX,YMAX"),
+     ("0,0,inf,1", "'inf' is not a finite number"),
+     ("0, 0,nan ,1", "'nan' is not a finite number"),
+     ("1,0,0,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
+     ("0,1,1,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
+     ("", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 1")],
 )
 def test_bad_bbox_names_the_value(capsys, tmp_path, points_csv, value, why):
+    """The API's box check (tvoronoi.api.as_bbox) in the CLI's words: the option, the text given, upper-case names."""
     stderr = assert_error(capsys, tmp_path, points_csv, f"--bbox={value}", contains=[why])
-    assert f"--bbox {value!r}" in stderr
+    assert stderr == f"tvoronoi: error: --bbox {value!r}: {why}\n"
+
+
+def test_a_tiny_bbox_around_tiny_sites_is_accepted(capsys, tmp_path):
+    """The box's range is judged against the sites read, not before reading them."""
+    path = tmp_path / "tiny.csv"
+    sites = np.array([[1e-250, 1e-250], [3e-250, 2e-250], [2e-250, 4e-250]])
+    path.write_text(csv_text(sites))
+    out = tmp_path / "cells.geojson"
+    status, _, stderr = run(capsys, "batch", path, "-o", out, "--bbox", "0,0,5e-250,5e-250")
+    assert status == 0, stderr
+    doc = load(out)
+    assert doc["bbox"] == [0.0, 0.0, 5e-250, 5e-250]
+    assert all(f["geometry"]["type"] == "Polygon" for f in doc["features"])
+
+
+def test_a_bbox_out_of_range_for_the_sites_is_refused(capsys, tmp_path, points_csv):
+    assert_error(capsys, tmp_path, points_csv, "--bbox=0,0,1e-250,1", contains=["xmax = 1e-250 is beyond the exact range"])
 
 
 def test_engine_fortune_writes_the_same_valid_cells(capsys, tmp_path, points_csv):

@@ -7,10 +7,10 @@ import json
 import sys
 
 import numpy as np
-from hypothesis import given, settings
-from hypothesis import strategies as st
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from conftest import DATASETS
 from tvoronoi import cli

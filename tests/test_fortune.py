@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 import scipy.spatial
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tvoronoi
 from test_fortune import assert_same_diagram  # noqa: F401 (used on the fixtures)

@@ -15,10 +15,10 @@ import shapely
 import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.readers import PointSet
 from tvoronoi.writers import geojson_diagram
 from tvoronoi.writers.geojson_diagram import missing_cells, write_cells, write_delaunay
 from tvoronoi.writers.targets import TEMP_SUFFIX
-from tvoronoi.readers import PointSet
 
 AREA_RTOL = 1e-9
 

@@ -3,9 +3,8 @@
 import numpy as np
 import pytest
 
-from tvoronoi.kernels.order import brio_order
-
 from conftest import DATASETS
+from tvoronoi.kernels.order import brio_order
 
 
 @pytest.mark.parametrize("name", sorted(DATASETS))

@@ -16,7 +16,7 @@ def segment_keys(edges):
 @pytest.fixture(scope="module")
 def fortune_run():
     pts = uniform(60, seed=7)
-    trace = tvoronoi.fortune_steps(pts)
+    trace = tvoronoi.steps(pts, engine="fortune")
     return pts, trace, [trace.step(k) for k in range(len(trace) + 1)]
 
 
@@ -74,7 +74,7 @@ def test_fortune_step_describes_itself(fortune_run):
 def test_fortune_trace_on_degenerate_sets():
     for name in ("grid", "collinear", "duplicates", "circle"):
         pts = DATASETS[name]
-        trace = tvoronoi.fortune_steps(pts)
+        trace = tvoronoi.steps(pts, engine="fortune")
         last = trace.step(len(trace))
         d = tvoronoi.voronoi(pts, engine="fortune")
         assert len({tuple(np.round(v, 9)) for v in last.vertices}) == d.n_vertices
@@ -85,7 +85,7 @@ def test_fortune_trace_on_degenerate_sets():
 @pytest.fixture(scope="module")
 def incremental_run():
     pts = uniform(50, seed=11)
-    trace = tvoronoi.incremental_steps(pts)
+    trace = tvoronoi.steps(pts, engine="incremental")
     return pts, trace, [trace.step(k) for k in range(len(trace) + 1)]
 
 
@@ -126,8 +126,74 @@ def test_incremental_steps_grow_one_site_at_a_time(incremental_run):
 def test_incremental_trace_on_degenerate_sets():
     for name in ("grid", "collinear", "duplicates", "circle", "two", "one"):
         pts = DATASETS[name]
-        trace = tvoronoi.incremental_steps(pts)
+        trace = tvoronoi.steps(pts, engine="incremental")
         for k in range(len(trace) + 1):
             s = trace.step(k)
             assert len(s.inserted) == k
         assert_same_diagram(trace.step(len(trace)).diagram, tvoronoi.voronoi(pts))
+
+
+# -- the one entry: steps(points, engine=..., bbox=..., seed=...) -------------------------------------
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_steps_takes_the_same_arguments_for_both_engines(engine):
+    pts = uniform(20, seed=3)
+    box = (-1.0, -2.0, 3.0, 4.0)
+    trace = tvoronoi.steps(pts, engine=engine, bbox=box, seed=5)
+    assert trace.engine == engine
+    assert trace.bbox == box
+    np.testing.assert_array_equal(trace.points, pts)
+    default = tvoronoi.steps(pts, engine=engine)
+    assert default.bbox == tvoronoi.voronoi(pts).bbox
+    last = trace.step(len(trace))
+    assert last.index == len(trace)
+    assert last.describe() == tvoronoi.steps(pts, engine=engine, bbox=box, seed=5).step(len(trace)).describe()
+
+
+def test_steps_defaults_to_the_incremental_engine_as_voronoi_does():
+    pts = uniform(10, seed=4)
+    trace = tvoronoi.steps(pts)
+    assert trace.engine == "incremental" and len(trace) == len(pts)
+
+
+def test_steps_clips_the_incremental_diagrams_to_the_box_given():
+    pts = uniform(30, seed=8)
+    box = (0.25, 0.25, 0.75, 0.75)
+    trace = tvoronoi.steps(pts, engine="incremental", bbox=box)
+    d = trace.step(len(trace)).diagram
+    assert d.bbox == box
+    assert_same_diagram(d, tvoronoi.voronoi(pts, bbox=box))
+
+
+def test_the_seed_orders_the_insertions_and_leaves_the_sweep_alone():
+    pts = uniform(40, seed=9)
+    first = [tvoronoi.steps(pts, engine="incremental", seed=s).step(1).site for s in range(6)]
+    assert len(set(first)) > 1, "the insertion order does not depend on the seed"
+    # the sweep takes the sites by y whatever the seed
+    sweep = {tuple(int(tvoronoi.steps(pts, engine="fortune", seed=s).step(k).site) for k in range(1, 10))
+             for s in range(3)}
+    assert len(sweep) == 1
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_steps_checks_the_box_for_both_engines(engine):
+    with pytest.raises(tvoronoi.TvoronoiError, match="the box is empty"):
+        tvoronoi.steps([[0, 0], [1, 1]], engine=engine, bbox=(1, 0, 0, 1))
+    with pytest.raises(tvoronoi.TvoronoiError, match="bbox xmax = 1e-250 is beyond the exact range"):
+        tvoronoi.steps([[0.5, 0.5], [0.25, 0.75]], engine=engine, bbox=(0, 0, 1e-250, 1))
+
+
+def test_steps_refuses_an_unknown_engine():
+    with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull': choose one of incremental, fortune"):
+        tvoronoi.steps([[0, 0]], engine="qhull")
+
+
+@pytest.mark.parametrize("name, engine", [("fortune_steps", "fortune"), ("incremental_steps", "incremental")])
+def test_the_engine_named_entries_are_steps(name, engine):
+    pts = uniform(15, seed=2)
+    trace = getattr(tvoronoi, name)(pts, bbox=(-1, -1, 2, 2))
+    assert trace.engine == engine and trace.bbox == (-1.0, -1.0, 2.0, 2.0)
+    same = tvoronoi.steps(pts, engine=engine, bbox=(-1, -1, 2, 2))
+    assert [trace.step(k).describe() for k in range(len(trace) + 1)] == \
+        [same.step(k).describe() for k in range(len(same) + 1)]

@@ -1,5 +1,7 @@
 """Playback of the engines in the terminal UI: keys, timeline, timer, pictures of steps, snapshots."""
 
+import asyncio
+
 import numpy as np
 import pytest
 from textual.widgets import Button, Select
@@ -48,10 +50,7 @@ async def start_playback(app, pilot, engine="incremental"):
 def expected_describe(app, k: int) -> str:
     """What the step k of a fresh trace of the same points and engine says."""
     built = app.built
-    if built.diagram.engine == "fortune":
-        trace = tvoronoi.fortune_steps(built.points)
-    else:
-        trace = tvoronoi.incremental_steps(built.points, bbox=built.diagram.bbox)
+    trace = tvoronoi.steps(built.points, engine=built.diagram.engine, bbox=built.diagram.bbox)
     return trace.step(k).describe()
 
 
@@ -196,40 +195,84 @@ async def test_dragging_on_the_timeline_scrubs():
 # -- time ----------------------------------------------------------------------
 
 
+class FakeClock:
+    """The playback clock hook: time moves only when a test moves it; each read (one per timer tick
+    while playing) sets ``read``, so a test waits for the next tick instead of sleeping."""
+
+    def __init__(self, now: float) -> None:
+        self.now = now
+        self.read = asyncio.Event()
+
+    def __call__(self) -> float:
+        self.read.set()
+        return self.now
+
+    async def next_tick(self, pilot) -> None:
+        """Wait until the playback timer has read the clock once more, then until the app is idle."""
+        self.read.clear()
+        await asyncio.wait_for(self.read.wait(), timeout=10)
+        await pilot.pause()
+
+
 @pilot_test
 async def test_playing_advances_with_the_clock():
     app = make_app()
-    now = [100.0]
-    app.playback_clock = lambda: now[0]
+    clock = FakeClock(100.0)
+    app.playback_clock = clock
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot)
         await pilot.press("space")
         assert player.playing and app.timeline.playing
-        await pilot.pause(0.1)
+        await clock.next_tick(pilot)
         assert player.index == 0  # the clock has not moved
-        now[0] += 0.5
-        await pilot.pause(0.1)
+        clock.now += 0.5
+        await clock.next_tick(pilot)
         assert player.index == round(0.5 * player.speed)
-        now[0] += 100.0  # far past the end: playback stops at the last step
-        await pilot.pause(0.1)
+        clock.now += 100.0  # far past the end: playback stops at the last step
+        await clock.next_tick(pilot)
         assert player.index == player.n_steps and not player.playing
         await pilot.press("space")  # playing again from the end starts over
         assert player.index == 0 and player.playing
 
 
 @pilot_test
+async def test_time_spent_paused_does_not_count():
+    app = make_app()
+    clock = FakeClock(100.0)
+    app.playback_clock = clock
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press("space")
+        clock.now += 0.5
+        await clock.next_tick(pilot)
+        paused_at = player.index
+        assert paused_at == round(0.5 * player.speed)
+        await pilot.press("space")  # pause
+        assert not player.playing
+        clock.now += 50.0  # a long pause
+        await pilot.press("space")  # play on: the pause is not made up for
+        await clock.next_tick(pilot)
+        assert player.index == paused_at
+        clock.now += 0.25  # a binary fraction: the steps due are exact
+        await clock.next_tick(pilot)
+        assert player.index == paused_at + round(0.25 * player.speed)
+
+
+@pilot_test
 async def test_playing_advances_in_real_time():
+    """Without the hook the clock is the real one: wait (at most 10 s) for the first step, not a set time."""
     app = make_app()
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot)
         await pilot.press("greater_than_sign", "greater_than_sign")  # 100 steps/s
         await pilot.press("space")
-        await pilot.pause(0.4)
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + 10
+        while player.index == 0 and loop.time() < deadline:
+            await pilot.pause()
         assert player.index > 0
-        await pilot.press("space")
-        paused_at = player.index
-        await pilot.pause(0.2)
-        assert player.index == paused_at
+        await pilot.press("space")  # pause before the app closes (its timer would tick on a closing screen)
+        assert not player.playing
 
 
 # -- large point sets ----------------------------------------------------------------

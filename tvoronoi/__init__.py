@@ -2,8 +2,8 @@
 
 __version__ = "0.1.0"
 
-__all__ = ["voronoi", "lloyd", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "fortune_steps",
-           "incremental_steps"]
+__all__ = ["voronoi", "lloyd", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "steps",
+           "fortune_steps", "incremental_steps"]
 
 from tvoronoi.errors import TvoronoiError
 
@@ -27,14 +27,10 @@ def __getattr__(name):
         from tvoronoi.dynamic import DynamicVoronoi
 
         return DynamicVoronoi
-    if name == "fortune_steps":
-        from tvoronoi.trace import FortuneTrace
+    if name in ("steps", "fortune_steps", "incremental_steps"):
+        from tvoronoi import trace
 
-        return FortuneTrace
-    if name == "incremental_steps":
-        from tvoronoi.trace import IncrementalTrace
-
-        return IncrementalTrace
+        return getattr(trace, name)
     if name == "generate":
         from tvoronoi.generators import generate
 

@@ -114,18 +114,67 @@ def default_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
     return (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
 
 
-def as_bbox(bbox) -> tuple[float, float, float, float]:
-    """Check a user box (xmin, ymin, xmax, ymax)."""
+def as_bbox(bbox, *, what: str | None = None,
+            names: tuple[str, str, str, str] = ("xmin", "ymin", "xmax", "ymax"),
+            sep: str = ", ") -> tuple[float, float, float, float]:
+    """Check a box: four finite numbers (xmin, ymin, xmax, ymax) with xmin < xmax and ymin < ymax.
+
+    The one box check of the package: ``voronoi``, dynamic diagrams, traces and the CLI's
+    ``--bbox`` all use it. ``what`` names the box in messages (default: ``bbox`` and the value
+    given), ``names`` and ``sep`` spell its four values (the CLI: ``XMIN,YMIN,XMAX,YMAX``).
+
+    Raises
+    ------
+    TvoronoiError
+        Not four values, a value that is not a number or not finite, an empty box; the message
+        names the value at fault.
+
+    Examples
+    --------
+    >>> as_bbox([0, -1, 2.5, 1e3])
+    (0.0, -1.0, 2.5, 1000.0)
+    >>> as_bbox((1, 0, 0, 1))
+    Traceback (most recent call last):
+    ...
+    tvoronoi.errors.TvoronoiError: bbox (1, 0, 0, 1): the box is empty; it needs xmin < xmax and ymin < ymax
+    """
+    what = f"bbox {bbox!r}" if what is None else what
+    order = sep.join(names)
     try:
-        values = tuple(float(v) for v in bbox)
-    except (TypeError, ValueError):
-        raise TvoronoiError(f"bbox must be four numbers (xmin, ymin, xmax, ymax), got {bbox!r}") from None
-    if len(values) != 4 or not all(math.isfinite(v) for v in values):
-        raise TvoronoiError(f"bbox must be four finite numbers (xmin, ymin, xmax, ymax), got {bbox!r}")
+        parts = list(bbox)
+    except TypeError:
+        raise TvoronoiError(f"{what}: expected four numbers {order}") from None
+    if len(parts) != 4:
+        raise TvoronoiError(f"{what}: expected four numbers {order}, got {len(parts)}")
+    values = []
+    for part in parts:
+        try:
+            value = float(part)
+        except (TypeError, ValueError):
+            raise TvoronoiError(f"{what}: {part!r} is not a number; expected {order}") from None
+        if not math.isfinite(value):
+            raise TvoronoiError(f"{what}: {part!r} is not a finite number")
+        values.append(value)
     xmin, ymin, xmax, ymax = values
     if not (xmin < xmax and ymin < ymax):
-        raise TvoronoiError(f"bbox {values} is empty: it needs xmin < xmax and ymin < ymax")
-    return values
+        raise TvoronoiError(
+            f"{what}: the box is empty; it needs {names[0]} < {names[2]} and {names[1]} < {names[3]}"
+        )
+    return xmin, ymin, xmax, ymax
+
+
+def check_engine(engine: str, insertion: str = "brio") -> None:
+    """Refuse an unknown engine or insertion order (``voronoi``, traces and the CLI).
+
+    Raises
+    ------
+    EngineError
+        Naming the value given and the choices.
+    """
+    if engine not in ENGINES:
+        raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
+    if insertion not in INSERTION_ORDERS:
+        raise EngineError(f"unknown insertion order {insertion!r}: choose one of {', '.join(INSERTION_ORDERS)}")
 
 
 def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = "brio",
@@ -178,10 +227,7 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
     (1, 2)
     """
     pts = as_points(points)
-    if engine not in ENGINES:
-        raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
-    if insertion not in INSERTION_ORDERS:
-        raise EngineError(f"unknown insertion order {insertion!r}: choose one of {', '.join(INSERTION_ORDERS)}")
+    check_engine(engine, insertion)
     threads = as_threads(threads)
     from tvoronoi.build import build_diagram
 

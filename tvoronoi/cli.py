@@ -3,19 +3,22 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import re
 import signal
 import sys
 import warnings
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from tvoronoi import __version__
-from tvoronoi.api import ENGINES, INSERTION_ORDERS
+from tvoronoi.api import ENGINES, INSERTION_ORDERS, as_bbox, check_engine
 from tvoronoi.errors import CoordinateRangeError, TvoronoiError
 from tvoronoi.fileio import STDIO
 from tvoronoi.readers import FORMATS
+
+if TYPE_CHECKING:
+    from rich.progress import Progress
 
 PROG = "tvoronoi"
 # inputs this large show a progress display (on a terminal, without -q)
@@ -79,29 +82,13 @@ class OutputError(Exception):
 
 
 def parse_bbox(text: str) -> tuple[float, float, float, float]:
-    """Parse ``--bbox XMIN,YMIN,XMAX,YMAX``; errors name the value given.
+    """Parse ``--bbox XMIN,YMIN,XMAX,YMAX`` with the API's box check; errors name the value given.
 
     >>> parse_bbox("-1,0,2.5,1e3")
     (-1.0, 0.0, 2.5, 1000.0)
     """
-    parts = [part.strip() for part in text.split(",")]
-    if len(parts) != 4:
-        raise TvoronoiError(
-            f"--bbox {text!r}: expected four numbers XMIN,YMIN,XMAX,YMAX separated by commas, got {len(parts)}"
-        )
-    values = []
-    for part in parts:
-        try:
-            value = float(part)
-        except ValueError:
-            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a number; expected XMIN,YMIN,XMAX,YMAX") from None
-        if not math.isfinite(value):
-            raise TvoronoiError(f"--bbox {text!r}: {part!r} is not a finite number")
-        values.append(value)
-    xmin, ymin, xmax, ymax = values
-    if not (xmin < xmax and ymin < ymax):
-        raise TvoronoiError(f"--bbox {text!r}: the box is empty; it needs XMIN < XMAX and YMIN < YMAX")
-    return xmin, ymin, xmax, ymax
+    return as_bbox([part.strip() for part in text.split(",")], what=f"--bbox {text!r}",
+                   names=("XMIN", "YMIN", "XMAX", "YMAX"), sep=",")
 
 
 def parse_delimiter(text: str) -> str:
@@ -257,8 +244,8 @@ def _batch_run(args, phases: Phases) -> int:
 
     from tvoronoi.api import voronoi
     from tvoronoi.readers import read_points
-    from tvoronoi.writers.geoparquet import crs_name, projjson
     from tvoronoi.writers.geojson_diagram import missing_cells, write_cells, write_delaunay
+    from tvoronoi.writers.geoparquet import crs_name, projjson
     from tvoronoi.writers.targets import descriptor_of, is_direct, output_file
 
     bbox = None if args.bbox is None else parse_bbox(args.bbox)
@@ -279,9 +266,10 @@ def _batch_run(args, phases: Phases) -> int:
         require_pyarrow()
     if args.lloyd is not None and args.lloyd < 0:
         raise TvoronoiError(f"--lloyd {args.lloyd}: give a number of iterations, 0 or more")
+    # the engine and its options pass the API's own checks before a large file is read (the box's
+    # range against the sites' scale waits for the sites)
+    check_engine(args.engine, args.insertion)
     options = dict(engine=args.engine, bbox=bbox, insertion=args.insertion, seed=args.seed)
-    # the engine and its options pass the API's own checks before a large file is read
-    voronoi(np.empty((0, 2)), **options)
     region = None
     if args.clip is not None:
         from tvoronoi.readers.clip_region import read_region
@@ -340,7 +328,12 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{repeats} repeated point{'s share' if repeats > 1 else ' shares'} the cell of an earlier "
                 f'point (see "duplicates" in the output)'
             )
-        outside = diagram.n_outside if region is not None else 0
+        outside = 0
+        if region is not None:
+            from tvoronoi.region import ClippedDiagram
+
+            assert isinstance(diagram, ClippedDiagram), "voronoi(clip=...) returns a ClippedDiagram"
+            outside = diagram.n_outside
         if outside and not args.quiet:
             which = "sites lie" if outside > 1 else "site lies"
             phases.warn(f'{outside} {which} outside the --clip region {args.clip}: written with "geometry": null')
@@ -457,7 +450,7 @@ class Phases:
 
     def __init__(self, *, enabled: bool):
         self.enabled = enabled
-        self.progress = None
+        self.progress: Progress | None = None
 
     def __enter__(self) -> Phases:
         return self
@@ -495,16 +488,17 @@ class Phases:
     @contextmanager
     def counter(self, label: str):
         """A phase that counts; the block passes the yielded function as a progress(done, total) callback."""
-        if self.progress is None:
+        bar = self.progress
+        if bar is None:
             yield None
             return
-        task = self.progress.add_task(label, total=None, detail="")
+        task = bar.add_task(label, total=None, detail="")
 
         def progress(done: int, total: int) -> None:
-            self.progress.update(task, completed=done, total=total, detail=f"{done:,}/{total:,}")
+            bar.update(task, completed=done, total=total, detail=f"{done:,}/{total:,}")
 
         yield progress
-        self.progress.update(task, total=1, completed=1)
+        bar.update(task, total=1, completed=1)
 
     def note(self, message: str) -> None:
         """Tell what was chosen for the user (e.g. the x and y columns)."""

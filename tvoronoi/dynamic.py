@@ -7,11 +7,12 @@ import math
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.api import ENGINES, as_bbox, as_points, check_range, default_bbox
+from tvoronoi.api import as_bbox, as_points, check_engine, check_range, default_bbox
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
-from tvoronoi.errors import EngineError, TvoronoiError
+from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import dual, dynamic
+
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
     """A new site's coordinates: numbers, finite, and within the range rule of a diagram of scale 2^e."""
@@ -57,8 +58,7 @@ class DynamicVoronoi:
 
     def __init__(self, points=(), *, engine: str = "incremental", bbox=None):
         pts = as_points(points)
-        if engine not in ENGINES:
-            raise EngineError(f"unknown engine {engine!r}: choose one of {', '.join(ENGINES)}")
+        check_engine(engine)
         self.engine = engine
         self.bbox = default_bbox(pts) if bbox is None else as_bbox(bbox)
         # the one range rule (tvoronoi.api): the mesh holds sites scaled by 2^-e, e fixed by the box and
@@ -118,7 +118,7 @@ class DynamicVoronoi:
             return
         # the batch engine's order (a biased randomized insertion order, or the sweep's)
         t = engines.run(self._xy[ids, 0], self._xy[ids, 1], engine=self.engine, exponent=self._e)
-        sx, sy, dup, ok = t.sites.xs, t.sites.ys, t.dup, not t.flat
+        sx, sy, dup = t.sites.xs, t.sites.ys, t.dup
         order_ids = ids[t.sites.perm]
         # repeats: the smallest id at a place holds it
         groups: dict[int, list[int]] = {}
@@ -131,8 +131,8 @@ class DynamicVoronoi:
             self._copies[everyone[0]] = everyone[1:]
             for c in everyone[1:]:
                 self._primary[c] = everyone[0]
-        if not ok:
-            return
+        if t.tv is None or t.opp is None:
+            return      # the distinct sites are collinear (t.flat): no mesh until a site leaves the line
         mesh = dynamic.DynamicMesh(max(len(self._xy), 16))
         mesh.load(sx, sy, order_ids.astype(np.int32), t.tv, t.opp, len(sx))
         for k, holder in holder_of_vertex.items():

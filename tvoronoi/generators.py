@@ -212,9 +212,10 @@ def _check_positive(value, name: str) -> float:
     """Return ``value`` as a float if it is a finite number ``> 0``, else raise."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TvoronoiError(f"{name} must be a positive number, got {value!r}")
-    if not (math.isfinite(value) and value > 0):
+    number = float(value)
+    if not (math.isfinite(number) and number > 0):
         raise TvoronoiError(f"{name} must be a positive finite number, got {value}")
-    return float(value)
+    return number
 
 
 def _check_pair(value, name: str) -> tuple[float, float]:

@@ -1,6 +1,7 @@
 """Step-by-step traces of both engines, for playback: the state after any number of events.
 
-A trace reruns its engine up to the requested step, which costs well under a
+``steps(points, engine=..., bbox=..., seed=...)`` is the one entry, with the same arguments for
+both engines. A trace reruns its engine up to the requested step, which costs well under a
 millisecond per thousand sites, so a timeline can be scrubbed freely.
 """
 
@@ -11,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tvoronoi.api import as_points, default_bbox, as_bbox
 from tvoronoi import engines
+from tvoronoi.api import as_bbox, as_points, check_engine, default_bbox
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
 from tvoronoi.kernels import dual, fortune, incremental
@@ -99,6 +100,7 @@ class FortuneStep:
             return f"site event at ({x:.4g}, {y:.4g}): site {self.site} splits an arc"
         if self.kind == "repeat":
             return f"site {self.site} repeats an earlier site at ({x:.4g}, {y:.4g}): no new arc"
+        assert self.vertex is not None, "a circle event creates a vertex"
         vx, vy = self.vertex
         return (f"circle event at ({vx:.4g}, {vy:.4g}): vertex {len(self.vertices) - 1} created, "
                 f"arc of site {self.site} vanishes")
@@ -107,18 +109,26 @@ class FortuneStep:
 class FortuneTrace:
     """Replay Fortune's sweep over a point set, one event at a time.
 
+    The sweep takes the sites in the order of y then x, so ``seed`` changes nothing (it is taken so
+    that both traces are made alike); ``bbox`` is checked and kept as ``self.bbox``, the box the
+    playback draws in.
+
     >>> import tvoronoi.trace as tr
     >>> t = tr.FortuneTrace([[0, 0], [2, 0], [1, 2]])
     >>> len(t), t.step(len(t)).kind
     (4, 'circle')
     """
 
-    def __init__(self, points):
+    engine = "fortune"
+
+    def __init__(self, points, *, bbox=None, seed: int = 0):
         self.points = as_points(points)
+        self.bbox = default_bbox(self.points) if bbox is None else as_bbox(bbox)
         # the kernel sweeps sites scaled by 2^-e, as in a batch build (the one range rule); what a
         # step shows is in the user's unit
-        sites = engines.prepare(self.points[:, 0], self.points[:, 1], engine="fortune")
+        sites = engines.prepare(self.points[:, 0], self.points[:, 1], engine="fortune", seed=seed)
         self._perm, self._e, self._xs, self._ys = sites.perm, sites.exponent, sites.xs, sites.ys
+        engines.check_box_scale(self.bbox, self._e)
         self.n_steps = int(fortune.sweep(self._xs, self._ys)["steps"])
 
     def __len__(self) -> int:
@@ -204,7 +214,13 @@ class IncrementalStep:
 
 
 class IncrementalTrace:
-    """Replay the randomized incremental engine, one insertion at a time."""
+    """Replay the randomized incremental engine, one insertion at a time.
+
+    The sites are inserted in the batch engine's order for ``seed``; each step's diagram is clipped
+    to ``bbox`` (kept as ``self.bbox``).
+    """
+
+    engine = "incremental"
 
     def __init__(self, points, *, bbox=None, seed: int = 0):
         self.points = as_points(points)
@@ -255,6 +271,63 @@ class IncrementalTrace:
             conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[_finite(fan, n)].reshape(-1, 3),
             stolen_from=to_row[stolen], inserted=np.sort(to_row[present]), diagram=d,
         )
+
+
+Trace = FortuneTrace | IncrementalTrace
+
+
+def steps(points, *, engine: str = "incremental", bbox=None, seed: int = 0) -> Trace:
+    """A step-by-step trace of an engine over a point set, for playback and teaching.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2), or shapely / geopandas / pandas points
+        As for :func:`tvoronoi.voronoi`.
+    engine : {"incremental", "fortune"}
+        The randomized incremental algorithm (a step inserts a site), or Fortune's sweepline
+        (a step is a site or circle event).
+    bbox : (xmin, ymin, xmax, ymax), optional
+        The box of the trace's diagrams; by default the points' bounding box grown by 10% of its
+        larger side on every side, as for ``voronoi``. The trace keeps it as ``bbox``.
+    seed : int
+        Seed of the incremental engine's insertion order (the batch build's for the same seed);
+        Fortune's sweep takes the sites by y then x whatever the seed.
+
+    Returns
+    -------
+    FortuneTrace or IncrementalTrace
+        ``len(trace)`` steps; ``trace.step(k)`` the state after k of them (0: before the first),
+        whose ``describe()`` says in one line what the step did; ``trace.engine``, ``trace.points``
+        and ``trace.bbox`` as checked.
+
+    Raises
+    ------
+    TvoronoiError
+        Bad points or box, an unknown engine.
+
+    Examples
+    --------
+    >>> import tvoronoi
+    >>> t = tvoronoi.steps([[0, 0], [2, 0], [1, 2]], engine="fortune")
+    >>> len(t), t.step(len(t)).describe()
+    (4, 'circle event at (1, 0.75): vertex 0 created, arc of site 0 vanishes')
+    >>> t = tvoronoi.steps([[0, 0], [2, 0], [1, 2]])
+    >>> len(t), t.step(0).describe()
+    (3, 'before the first insertion: 3 sites to insert')
+    """
+    check_engine(engine)
+    trace_class = FortuneTrace if engine == "fortune" else IncrementalTrace
+    return trace_class(points, bbox=bbox, seed=seed)
+
+
+def fortune_steps(points, *, bbox=None, seed: int = 0) -> FortuneTrace:
+    """``steps(points, engine="fortune", ...)``: the name callers used before ``steps``."""
+    return FortuneTrace(points, bbox=bbox, seed=seed)
+
+
+def incremental_steps(points, *, bbox=None, seed: int = 0) -> IncrementalTrace:
+    """``steps(points, engine="incremental", ...)``: the name callers used before ``steps``."""
+    return IncrementalTrace(points, bbox=bbox, seed=seed)
 
 
 def _finite(tri: np.ndarray, inf: int) -> np.ndarray:

@@ -1,0 +1,118 @@
+"""Bad input to the API: every check happens once, in tvoronoi.api, and its message names the culprit.
+
+voronoi, DynamicVoronoi, lloyd and steps share the checks of points, box and engine; the CLI's
+--bbox and --engine use the same ones (their CLI spelling: tests/test_cli.py).
+"""
+
+import re
+
+import numpy as np
+import pytest
+
+import exact_checks
+import tvoronoi
+from tvoronoi.api import as_bbox, check_engine
+from tvoronoi.engines import BOX_SCALED_MAX
+
+# -- points ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bad, message", [
+    ([[0, 0], [np.nan, 1]], "point 1"),
+    ([[0, 0], [1, np.inf]], "finite"),
+    ([[0, 0, 0]], "shape"),
+    ([["a", "b"]], "numbers"),
+])
+def test_bad_points_are_named(bad, message):
+    with pytest.raises(tvoronoi.TvoronoiError, match=message):
+        tvoronoi.voronoi(bad)
+
+
+def test_dynamic_range_beyond_exact_arithmetic_is_refused():
+    with pytest.raises(tvoronoi.TvoronoiError, match="point 2: .* 2\\^170"):
+        tvoronoi.voronoi([[0.0, 0.0], [0.0, 1.0], [1e-60, 0.5]])
+
+
+# -- the box ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bbox, message", [
+    ((0, 0, 0, 1), "bbox (0, 0, 0, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
+    ((0, 2, 1, 1), "bbox (0, 2, 1, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
+    ((0, 0, 1), "bbox (0, 0, 1): expected four numbers xmin, ymin, xmax, ymax, got 3"),
+    (5, "bbox 5: expected four numbers xmin, ymin, xmax, ymax"),
+    ((0, 0, np.nan, 1), "bbox (0, 0, nan, 1): nan is not a finite number"),
+    ((0, 0, "inf", 1), "bbox (0, 0, 'inf', 1): 'inf' is not a finite number"),
+    ("abcd", "bbox 'abcd': 'a' is not a number; expected xmin, ymin, xmax, ymax"),
+    ((0, None, 1, 1), "bbox (0, None, 1, 1): None is not a number; expected xmin, ymin, xmax, ymax"),
+])
+def test_bad_boxes_name_the_value(bbox, message):
+    with pytest.raises(tvoronoi.TvoronoiError) as caught:
+        tvoronoi.voronoi([[0.5, 0.5]], bbox=bbox)
+    assert str(caught.value) == message
+    # the same check, the same words, everywhere a box is taken
+    for call in (lambda: tvoronoi.DynamicVoronoi([[0.5, 0.5]], bbox=bbox),
+                 lambda: tvoronoi.lloyd([[0.5, 0.5]], 1, bbox=bbox),
+                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="fortune", bbox=bbox),
+                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="incremental", bbox=bbox)):
+        with pytest.raises(tvoronoi.TvoronoiError) as again:
+            call()
+        assert str(again.value) == message
+
+
+def test_the_box_check_speaks_the_callers_names():
+    """The CLI passes its own spelling: the option, and the values as its users type them."""
+    with pytest.raises(tvoronoi.TvoronoiError) as caught:
+        as_bbox(["1", "0", "0", "1"], what="--bbox '1,0,0,1'", names=("XMIN", "YMIN", "XMAX", "YMAX"), sep=",")
+    assert str(caught.value) == "--bbox '1,0,0,1': the box is empty; it needs XMIN < XMAX and YMIN < YMAX"
+    assert as_bbox([" -1", "0", "2.5 ", "1e3"]) == (-1.0, 0.0, 2.5, 1000.0)
+    assert all(type(v) is float for v in as_bbox(np.array([0, 0, 1, 1], np.int64)))
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize("side", [1.5e300, 2.0 ** 1000, 2.0 ** -701, 1e-250])
+def test_a_box_beyond_the_range_rule_is_refused(engine, side):
+    """Unit-square sites: box sides past about 1.3e300 (2^997: the exact products split a coordinate by
+    multiplying it with 2^27 + 1) or, when nonzero, under 2^-700 are refused with the side and value named."""
+    pts = np.random.default_rng(0).random((30, 2))
+    with pytest.raises(tvoronoi.TvoronoiError, match=re.escape(f"bbox xmax = {side!r} is beyond the exact range")):
+        tvoronoi.voronoi(pts, bbox=(-1.0, -1.0, side, 2.0), engine=engine)
+    if side < 1:
+        # a dynamic diagram's scale comes from its box too: only a tiny side can be out of range
+        with pytest.raises(tvoronoi.TvoronoiError, match="bbox ymin"):
+            tvoronoi.DynamicVoronoi(pts, bbox=(-1.0, -side, 2.0, 2.0), engine=engine)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_the_largest_and_smallest_boxes_of_the_range_rule_build(engine):
+    pts = np.random.default_rng(0).random((30, 2))
+    big = BOX_SCALED_MAX
+    d = tvoronoi.voronoi(pts, bbox=(-big, -big, big, big), engine=engine)
+    exact_checks.check_cells_valid(d)     # exact at any span (validate's box frame and GEOS are not)
+    exact_checks.check_tiling(d)
+    small = 2.0 ** -700
+    d = tvoronoi.voronoi(np.vstack([pts, [[0.0, 0.0]]]), bbox=(-small, -small, small, small), engine=engine)
+    assert len(d.cell_polygon(30)) == 4         # the box around the site at the origin is its cell
+
+
+def test_a_tiny_box_around_tiny_sites_is_in_range():
+    """The box's range is judged against the sites' scale, never against 1."""
+    pts = np.array([[1e-250, 1e-250], [3e-250, 2e-250], [2e-250, 4e-250]])
+    d = tvoronoi.voronoi(pts, bbox=(0.0, 0.0, 5e-250, 5e-250))
+    assert d.bbox == (0.0, 0.0, 5e-250, 5e-250)
+    assert all(len(d.cell_polygon(i)) >= 3 for i in range(3))
+
+
+# -- engine and options -----------------------------------------------------------------------------
+
+
+def test_unknown_engine_and_order():
+    with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull': choose one of incremental, fortune"):
+        tvoronoi.voronoi([[0, 0]], engine="qhull")
+    with pytest.raises(tvoronoi.TvoronoiError, match="unknown insertion order 'sorted': choose one of brio, random"):
+        tvoronoi.voronoi([[0, 0]], insertion="sorted")
+    for call in (lambda: tvoronoi.DynamicVoronoi([[0, 0]], engine="qhull"),
+                 lambda: tvoronoi.steps([[0, 0]], engine="qhull"),
+                 lambda: check_engine("qhull")):
+        with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull'"):
+            call()
