@@ -116,15 +116,22 @@ def others(pts: np.ndarray, geos_max: int) -> dict:
 
 
 PEAK = """
-import resource, sys
-import numpy as np
+import sys
 sys.path.insert(0, {repo!r})
 from benchmarks.phases import points
 import tvoronoi
+
+def hwm():
+    # this process's own peak resident set (VmHWM, KiB): unlike ru_maxrss, not raised by the peak of
+    # the process it was forked from
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1])
+
 pts = points({dist!r}, {n})
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = hwm()
 tvoronoi.voronoi(pts, engine={engine!r}, threads={threads})
-print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024)
+print((hwm() - before) / 1024)
 """
 
 
