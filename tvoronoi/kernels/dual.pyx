@@ -19,6 +19,7 @@ cdef extern from *:
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
     BLOCK = 1 << 18     # parallel loops run in blocks of this many, signals polled between
+    PARALLEL_MIN_SITES = 1 << 15    # fewer sites: one thread (waking the others costs more than it saves)
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
@@ -42,7 +43,8 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 
 
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
-                          const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1):
+                          const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
+                          int parallel_min=PARALLEL_MIN_SITES):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -62,7 +64,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
         returned in the user's unit, each coordinate correctly rounded.
     threads : int, threads for the circumcentres and the cocircular test (the result is the same
-        for any count).
+        for any count), when there are at least parallel_min sites.
 
     Returns
     -------
@@ -106,6 +108,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
     cdef int n_zero = 0, lo, hi
+    if n < parallel_min:
+        threads = 1
 
     with nogil:
         # the walk: half-edges cell by cell, each triangle's vertex numbered when first met
