@@ -279,6 +279,8 @@ class PlaybackMixin:
         player = self.player
         if player is None or not player.playing:
             return
+        if not self.screen.query("#timeline"):
+            return              # the app is closing: its widgets are gone, and the timer with them next
         now = self.playback_clock()
         if player.last_tick is not None:
             player.carry += (now - player.last_tick) * player.speed
