@@ -32,6 +32,7 @@ from tvoronoi.tui.files import FilesMixin
 from tvoronoi.tui.inspector import InspectorMixin
 from tvoronoi.tui.legend import legend_text
 from tvoronoi.tui.playback import PlaybackMixin
+from tvoronoi.tui.relaxing import relaxed_live, relaxed_points, relaxed_source
 from tvoronoi.tui.screens import HelpScreen, OpenRequest
 from tvoronoi.tui.timeline import Timeline
 
@@ -118,6 +119,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         Binding("o", "open", "Open", show=False),
         Binding("s", "save", "Save", show=False),
         Binding("p", "toggle_panel", "Panel", show=False),
+        Binding("r", "relax", "Relax", show=False),
         Binding("escape", "focus_canvas", "Back to the diagram", show=False),
         *playback.BINDINGS,
         # the footer names L outside playback only: there the playback keys need the room
@@ -433,6 +435,27 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self._set_status(" · ".join(parts))
 
     # -- actions -------------------------------------------------------------
+
+    def action_relax(self) -> None:
+        """One Lloyd step: every site moves to the centroid of its cell, and the diagram is rebuilt."""
+        built = self.built
+        if built is None:
+            return
+        if self.player is not None:
+            self.notify("relaxing changes the sites: end playback first (t)", title="Not relaxed",
+                        severity="warning", timeout=5)
+            return
+        source = relaxed_source(built.source)
+        if self.live is not None:
+            # edited sites: their whole diagram is built once to find the centroids
+            live = self.live
+            points = relaxed_live(live.points(), live.bbox, self._engine())
+            bbox = live.bbox
+        else:
+            points = relaxed_points(built.diagram, built.points)
+            bbox = built.diagram.bbox
+        self._request_build(lambda: points, source=source, size=len(points), fit=False,
+                            point_set=built.point_set, bbox=bbox)
 
     def action_toggle_delaunay(self) -> None:
         """Show or hide the Delaunay triangulation over the cells."""
