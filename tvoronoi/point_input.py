@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tvoronoi.coordinate_names import named_column
 from tvoronoi.errors import TvoronoiError
 
 
@@ -141,20 +142,8 @@ def _geometry_points(geoms: np.ndarray, labels=None) -> np.ndarray:
 
 def _frame_points(frame) -> np.ndarray:
     """The x and y columns of a pandas DataFrame, chosen by name or as its only two columns."""
-    from tvoronoi.readers.columns import PAIRED_ONLY, X_NAMES, Y_NAMES
-
     names = [str(c) for c in frame.columns]
-    lowered = [name.lower() for name in names]
-
-    def find(candidates) -> int | None:
-        for candidate in candidates:
-            if candidate in PAIRED_ONLY and PAIRED_ONLY[candidate] not in lowered:
-                continue
-            if candidate in lowered:
-                return lowered.index(candidate)
-        return None
-
-    ix, iy = find(X_NAMES), find(Y_NAMES)
+    ix, iy = named_column(names, "x"), named_column(names, "y")
     if ix is None or iy is None:
         if len(names) != 2:
             raise TvoronoiError(

@@ -6,15 +6,9 @@ import re
 
 import numpy as np
 
+from ..coordinate_names import LAT_NAMES, LON_NAMES, PAIRED_ONLY, X_NAMES, Y_NAMES, named_column  # noqa: F401
 from ..errors import InputFileError, TvoronoiError
 
-# column names recognised in any case, in order of preference; "e" and "n" only as a pair
-X_NAMES = ("x", "lon", "lng", "long", "longitude", "easting", "e")
-Y_NAMES = ("y", "lat", "latitude", "northing", "n")
-PAIRED_ONLY = {"e": "n", "n": "e"}
-# names of longitude and latitude columns: their sites are lon/lat degrees
-LON_NAMES = ("lon", "lng", "long", "longitude")
-LAT_NAMES = ("lat", "latitude")
 # words that make a column an identifier, never a coordinate taken by position
 ID_WORDS = frozenset(
     "id fid gid oid uid pk key idx index row rowid rownum no num number objectid code zip zipcode "
@@ -56,17 +50,7 @@ def resolve_column(sel, role: str, names: list[str], by_name: bool, source: str)
     n_cols = len(names)
     listing = ", ".join(f"{j}:{name}" for j, name in enumerate(names))
     if sel is None:
-        if not by_name:
-            return None
-        lowered = [name.lower() for name in names]
-        for candidate in X_NAMES if role == "x" else Y_NAMES:
-            if candidate in PAIRED_ONLY and PAIRED_ONLY[candidate] not in lowered:
-                continue
-            exact = [j for j, name in enumerate(names) if name == candidate]
-            loose = [j for j, name in enumerate(lowered) if name == candidate]
-            if exact or loose:
-                return (exact or loose)[0]
-        return None
+        return named_column(names, role) if by_name else None
     if isinstance(sel, str):
         key = sel.strip()
         for j, name in enumerate(names):
