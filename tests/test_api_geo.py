@@ -293,3 +293,46 @@ def test_locate_on_a_dynamic_diagram_skips_removed_sites():
     dv.remove(0)
     dv.remove(2)
     assert dv.diagram().to_diagram().locate([0.0, 5.0], [0.0, -3.0]).tolist() == [1, 1]
+
+
+def _frame_with_points(xy, extra=None):
+    import pandas as pd
+
+    frame = pd.DataFrame({"name": [f"p{i}" for i in range(len(xy))], "geometry": shapely.points(xy)})
+    for key, values in (extra or {}).items():
+        frame[key] = values
+    return frame
+
+
+def test_dataframe_with_a_column_of_points():
+    xy = np.random.default_rng(SEED).random((300, 2))
+    want = tvoronoi.voronoi(xy)
+    got = tvoronoi.voronoi(_frame_with_points(xy))
+    assert np.array_equal(got.cell_points, want.cell_points)
+    assert np.array_equal(got.cell_vertices, want.cell_vertices)
+    # a points column under another name is found too
+    frame = _frame_with_points(xy).rename(columns={"geometry": "where"})
+    assert np.array_equal(as_points(frame), xy)
+
+
+def test_dataframe_named_coordinates_come_before_a_points_column():
+    xy = np.random.default_rng(SEED + 1).random((50, 2))
+    other = xy[::-1].copy()
+    frame = _frame_with_points(other, {"x": xy[:, 0], "y": xy[:, 1]})
+    assert np.array_equal(as_points(frame), xy)
+
+
+@pytest.mark.parametrize("bad, words", [
+    (shapely.LineString([(0, 0), (1, 1)]), ["column 'geometry'", "point 3", "LineString"]),
+    (None, ["column 'geometry'", "point 3", "None"]),
+    (shapely.Point(), ["column 'geometry'", "point 3", "empty"]),
+])
+def test_dataframe_points_column_errors_name_column_and_row(bad, words):
+    frame = _frame_with_points(np.random.default_rng(SEED).random((6, 2)))
+    values = frame["geometry"].to_numpy().copy()
+    values[3] = bad
+    frame["geometry"] = values
+    with pytest.raises(TvoronoiError) as info:
+        tvoronoi.voronoi(frame)
+    for word in words:
+        assert word in str(info.value)

@@ -34,8 +34,9 @@ def foreign_points(points):
     Accepted: a shapely Point, MultiPoint or GeometryCollection of points; a sequence or object array of
     shapely Points; a geopandas GeoSeries, or a GeoDataFrame (its active geometry); a pandas Series of
     shapely Points; a pandas DataFrame, whose columns are chosen by name (x/y, lon/lat, lng/lat,
-    longitude/latitude, easting/northing, e/n, in any case) or, failing names, taken when there are
-    exactly two. A z coordinate is dropped.
+    longitude/latitude, easting/northing, e/n, in any case), or failing names its column of shapely
+    Points (the one named "geometry" first), or else taken when there are exactly two. A z coordinate
+    is dropped.
 
     Returns
     -------
@@ -140,11 +141,32 @@ def _geometry_points(geoms: np.ndarray, labels=None) -> np.ndarray:
     return shapely.get_coordinates(geoms)
 
 
+def _geometry_column(frame, names: list[str]) -> int | None:
+    """The index of a column holding shapely geometries (its first non-null value one), "geometry" first."""
+    order = sorted(range(len(names)), key=lambda j: names[j].lower() != "geometry")
+    for j in order:
+        column = frame[frame.columns[j]]
+        if column.dtype != object:
+            continue
+        present = column.dropna()
+        if len(present) and _is_shapely(present.iloc[0]):
+            return j
+    return None
+
+
 def _frame_points(frame) -> np.ndarray:
-    """The x and y columns of a pandas DataFrame, chosen by name or as its only two columns."""
+    """The x and y columns of a pandas DataFrame, chosen by name; else its column of shapely points
+    (one named "geometry" first); else its only two columns."""
     names = [str(c) for c in frame.columns]
     ix, iy = named_column(names, "x"), named_column(names, "y")
     if ix is None or iy is None:
+        geometry = _geometry_column(frame, names)
+        if geometry is not None:
+            column = frame[frame.columns[geometry]]
+            try:
+                return _geometry_points(column.to_numpy(), labels=column.index)
+            except TvoronoiError as exc:
+                raise TvoronoiError(f"DataFrame column {names[geometry]!r}: {exc}") from None
         if len(names) != 2:
             raise TvoronoiError(
                 f"cannot tell which DataFrame columns are x and y among {names}: name them x and y "
