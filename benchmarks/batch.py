@@ -1,0 +1,100 @@
+"""End to end: a CSV of points with text columns in, cells out, as a GIS user runs it.
+
+Times whole processes (start-up included) and their peak memory, for
+  tvoronoi batch points.csv -o cells.geojson
+  tvoronoi batch points.csv -o cells.parquet          (GeoParquet, needs the parquet extra)
+  pandas.read_csv -> shapely.voronoi_polygons -> geopandas.to_file (GeoJSON), the usual pipeline
+on the same file of n points (x, y and two text columns).
+
+    python benchmarks/batch.py --n 1M --out benchmarks/results/batch
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.common import atomic_write, describe_machine, machine, parse_sizes, subprocess_env  # noqa: E402
+
+PANDAS_SHAPELY = """
+import sys
+import geopandas, pandas, shapely
+frame = pandas.read_csv(sys.argv[1])
+points = shapely.points(frame["x"].to_numpy(), frame["y"].to_numpy())
+cells = shapely.voronoi_polygons(shapely.multipoints(points), ordered=True)
+out = geopandas.GeoDataFrame(frame[["name", "kind"]], geometry=list(shapely.get_parts(cells)))
+out.to_file(sys.argv[2], driver="GeoJSON")
+"""
+
+
+def write_points(path: Path, n: int) -> None:
+    rng = np.random.default_rng(17)
+    xy = rng.random((n, 2)) * 1000.0
+    kinds = np.array(["shop", "school", "clinic", "park"])[rng.integers(0, 4, n)]
+    with open(path, "w") as f:
+        f.write("x,y,name,kind\n")
+        for k in range(0, n, 100_000):
+            block = range(k, min(n, k + 100_000))
+            f.write("".join(f"{xy[i, 0]:.6f},{xy[i, 1]:.6f},site {i},{kinds[i]}\n" for i in block))
+
+
+def run(cmd: list[str]) -> tuple[float, float]:
+    """Wall seconds and peak MiB of one whole process (its own peak, from wait4)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, env=subprocess_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    if status != 0:
+        raise RuntimeError(f"{cmd} failed: {proc.stderr.read().decode()[-2000:]}")
+    return wall, usage.ru_maxrss / 1024
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", default="1M")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default="benchmarks/results/batch")
+    args = ap.parse_args(argv)
+    n = parse_sizes(args.n)[0]
+    info = machine()
+    out_dir = Path(args.out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "points.csv"
+        write_points(src, n)
+        tv = [sys.executable, "-m", "tvoronoi", "batch", "-q", "--force", str(src), "-o"]
+        cases = {
+            "tvoronoi batch -> GeoJSON": tv + [str(Path(tmp) / "cells.geojson")],
+            "tvoronoi batch -> GeoParquet": tv + [str(Path(tmp) / "cells.parquet")],
+            "pandas + shapely.voronoi_polygons + to_file (GeoJSON)": [
+                sys.executable, "-c", PANDAS_SHAPELY, str(src), str(Path(tmp) / "shapely.geojson")],
+        }
+        rows = {name: [] for name in cases}
+        for _ in range(args.repeats):            # interleaved rounds
+            for name, cmd in cases.items():
+                rows[name].append(run(cmd))
+                print(f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB", flush=True)
+        sizes = {name: (Path(cmd[-1]).stat().st_size if Path(cmd[-1]).exists() else 0) for name, cmd in cases.items()}
+    lines = ["# Batch end to end", "", f"Machine: {describe_machine(info)}", "",
+             f"{n:,} points in a CSV (x, y and two text columns), cells out; whole processes, start-up included; "
+             f"median of {args.repeats} interleaved runs, peak resident memory of the process.", "",
+             "| pipeline | wall s | peak MiB | output MB |", "|---|---:|---:|---:|"]
+    for name, runs in rows.items():
+        lines.append(f"| {name} | {statistics.median(r[0] for r in runs):.2f} | "
+                     f"{statistics.median(r[1] for r in runs):.0f} | {sizes[name] / 1e6:.0f} |")
+    atomic_write(out_dir / "batch.md", "\n".join(lines) + "\n")
+    print(f"# wrote {out_dir / 'batch.md'}")
+
+
+if __name__ == "__main__":
+    main()
