@@ -27,6 +27,7 @@ from tvoronoi.generators import DISTRIBUTIONS, generate
 from tvoronoi.tui import editing, playback
 from tvoronoi.tui.building import BUILD_THREAD_MIN_SITES, Built, BuildingMixin, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
+from tvoronoi.tui.commands import app_commands
 from tvoronoi.tui.editing import EditingMixin
 from tvoronoi.tui.files import FilesMixin
 from tvoronoi.tui.inspector import InspectorMixin
@@ -435,6 +436,17 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self._set_status(" · ".join(parts))
 
     # -- actions -------------------------------------------------------------
+
+    def get_system_commands(self, screen):
+        """The command palette: Textual's commands, then the app's own (tui/commands.py)."""
+        yield from super().get_system_commands(screen)
+        yield from app_commands(self)
+
+    def action_next_engine(self) -> None:
+        """Switch to the other engine: the same points again, the view kept."""
+        select = self.query_one("#engine", Select)
+        engines = list(ENGINES)
+        select.value = engines[(engines.index(str(select.value)) + 1) % len(engines)]
 
     def action_relax(self) -> None:
         """One Lloyd step: every site moves to the centroid of its cell, and the diagram is rebuilt."""
