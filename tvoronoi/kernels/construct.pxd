@@ -36,8 +36,34 @@ cdef extern from *:
     #include <float.h>
     /* the unit roundoff of long double: 2^-64 for x87 extended, 2^-53 where long double is double */
     #define TVORONOI_LDBL_EPS (LDBL_EPSILON / 2.0L)
+    #include <stdint.h>
+    #include <string.h>
+    /* Half the smaller of the two gaps between s and its neighbouring doubles, from s's bits (no libm
+       call). 0 where that is not a normal double or the neighbour may not be: s zero, subnormal or
+       near the bottom of the normal range, in the top binade, infinite or NaN; a caller then proves
+       nothing and takes its slow path. s = 1.f 2^(ex - 1023) has gaps of 2^(ex - 1075), except a
+       power of two, whose gap toward zero is half that. */
+    static inline double tvoronoi_half_gap(double s) {
+        uint64_t b, h;
+        double r;
+        memcpy(&b, &s, sizeof b);
+        uint64_t ex = (b >> 52) & 0x7ff;
+        if (ex <= 54 || ex >= 0x7fe) return 0.0;
+        h = ((b & 0xfffffffffffffULL) == 0 ? ex - 54 : ex - 53) << 52;
+        memcpy(&r, &h, sizeof r);
+        return r;
+    }
+    /* 2^e as a double, for -1022 <= e <= 1023 */
+    static inline double tvoronoi_pow2(int e) {
+        uint64_t b = (uint64_t)(e + 1023) << 52;
+        double r;
+        memcpy(&r, &b, sizeof r);
+        return r;
+    }
     """
     const long double LDBL_EPS "TVORONOI_LDBL_EPS"
+    double half_gap "tvoronoi_half_gap"(double s) noexcept nogil
+    double pow2 "tvoronoi_pow2"(int e) noexcept nogil
 
 cdef enum:
     # largest expansions met here: a circumcentre's numerator (3 terms of 16) and denominator (3 of 4)
@@ -302,19 +328,22 @@ cdef inline bint circumcentre_relative(double ax, double ay, double bx, double b
 
 cdef inline bint settled(double a, double u, double err, int e, double* out) noexcept nogil:
     # a + u with |u - exact| <= err: is the rounding of a + exact known to be fl(a + u)? (then 2^e * it)
-    cdef double s, t, g_hi, g_lo, r
+    cdef double s, t, hg
     s, t = two_sum(a, u)
-    g_hi = nextafter(s, INFINITY) - s
-    g_lo = s - nextafter(s, -INFINITY)
-    # strictly inside the rounding interval of s: no tie, no neighbour
-    if not (t + err < 0.5 * g_hi and t - err > -0.5 * g_lo):
+    # strictly inside the rounding interval of s (narrowed to its shorter side): no tie, no neighbour
+    hg = half_gap(s)
+    if not (t + err < hg and t - err > -hg):
         return False
     return scaled_back(s, e, out)
 
 
 cdef inline bint scaled_back(double s, int e, double* out) noexcept nogil:
     # 2^e * s, if exact: no overflow, no subnormal result
-    cdef double r = ldexp(s, e)
+    cdef double r
+    if -1022 <= e <= 1023:
+        r = s * pow2(e)             # exact, unless it overflows or turns subnormal (refused below)
+    else:
+        r = ldexp(s, e)
     if fabs(r) == INFINITY or (r != 0.0 and fabs(r) < 2.2250738585072014e-308) or (r == 0.0 and s != 0.0):
         return False
     out[0] = r
