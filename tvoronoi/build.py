@@ -60,13 +60,14 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
     cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row)
+    del ring, offsets, cell_of_row                   # the clipper's buffer, before the relabelling below
 
     face_edge = np.full(n, -1, np.int32)
     face_edge[owner[firsts]] = out["face_edge"][firsts]
     # engine sites to input rows in place (out is this build's own), and the vertices are the first
     # rows of the clipper's points (the same doubles): no second copy of either
-    he_face = np.take(owner, out["he_face"], out=out["he_face"], mode="clip")
-    triangles = np.take(owner, out["triangles"], out=out["triangles"], mode="clip")
+    he_face = clip.relabel(owner, out["he_face"], threads)
+    triangles = clip.relabel(owner, out["triangles"].reshape(-1), threads)
     return Diagram(
         sites=pts,
         site_of=site_of,

@@ -428,6 +428,20 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int6
     return cell_offsets_arr, vertices_arr
 
 
+def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
+    """ids[k] = label[ids[k]] in place (engine sites to input rows in the Diagram's arrays), with no
+    index copy; ids must lie in [0, len(label)). The same result for any thread count."""
+    cdef Py_ssize_t k, count = ids.shape[0], n_label = label.shape[0]
+    cdef int T = threads if count >= (1 << 18) and threads > 1 else 1
+    with nogil:
+        for k in prange(count, num_threads=T, schedule="static"):
+            if 0 <= ids[k] < n_label:
+                ids[k] = label[ids[k]]
+            else:
+                ids[k] = -1
+    return np.asarray(ids)
+
+
 def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind):
     """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
     cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
