@@ -116,7 +116,8 @@ def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) 
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
         raise TvoronoiError(
-            f"partition {number}, row {row}: the point ({xs[row]!r}, {ys[row]!r}) is not finite "
+            f"partition {number}, row {row} (index {part.index[row]!r}): the point ({float(xs[row])!r}, "
+            f"{float(ys[row])!r}) is not finite "
             f"({int(bad.sum())} such point(s) in this partition); drop or fix those rows"
         )
     if clip is not None:
@@ -124,7 +125,7 @@ def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) 
 
         keep = sites_inside(np.column_stack([xs, ys]), clip)
         xs, ys = xs[keep], ys[keep]
-    out = {"n": len(part), "m": len(xs), "extent": None, "sample": np.empty((0, 2))}
+    out: dict = {"n": len(part), "m": len(xs), "extent": None, "sample": np.empty((0, 2))}
     if len(xs):
         out["extent"] = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
         rng = np.random.default_rng([seed, number])
@@ -306,7 +307,6 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k) for k, p in enumerate(parts)]
     ))
     counts = [s["n"] for s in summaries]
-    n = int(sum(counts))
     m = int(sum(s["m"] for s in summaries))
     if m == 0:
         where = "inside the clip region" if clip is not None else "in the input"
@@ -353,7 +353,7 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
         outputs.extend(cells)
         pending = {t: ids for t, ids in zip(list(pending), left) if len(ids)}
-        pending_after.append(int(sum(len(ids) for ids in pending.values())))
+        pending_after.append(sum(len(ids) for ids in left))
     if to is not None:
         from tvoronoi.writers.parts import finish_directory
 

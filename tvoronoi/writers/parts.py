@@ -61,7 +61,7 @@ def _write_parquet_part(frame, path: str, crs) -> None:
     from tvoronoi.writers.geoparquet import _geo_metadata, _write, require_pyarrow
 
     pa = require_pyarrow()
-    geometry, bbox, extent, types = _geometry_columns(pa, np.asarray(frame["geometry"].to_numpy(), object))
+    geometry, bbox, extent, types = _geometry_columns(pa, frame["geometry"].to_numpy(dtype=object, na_value=None))
     table = pa.Table.from_pandas(frame.drop(columns=["geometry"]), preserve_index=False)
     table = table.append_column("geometry", geometry).append_column("bbox", bbox)
     table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, types or ["Polygon"], crs)})
@@ -71,7 +71,7 @@ def _write_parquet_part(frame, path: str, crs) -> None:
 def _write_geojsonseq_part(frame, path: str) -> None:
     import shapely
 
-    geoms = shapely.from_wkb(np.asarray(frame["geometry"].to_numpy(), object))
+    geoms = shapely.from_wkb(frame["geometry"].to_numpy(dtype=object, na_value=None))
     names = [c for c in frame.columns if c != "geometry"]
     columns = [frame[c].to_numpy() for c in names]
     with open_output(path, overwrite=False) as stream:
