@@ -150,3 +150,70 @@ def test_the_core_package_works_without_dask():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "pip install 'tvoronoi[dask]'" in out
+
+
+# ---------------------------------------------------------------------------------------------
+# the command line: tvoronoi batch INPUT -o DIR --dask ...
+
+
+def write_csv_parts(directory, pts: np.ndarray, parts: int) -> None:
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), parts)):
+        pd.DataFrame({"label": [f"r{i}" for i in chunk], "x": pts[chunk, 0], "y": pts[chunk, 1]}).to_csv(
+            directory / f"points-{k}.csv", index=False)
+
+
+def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, capsys):
+    import geopandas
+
+    from tvoronoi.cli import main
+
+    pts = generate("gaussian", 20_000, seed=4)
+    write_csv_parts(tmp_path, pts, 3)
+    out = tmp_path / "cells.parquet"
+    status = main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", client.scheduler.address,
+                   "--tiles", "5"])
+    assert status == 0, capsys.readouterr().err
+    assert "3 file(s)" in capsys.readouterr().err
+    frame = geopandas.read_parquet(out).sort_values("site").reset_index(drop=True)
+    assert frame["label"].tolist() == [f"r{i}" for i in range(len(pts))]
+    assert shapely.equals_exact(frame.geometry.to_numpy(), tvoronoi.voronoi(pts).to_shapely(), tolerance=0).all()
+
+
+def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path):
+    import geopandas
+
+    from tvoronoi.cli import main
+
+    pts = generate("clustered", 10_000, seed=6)
+    source = tmp_path / "points"
+    source.mkdir()
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), 2)):
+        geopandas.GeoDataFrame({"w": chunk * 2.0}, geometry=geopandas.points_from_xy(*pts[chunk].T)).to_parquet(
+            source / f"part{k}.parquet")
+    out = tmp_path / "cells"
+    assert main(["batch", str(source), "-o", str(out), "--dask", "local:2", "--to", "geojsonseq", "-q"]) == 0
+    import orjson
+
+    features = [orjson.loads(line.lstrip(b"\x1e")) for part in out.iterdir() for line in part.read_bytes().splitlines()]
+    assert sorted(f["properties"]["site"] for f in features) == list(range(len(pts)))
+    full = tvoronoi.voronoi(pts)
+    for f in features[::50]:
+        i = f["properties"]["site"]
+        assert f["properties"]["w"] == 2.0 * i
+        assert np.array_equal(np.array(f["geometry"]["coordinates"][0][:-1]), full.cell_polygon(i))
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--dask", "loc"], "--dask 'loc': give local"),
+    (["--dask", "local:0"], "needs at least one worker"),
+    (["--dask", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+    (["--tiles", "3"], "--tiles goes with --dask"),
+    (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
+    (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
+])
+def test_cli_errors_are_named(tmp_path, capsys, argv, message):
+    from tvoronoi.cli import main
+
+    write_csv_parts(tmp_path, generate("uniform", 100, seed=1), 1)
+    assert main(["batch", str(tmp_path / "points-0.csv"), "-o", str(tmp_path / "out"), *argv]) == 2
+    assert message in capsys.readouterr().err

@@ -375,7 +375,7 @@ def local_client(workers: int | None = None):
         except AttributeError:
             workers = os.cpu_count() or 1
     cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None)
+                                       dashboard_address=":0")
     return distributed.Client(cluster)
 
 
