@@ -120,18 +120,31 @@ def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) 
             f"{float(ys[row])!r}) is not finite "
             f"({int(bad.sum())} such point(s) in this partition); drop or fix those rows"
         )
+    out: dict = {"n": len(part), "extent_all": _extent(xs, ys)}
     if clip is not None:
         from tvoronoi.region import sites_inside
 
         keep = sites_inside(np.column_stack([xs, ys]), clip)
         xs, ys = xs[keep], ys[keep]
-    out: dict = {"n": len(part), "m": len(xs), "extent": None, "sample": np.empty((0, 2))}
+    out.update(m=len(xs), extent=None, sample=np.empty((0, 2)))
     if len(xs):
-        out["extent"] = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+        out["extent"] = _extent(xs, ys)
         rng = np.random.default_rng([seed, number])
         take = rng.choice(len(xs), min(len(xs), n_sample), replace=False) if len(xs) > n_sample else slice(None)
         out["sample"] = np.column_stack([xs[take], ys[take]])
     return out
+
+
+def _extent(xs: np.ndarray, ys: np.ndarray) -> Region | None:
+    if len(xs) == 0:
+        return None
+    return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+
+
+def _meets(extent: Region | None, region: Region) -> bool:
+    """Whether a partition's sites (their extent) can lie in the closed region."""
+    return extent is not None and not (extent[2] < region[0] or extent[0] > region[2] or extent[3] < region[1]
+                                       or extent[1] > region[3])
 
 
 def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str], clip):
@@ -346,8 +359,11 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         tasks = []
         for t, ids in pending.items():
             region = plan.region(t, round_)
-            pieces = [dask.delayed(_select)(p, int(firsts[k]), xname, yname, region, list(properties), clip)
-                      for k, p in enumerate(parts)]
+            # only the partitions whose sites reach the region (all of them for shuffled input; a few for
+            # input sorted in space); one piece at least, so that the task knows the columns
+            reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
+            pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
+                      for k in reach]
             tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, round_, ids, job))
         futures = client.compute([task[0] for task in tasks] + [task[1] for task in tasks])
         cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
