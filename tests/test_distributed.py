@@ -65,11 +65,11 @@ def test_a_1e9_cluster_with_repeats_equals_one_process(client):
     assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
 
 
-def test_a_grid_with_a_tight_halo_needs_rounds_and_equals_one_process(client):
+def test_a_grid_with_a_tight_halo_needs_a_second_round_and_equals_one_process(client):
     side = 200
     pts = np.stack(np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float)), -1).reshape(-1, 2)
     result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1)
-    assert result.rounds > 2
+    assert result.rounds > 1 and result.pending_after[0] > 0
     assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
 
 

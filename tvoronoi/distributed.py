@@ -170,8 +170,8 @@ def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str
 # one tile, one round (runs on a worker)
 
 
-def _run_tile(pieces: list, t: int, round_: int, pending, job: Job):
-    """Build tile t's region in this round; return (cells frame or part path, pending ids)."""
+def _run_tile(pieces: list, t: int, region: Region, pending, job: Job, round_: int):
+    """Build tile t's region; return (cells frame or part path, (pending ids, their reach))."""
     import pandas as pd
 
     sites = pd.concat(pieces, ignore_index=True) if pieces else pd.DataFrame()
@@ -184,17 +184,17 @@ def _run_tile(pieces: list, t: int, round_: int, pending, job: Job):
     inside = sites["__tvoronoi_inside"].to_numpy(bool)
     built = np.flatnonzero(inside)
     pts = np.column_stack([xs[built], ys[built]])
-    region = plan.region(t, round_)
     cells = build_tile(pts, ids[built], own[built], region, plan.box,
-                       everything=plan.sees_everything(t, round_), engine=job.engine)
+                       everything=plan.sees_everything(region), engine=job.engine)
     # the tile's own sites outside the clip region get no cell: written once, in the first round
     outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
     frame = _cells_frame(sites, ids, cells, outside, job)
+    left = (cells.pending, cells.reach)
     if job.to is None:
-        return frame, cells.pending
+        return frame, left
     from tvoronoi.writers.parts import write_part
 
-    return write_part(frame, job.to, f"part-r{round_:02d}-t{t:05d}", job.format, job.crs), cells.pending
+    return write_part(frame, job.to, f"part-r{round_:02d}-t{t:05d}", job.format, job.crs), left
 
 
 def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
@@ -348,7 +348,7 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs)
 
     # rounds: every tile in the first, then the tiles with pending cells, their halos doubled
-    pending: dict[int, np.ndarray | None] = {t: None for t in range(plan.n_tiles)}
+    pending: dict[int, tuple | None] = {t: None for t in range(plan.n_tiles)}   # tile -> (ids, reach)
     outputs = []
     pending_after = []
     round_ = 0
@@ -357,19 +357,20 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
         tasks = []
-        for t, ids in pending.items():
-            region = plan.region(t, round_)
+        for t, left_over in pending.items():
+            ids, reach = (None, None) if left_over is None else left_over
+            region = plan.region(t, round_, reach)
             # only the partitions whose sites reach the region (all of them for shuffled input; a few for
             # input sorted in space); one piece at least, so that the task knows the columns
             reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
             pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
                       for k in reach]
-            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, round_, ids, job))
+            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, region, ids, job, round_))
         futures = client.compute([task[0] for task in tasks] + [task[1] for task in tasks])
         cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
         outputs.extend(cells)
-        pending = {t: ids for t, ids in zip(list(pending), left) if len(ids)}
-        pending_after.append(sum(len(ids) for ids in left))
+        pending = {t: (ids, reach) for t, (ids, reach) in zip(list(pending), left) if len(ids)}
+        pending_after.append(sum(len(ids) for ids, _ in left))
     if to is not None:
         from tvoronoi.writers.parts import finish_directory
 

@@ -177,18 +177,37 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     return bad == 0
 
 
+def flower_box(ring_xy: np.ndarray, sites: np.ndarray) -> Region:
+    """The bounding box of the disks centred at each ring point through its cell's site (the cells' "flowers").
+
+    ``sites`` (K, 2) repeats each cell's site for each point of its ring (a site lies on its disks). A
+    later build that sees every
+    site of this box (grown by a margin for rounding) certifies the cells: with more sites a cell can
+    only shrink, and a disk centred at a point w of a smaller cell through the site lies in the union of
+    the disks at the larger cell's vertices (a half-plane {q : |q - p| <= |q - s|} that holds w holds a
+    vertex of the larger convex cell).
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = np.hypot(ring_xy[:, 0] - sites[:, 0], ring_xy[:, 1] - sites[:, 1])
+        lo = (ring_xy - r[:, None]).min(axis=0)
+        hi = (ring_xy + r[:, None]).max(axis=0)
+    return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
+
 @dataclass(frozen=True)
 class TileCells:
     """The cells one task certified: site ids, their rings in CSR form, and the ids left for a later round.
 
     ``ids`` (c,) int64 ascending, ``offsets`` (c + 1,) int64, ``ring_xy`` (K, 2) float64 (cell k is
     ``ring_xy[offsets[k]:offsets[k + 1]]``, as ``Diagram.cell_polygon``); ``pending`` (p,) int64.
+    ``reach`` bounds what the pending cells need seen (see ``flower_box``); None without pending cells.
     """
 
     ids: np.ndarray
     offsets: np.ndarray
     ring_xy: np.ndarray
     pending: np.ndarray
+    reach: Region | None = None
 
     def rings(self):
         """Iterate over (id, ring) pairs."""
@@ -234,8 +253,12 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     k_off = np.zeros(len(keep) + 1, np.int64)
     np.cumsum(k_len, out=k_off[1:])
     k_gather = np.repeat(offsets[keep] - k_off[:-1], k_len) + np.arange(k_off[-1])
+    reach = None
+    if not ok.all():
+        bad = np.repeat(~ok, lengths)
+        reach = flower_box(ring_xy[bad], np.repeat(pts[rows], lengths, axis=0)[bad])
     return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[k_gather],
-                     ids[rows[~ok]].astype(np.int64))
+                     ids[rows[~ok]].astype(np.int64), reach)
 
 
 @dataclass(frozen=True)
@@ -251,12 +274,19 @@ class Plan:
     def n_tiles(self) -> int:
         return len(self.rects)
 
-    def region(self, t: int, round_: int) -> Region:
-        """The closed rectangle tile t's task sees in round ``round_`` (1, 2, ...): the halo doubles each round."""
-        return grown(self.rects[t], float(self.halos[t]) * 2.0 ** (round_ - 1))
+    def region(self, t: int, round_: int = 1, reach: Region | None = None) -> Region:
+        """The closed rectangle tile t's task sees in round ``round_`` (1, 2, ...).
 
-    def sees_everything(self, t: int, round_: int) -> bool:
-        return covers(self.region(t, round_), self.extent)
+        The first round sees the tile grown by its halo; a later one the ``reach`` of the cells still
+        pending (``TileCells.reach``, which holds what they need seen) grown by the halo doubled once
+        per round (a margin far above the certification's rounding slack, so every round makes progress).
+        """
+        if reach is None:
+            return grown(self.rects[t], float(self.halos[t]))
+        return grown(reach, float(self.halos[t]) * 2.0 ** (round_ - 1))
+
+    def sees_everything(self, region: Region) -> bool:
+        return covers(region, self.extent)
 
 
 def plan_tiles(sample: np.ndarray, n_tiles: int, extent: Region, box: Region) -> Plan:
@@ -337,19 +367,23 @@ def tiled_cells(points, *, tiles: int, bbox=None, engine: str = "incremental", s
     todo = np.ones(n, bool)
     parts: list[TileCells] = []
     pending_after: list[int] = []
+    reaches: dict[int, Region | None] = {t: None for t in range(plan.n_tiles)}
     round_ = 0
-    while todo.any():
+    while reaches:
         round_ += 1
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
-        for t in np.unique(owner[todo]).tolist():
-            region = plan.region(t, round_)
-            seen = in_region(pts[:, 0], pts[:, 1], region)
-            rows = np.flatnonzero(seen)
+        next_reaches: dict[int, Region | None] = {}
+        for t, reach in reaches.items():
+            region = plan.region(t, round_, reach)
+            rows = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
             cells = build_tile(pts[rows], ids[rows], (owner[rows] == t) & todo[rows], region, box,
-                               everything=plan.sees_everything(t, round_), engine=engine)
+                               everything=plan.sees_everything(region), engine=engine)
             todo[cells.ids] = False
             parts.append(cells)
+            if len(cells.pending):
+                next_reaches[t] = cells.reach
+        reaches = next_reaches
         pending_after.append(int(todo.sum()))
     out_ids, offsets, ring_xy = concat_cells(parts)
     return TiledCells(out_ids, offsets, ring_xy, round_, pending_after)
