@@ -188,17 +188,21 @@ def _run_tile(pieces: list, t: int, region: Region, pending, job: Job, round_: i
                        everything=plan.sees_everything(region), engine=job.engine)
     # the tile's own sites outside the clip region get no cell: written once, in the first round
     outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
-    frame = _cells_frame(sites, ids, cells, outside, job)
     left = (cells.pending, cells.reach)
     if job.to is None:
-        return frame, left
+        return _cells_frame(sites, ids, cells, outside, job), left
     from tvoronoi.writers.parts import write_part
 
-    return write_part(frame, job.to, f"part-r{round_:02d}-t{t:05d}", job.format, job.crs), left
+    frame, geoms = _cells_frame(sites, ids, cells, outside, job)
+    return write_part(frame, geoms, job.to, f"part-r{round_:02d}-t{t:05d}", job.format, job.crs), left
 
 
 def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
-    """The emitted rows in site order: ``site``, the properties, ``geometry`` (WKB; None without a cell)."""
+    """The emitted rows in site order: ``site``, the properties, ``geometry`` (WKB; None without a cell).
+
+    When the cells are written (``job.to``), the frame has no geometry column and the shapely cells come
+    beside it: (frame, geometries); the writer takes them as they are.
+    """
     import pandas as pd
     import shapely
 
@@ -221,6 +225,8 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
     out = {SITE: site[order]}
     for name in job.properties:
         out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
+    if job.to is not None:
+        return pd.DataFrame(out), geoms[order]
     wkb = shapely.to_wkb(geoms[order]) if len(order) else np.empty(0, object)
     out[GEOMETRY] = pd.array(wkb, dtype=_binary_dtype())
     return pd.DataFrame(out)

@@ -32,8 +32,9 @@ def prepare_directory(path) -> Path:
     return out
 
 
-def write_part(frame, directory, stem: str, format: str, crs=None) -> str:
-    """Write one task's cells (a frame of ``site``, properties, WKB ``geometry``); return the part's name.
+def write_part(frame, geoms: np.ndarray, directory, stem: str, format: str, crs=None) -> str:
+    """Write one task's cells (a frame of ``site`` and properties, and the cells as shapely geometries or
+    None); return the part's name.
 
     Returns "" for a task without rows (no empty part is written).
     """
@@ -42,37 +43,25 @@ def write_part(frame, directory, stem: str, format: str, crs=None) -> str:
     name = stem + SUFFIXES[format]
     path = os.path.join(str(directory), name)
     if format == "parquet":
-        _write_parquet_part(frame, path, crs)
+        _write_parquet_part(frame, geoms, path, crs)
     else:
-        _write_geojsonseq_part(frame, path)
+        _write_geojsonseq_part(frame, geoms, path)
     return name
 
 
-def _geometry_columns(pa, wkb: np.ndarray):
-    """The geometry (WKB) and bbox covering columns, the extent and the geometry types of WKB cells."""
-    from tvoronoi.writers.geoparquet import _shapely_cells
-
-    import shapely
-
-    return _shapely_cells(pa, shapely.from_wkb(wkb))
-
-
-def _write_parquet_part(frame, path: str, crs) -> None:
-    from tvoronoi.writers.geoparquet import _geo_metadata, _write, require_pyarrow
+def _write_parquet_part(frame, geoms: np.ndarray, path: str, crs) -> None:
+    from tvoronoi.writers.geoparquet import _geo_metadata, _shapely_cells, _write, require_pyarrow
 
     pa = require_pyarrow()
-    geometry, bbox, extent, types = _geometry_columns(pa, frame["geometry"].to_numpy(dtype=object, na_value=None))
-    table = pa.Table.from_pandas(frame.drop(columns=["geometry"]), preserve_index=False)
+    geometry, bbox, extent, types = _shapely_cells(pa, geoms)
+    table = pa.Table.from_pandas(frame, preserve_index=False)
     table = table.append_column("geometry", geometry).append_column("bbox", bbox)
     table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, types or ["Polygon"], crs)})
     _write(pa, table, path, overwrite=False)
 
 
-def _write_geojsonseq_part(frame, path: str) -> None:
-    import shapely
-
-    geoms = shapely.from_wkb(frame["geometry"].to_numpy(dtype=object, na_value=None))
-    names = [c for c in frame.columns if c != "geometry"]
+def _write_geojsonseq_part(frame, geoms: np.ndarray, path: str) -> None:
+    names = list(frame.columns)
     columns = [frame[c].to_numpy() for c in names]
     with open_output(path, overwrite=False) as stream:
         for k, geom in enumerate(geoms):
