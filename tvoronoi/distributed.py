@@ -208,6 +208,9 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
 
     lengths = np.diff(cells.offsets)
     has = lengths >= 3                              # fewer points: no area (a cell touching the box)
+    if job.to is not None and job.format == "parquet" and job.clip is None:
+        # rings straight to WKB in bulk (writers.geoparquet), no shapely geometry per cell
+        return _rings_frame(sites, ids, cells, has, job)
     geoms = np.full(len(cells.ids), None, object)
     if has.any():
         keep = np.repeat(has, lengths)
@@ -230,6 +233,27 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
     wkb = shapely.to_wkb(geoms[order]) if len(order) else np.empty(0, object)
     out[GEOMETRY] = pd.array(wkb, dtype=_binary_dtype())
     return pd.DataFrame(out)
+
+
+def _rings_frame(sites, ids: np.ndarray, cells, has: np.ndarray, job: Job):
+    """(frame, rings): the frame as ``_cells_frame`` writes it, and the cells as closed rings
+    ``(xy, ring_offsets, present)`` for ``writers.geoparquet``'s bulk WKB (cells.ids is ascending)."""
+    import pandas as pd
+
+    lengths = np.diff(cells.offsets)
+    keep = np.repeat(has, lengths)
+    ring = cells.ring_xy[keep]
+    kept = lengths[has]
+    stops = np.cumsum(kept)
+    starts = stops - kept
+    xy = np.insert(ring, stops, ring[starts], axis=0)           # each ring's first point again at its end
+    ring_offsets = np.zeros(len(kept) + 1, np.int64)
+    np.cumsum(kept + 1, out=ring_offsets[1:])
+    position = np.searchsorted(ids, cells.ids)
+    out = {SITE: cells.ids}
+    for name in job.properties:
+        out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
+    return pd.DataFrame(out), (np.ascontiguousarray(xy), ring_offsets, has)
 
 
 def _binary_dtype():

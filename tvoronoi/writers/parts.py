@@ -32,9 +32,9 @@ def prepare_directory(path) -> Path:
     return out
 
 
-def write_part(frame, geoms: np.ndarray, directory, stem: str, format: str, crs=None) -> str:
-    """Write one task's cells (a frame of ``site`` and properties, and the cells as shapely geometries or
-    None); return the part's name.
+def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str:
+    """Write one task's cells (a frame of ``site`` and properties, and the cells: shapely geometries or
+    None, or for GeoParquet closed rings ``(xy, ring_offsets, present)``); return the part's name.
 
     Returns "" for a task without rows (no empty part is written).
     """
@@ -49,11 +49,17 @@ def write_part(frame, geoms: np.ndarray, directory, stem: str, format: str, crs=
     return name
 
 
-def _write_parquet_part(frame, geoms: np.ndarray, path: str, crs) -> None:
+def _write_parquet_part(frame, geoms, path: str, crs) -> None:
     from tvoronoi.writers.geoparquet import _geo_metadata, _shapely_cells, _write, require_pyarrow
 
     pa = require_pyarrow()
-    geometry, bbox, extent, types = _shapely_cells(pa, geoms)
+    if isinstance(geoms, tuple):
+        from tvoronoi.writers.geoparquet import _polygons
+
+        geometry, bbox, extent = _polygons(pa, *geoms)
+        types = ["Polygon"]
+    else:
+        geometry, bbox, extent, types = _shapely_cells(pa, geoms)
     table = pa.Table.from_pandas(frame, preserve_index=False)
     table = table.append_column("geometry", geometry).append_column("bbox", bbox)
     table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, types or ["Polygon"], crs)})
