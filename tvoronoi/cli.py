@@ -51,6 +51,12 @@ output:
   first moves every site N times to the centroid of its cell (within the
   box, or the clip region) and writes the cells of the moved sites.
 
+  --dask local[:WORKERS] or --dask tcp://HOST:PORT builds the cells tile by
+  tile on a Dask cluster (pip install 'tvoronoi[dask]'), the same cells bit
+  for bit: INPUT may then be a CSV/Parquet file, a directory or a glob, and
+  OUTPUT is a new directory of GeoParquet parts (with _metadata) or, with
+  --to geojsonseq, of GeoJSONSeq parts; --tiles N sets the tiles.
+
   A progress display appears on stderr for inputs of 200,000 points or more
   when stderr is a terminal and -q is not given.
 
