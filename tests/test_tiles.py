@@ -16,6 +16,7 @@ from tvoronoi.tiles import (
     build_tile,
     certified,
     extent_of,
+    group_reaches,
     grown,
     in_region,
     kd_rects,
@@ -162,10 +163,23 @@ def test_hunt_certified_cells_are_final(seed, k):
         assert np.array_equal(ring, full.cell_polygon(i))
     if len(cells.pending) == 0:
         return
-    # the reach of the pending cells, grown by a margin, is enough: a second build certifies them all
-    region = grown(cells.reach, 1e-6)
-    seen = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
-    again = build_tile(pts[seen], seen.astype(np.int64), np.isin(seen, cells.pending), region, box)
-    assert len(again.pending) == 0 and sorted(again.ids.tolist()) == sorted(cells.pending.tolist())
-    for i, ring in again.rings():
-        assert np.array_equal(ring, full.cell_polygon(i))
+    # the reach of each group of pending cells, grown by a margin, is enough: a second build certifies them
+    groups = group_reaches(cells.pending, cells.reaches, 1e-6)
+    assert sorted(np.concatenate([g for g, _ in groups]).tolist()) == sorted(cells.pending.tolist())
+    for group, reach in groups:
+        region = grown(reach, 1e-6)
+        seen = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+        again = build_tile(pts[seen], seen.astype(np.int64), np.isin(seen, group), region, box)
+        assert len(again.pending) == 0 and sorted(again.ids.tolist()) == sorted(group.tolist())
+        for i, ring in again.rings():
+            assert np.array_equal(ring, full.cell_polygon(i))
+
+
+def test_group_reaches_keeps_far_cells_apart_and_joins_overlapping_ones():
+    pending = np.array([7, 3, 9])
+    reaches = np.array([[0.0, 0.0, 1.0, 1.0], [0.9, 0.9, 2.0, 2.0], [10.0, 10.0, 11.0, 11.0]])
+    groups = group_reaches(pending, reaches, 0.05)
+    assert sorted((g.tolist(), box) for g, box in groups) == [
+        ([3, 7], (0.0, 0.0, 2.0, 2.0)), ([9], (10.0, 10.0, 11.0, 11.0))]
+    # a margin that bridges the gap joins all three
+    assert [g.tolist() for g, _ in group_reaches(pending, reaches, 5.0)] == [[3, 7, 9]]

@@ -23,6 +23,7 @@ from tvoronoi.tiles import (
     Region,
     build_tile,
     default_tiles,
+    group_reaches,
     in_region,
     plan_tiles,
     tile_of,
@@ -170,8 +171,9 @@ def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str
 # one tile, one round (runs on a worker)
 
 
-def _run_tile(pieces: list, t: int, region: Region, pending, job: Job, round_: int):
-    """Build tile t's region; return (cells frame or part path, (pending ids, their reach))."""
+def _run_tile(pieces: list, t: int, region: Region, group, job: Job, round_: int, name: str):
+    """Build a region of tile t for its own sites (``group``: those of a group of pending cells only);
+    return (cells frame or part name, (pending ids, their reaches))."""
     import pandas as pd
 
     sites = pd.concat(pieces, ignore_index=True) if pieces else pd.DataFrame()
@@ -179,8 +181,8 @@ def _run_tile(pieces: list, t: int, region: Region, pending, job: Job, round_: i
     xs, ys = sites[X].to_numpy(), sites[Y].to_numpy()
     ids = sites[ID].to_numpy(np.int64)
     own = tile_of(xs, ys, plan.rects[t:t + 1]) == 0 if len(sites) else np.zeros(0, bool)
-    if pending is not None:
-        own &= np.isin(ids, pending)
+    if group is not None:
+        own &= np.isin(ids, group)
     inside = sites["__tvoronoi_inside"].to_numpy(bool)
     built = np.flatnonzero(inside)
     pts = np.column_stack([xs[built], ys[built]])
@@ -188,13 +190,13 @@ def _run_tile(pieces: list, t: int, region: Region, pending, job: Job, round_: i
                        everything=plan.sees_everything(region), engine=job.engine)
     # the tile's own sites outside the clip region get no cell: written once, in the first round
     outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
-    left = (cells.pending, cells.reach)
+    left = (cells.pending, cells.reaches)
     if job.to is None:
         return _cells_frame(sites, ids, cells, outside, job), left
     from tvoronoi.writers.parts import write_part
 
     frame, geoms = _cells_frame(sites, ids, cells, outside, job)
-    return write_part(frame, geoms, job.to, f"part-r{round_:02d}-t{t:05d}", job.format, job.crs), left
+    return write_part(frame, geoms, job.to, name, job.format, job.crs), left
 
 
 def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
@@ -368,7 +370,7 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     else:
         box = default_bbox(np.array([extent[:2], extent[2:]]))
     sample = np.concatenate([s["sample"] for s in summaries])
-    plan = plan_tiles(sample, tiles, extent, box)
+    plan = plan_tiles(sample, tiles, extent, box, m)
     plan = Plan(plan.rects, plan.halos * halo_scale, plan.extent, plan.box)
     firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     if to is not None:
@@ -377,30 +379,33 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         to = prepare_directory(to)
     job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs)
 
-    # rounds: every tile in the first, then the tiles with pending cells, their halos doubled
-    pending: dict[int, tuple | None] = {t: None for t in range(plan.n_tiles)}   # tile -> (ids, reach)
+    # rounds: every tile in the first; then each group of pending cells (group_reaches) with the box it
+    # needs, grown by the tile's halo doubled each round
+    units: list[tuple[int, np.ndarray | None, Region | None]] = [(t, None, None) for t in range(plan.n_tiles)]
     outputs = []
     pending_after = []
     round_ = 0
-    while pending:
+    while units:
         round_ += 1
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
         tasks = []
-        for t, left_over in pending.items():
-            ids, reach = (None, None) if left_over is None else left_over
-            region = plan.region(t, round_, reach)
+        for g, (t, group, box_needed) in enumerate(units):
+            region = plan.region(t, round_, box_needed)
             # only the partitions whose sites reach the region (all of them for shuffled input; a few for
             # input sorted in space); one piece at least, so that the task knows the columns
             reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
             pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
                       for k in reach]
-            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, region, ids, job, round_))
+            name = f"part-r{round_:02d}-t{t:05d}" + ("" if group is None else f"-g{g:05d}")
+            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, region, group, job, round_, name))
         futures = client.compute([task[0] for task in tasks] + [task[1] for task in tasks])
         cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
         outputs.extend(cells)
-        pending = {t: (ids, reach) for t, (ids, reach) in zip(list(pending), left) if len(ids)}
-        pending_after.append(sum(len(ids) for ids, _ in left))
+        units = [(t, ids, box_needed)
+                 for (t, _, _), (pending, reaches) in zip(units, left)
+                 for ids, box_needed in group_reaches(pending, reaches, plan.margin(t, round_))]
+        pending_after.append(sum(len(pending) for pending, _ in left))
     if to is not None:
         from tvoronoi.writers.parts import finish_directory
 

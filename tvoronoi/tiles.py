@@ -112,8 +112,7 @@ def covers(region: Region, extent: Region) -> bool:
 def first_halos(rects: np.ndarray, counts: np.ndarray, extent: Region) -> np.ndarray:
     """(T,) the first halo of each tile: ``HALO_SPACINGS`` typical site spacings of the tile.
 
-    ``counts`` are the tiles' shares of the sample (any scale: only the spacing matters, so a
-    count is taken relative to the sample's density over the extent); ``extent`` the sites' bounding
+    ``counts`` are the tiles' site counts (estimated from the sample); ``extent`` the sites' bounding
     box. A tile's area is that of its rectangle within the extent.
     """
     ex0, ey0, ex1, ey1 = extent
@@ -200,14 +199,14 @@ class TileCells:
 
     ``ids`` (c,) int64 ascending, ``offsets`` (c + 1,) int64, ``ring_xy`` (K, 2) float64 (cell k is
     ``ring_xy[offsets[k]:offsets[k + 1]]``, as ``Diagram.cell_polygon``); ``pending`` (p,) int64.
-    ``reach`` bounds what the pending cells need seen (see ``flower_box``); None without pending cells.
+    ``reaches`` (p, 4): for each pending cell, the box of what it needs seen (``flower_box``).
     """
 
     ids: np.ndarray
     offsets: np.ndarray
     ring_xy: np.ndarray
     pending: np.ndarray
-    reach: Region | None = None
+    reaches: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
 
     def rings(self):
         """Iterate over (id, ring) pairs."""
@@ -253,12 +252,48 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     k_off = np.zeros(len(keep) + 1, np.int64)
     np.cumsum(k_len, out=k_off[1:])
     k_gather = np.repeat(offsets[keep] - k_off[:-1], k_len) + np.arange(k_off[-1])
-    reach = None
-    if not ok.all():
-        bad = np.repeat(~ok, lengths)
-        reach = flower_box(ring_xy[bad], np.repeat(pts[rows], lengths, axis=0)[bad])
+    failed = np.flatnonzero(~ok)
+    reaches = np.empty((len(failed), 4))
+    site_of_point = np.repeat(pts[rows], lengths, axis=0)
+    for j, k in enumerate(failed.tolist()):
+        a, b = offsets[k], offsets[k + 1]
+        reaches[j] = flower_box(ring_xy[a:b], site_of_point[a:b])
     return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[k_gather],
-                     ids[rows[~ok]].astype(np.int64), reach)
+                     ids[rows[failed]].astype(np.int64), reaches)
+
+
+def group_reaches(pending: np.ndarray, reaches: np.ndarray, margin: float) -> list[tuple[np.ndarray, Region]]:
+    """Gather pending cells whose reaches, grown by ``margin``, overlap: [(ids, box)], one build each.
+
+    Cells at opposite ends of a tile are rebuilt apart, each with the few sites around it, instead of
+    in one box spanning the tile.
+    """
+    boxes = [list(grown(r, margin)) for r in reaches]
+    members = [[k] for k in range(len(boxes))]
+    merged = True
+    while merged:
+        merged = False
+        for a in range(len(boxes)):
+            if not members[a]:
+                continue
+            for b in range(a + 1, len(boxes)):
+                if members[b] and _overlap(boxes[a], boxes[b]):
+                    boxes[a] = [min(boxes[a][0], boxes[b][0]), min(boxes[a][1], boxes[b][1]),
+                                max(boxes[a][2], boxes[b][2]), max(boxes[a][3], boxes[b][3])]
+                    members[a] += members[b]
+                    members[b] = []
+                    merged = True
+    out = []
+    for ks in members:
+        if ks:
+            r = reaches[ks]
+            box = (float(r[:, 0].min()), float(r[:, 1].min()), float(r[:, 2].max()), float(r[:, 3].max()))
+            out.append((np.sort(pending[ks]), box))
+    return out
+
+
+def _overlap(a, b) -> bool:
+    return not (a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1])
 
 
 @dataclass(frozen=True)
@@ -277,22 +312,27 @@ class Plan:
     def region(self, t: int, round_: int = 1, reach: Region | None = None) -> Region:
         """The closed rectangle tile t's task sees in round ``round_`` (1, 2, ...).
 
-        The first round sees the tile grown by its halo; a later one the ``reach`` of the cells still
-        pending (``TileCells.reach``, which holds what they need seen) grown by the halo doubled once
-        per round (a margin far above the certification's rounding slack, so every round makes progress).
+        The first round sees the tile grown by its halo; a later one the ``reach`` of a group of cells
+        still pending (``group_reaches``: what they need seen) grown by the halo doubled once per round
+        (a margin far above the certification's rounding slack, so every round makes progress).
         """
         if reach is None:
             return grown(self.rects[t], float(self.halos[t]))
-        return grown(reach, float(self.halos[t]) * 2.0 ** (round_ - 1))
+        return grown(reach, self.margin(t, round_ - 1))
+
+    def margin(self, t: int, round_: int) -> float:
+        """How far beyond its reach a group of cells left after round ``round_`` is seen next."""
+        return float(self.halos[t]) * 2.0 ** round_
 
     def sees_everything(self, region: Region) -> bool:
         return covers(region, self.extent)
 
 
-def plan_tiles(sample: np.ndarray, n_tiles: int, extent: Region, box: Region) -> Plan:
-    """Cut the plane from a sample of the sites, and give each tile its first halo."""
+def plan_tiles(sample: np.ndarray, n_tiles: int, extent: Region, box: Region, n_sites: int) -> Plan:
+    """Cut the plane from a sample of the ``n_sites`` sites, and give each tile its first halo."""
     rects = kd_rects(sample, n_tiles)
-    counts = np.bincount(tile_of(sample[:, 0], sample[:, 1], rects), minlength=len(rects))
+    in_sample = np.bincount(tile_of(sample[:, 0], sample[:, 1], rects), minlength=len(rects))
+    counts = in_sample * (n_sites / max(1, len(sample)))
     return Plan(rects, first_halos(rects, counts, extent), extent, box)
 
 
@@ -360,30 +400,31 @@ def tiled_cells(points, *, tiles: int, bbox=None, engine: str = "incremental", s
     rng = np.random.default_rng(seed)
     take = min(n, SAMPLE_PER_TILE * tiles)
     sample = pts[np.sort(rng.choice(n, take, replace=False))] if take < n else pts
-    plan = plan_tiles(sample, tiles, extent_of(pts), box)
+    plan = plan_tiles(sample, tiles, extent_of(pts), box, n)
     plan = Plan(plan.rects, plan.halos * halo_scale, plan.extent, plan.box)
     ids = np.arange(n, dtype=np.int64)
     owner = tile_of(pts[:, 0], pts[:, 1], plan.rects)
     todo = np.ones(n, bool)
     parts: list[TileCells] = []
     pending_after: list[int] = []
-    reaches: dict[int, Region | None] = {t: None for t in range(plan.n_tiles)}
+    # a unit of work: a tile, and in later rounds a group of its pending cells with the box they need
+    units: list[tuple[int, np.ndarray | None, Region | None]] = [(t, None, None) for t in range(plan.n_tiles)]
     round_ = 0
-    while reaches:
+    while units:
         round_ += 1
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
-        next_reaches: dict[int, Region | None] = {}
-        for t, reach in reaches.items():
+        next_units: list[tuple[int, np.ndarray | None, Region | None]] = []
+        for t, group, reach in units:
             region = plan.region(t, round_, reach)
             rows = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
-            cells = build_tile(pts[rows], ids[rows], (owner[rows] == t) & todo[rows], region, box,
+            want = (owner[rows] == t) if group is None else np.isin(ids[rows], group)
+            cells = build_tile(pts[rows], ids[rows], want & todo[rows], region, box,
                                everything=plan.sees_everything(region), engine=engine)
             todo[cells.ids] = False
             parts.append(cells)
-            if len(cells.pending):
-                next_reaches[t] = cells.reach
-        reaches = next_reaches
+            next_units += [(t, g, b) for g, b in group_reaches(cells.pending, cells.reaches, plan.margin(t, round_))]
+        units = next_units
         pending_after.append(int(todo.sum()))
     out_ids, offsets, ring_xy = concat_cells(parts)
     return TiledCells(out_ids, offsets, ring_xy, round_, pending_after)
