@@ -152,8 +152,9 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     |v* - s| <= |v - s| + ulp(v.x)/2 + ulp(v.y)/2 from above. The floating-point evaluation of
     (v.x - x0), of |v - s| (two differences and a hypot) and of the comparison errs by a few units
     of 2^-53 relative; the relative slack ``CERTIFY_RELATIVE`` (2^-40) covers them, and
-    ``CERTIFY_ULPS`` ulps of both coordinates (plus the least subnormal, for results below the
-    normal range) cover the ring's rounding. Any non-finite value fails the test: never certified.
+    ``CERTIFY_ULPS`` ulps of the largest coordinate among the ring points, for each coordinate (an ulp
+    only grows with the magnitude; plus the least subnormal, for results below the normal range) cover
+    the ring's rounding. Any non-finite value fails the test: never certified.
     """
     n_cells = len(offsets) - 1
     lengths = np.diff(offsets)
@@ -164,7 +165,9 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     sx, sy = sites[owner, 0], sites[owner, 1]
     with np.errstate(over="ignore", invalid="ignore"):
         radius = np.hypot(vx - sx, vy - sy)
-        slack = CERTIFY_ULPS * (np.spacing(np.abs(vx)) + np.spacing(np.abs(vy))) + 4 * np.spacing(0.0)
+        # the ulp of the largest coordinate bounds every point's (ulps grow with magnitude)
+        top = max(float(np.abs(vx).max()), float(np.abs(vy).max()))
+        slack = 2 * CERTIFY_ULPS * float(np.spacing(top)) + 4 * float(np.spacing(0.0))
         need = radius * (1 + CERTIFY_RELATIVE) + slack
         ok = np.isfinite(need)
         x0, y0, x1, y1 = region
