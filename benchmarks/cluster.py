@@ -169,14 +169,21 @@ cells, WKB and the Arrow table of its part), and builds about {rate:,.0f} sites 
   what one Dask scheduler handles (~1 ms a task). At that scale the sites must first be shuffled to
   their tile once (dask.dataframe's shuffle on the tile number, n x 24 bytes over the network), the
   halos then taken from the 8 neighbouring tiles only (1.6% more); then 10^4 tasks a round at 10^10.
-- Rounds: with the first halo of 4 spacings, uniform data finishes in 2-3 rounds, each later round
-  rebuilding only the tiles with cells left (at box corners and sparse edges).
+- Rounds: with the first halo of 4 spacings, uniform data finishes in 2 rounds: the second rebuilds
+  each group of leftover cells (box corners and edges) with just the sites their disks reach, a few
+  thousand per group.
+- 10^8 here (not run): ~100 tiles of 10^6, peak ~{mem_gib:.1f} GiB per worker as above (goal < 4 GB), and
+  about {h8:.1f} hours on these 2 cores; the input (2.4 GB of x/y/row) never sits in one process.
 """
 
 
 def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | None, n: int | None,
            workers: int) -> str:
-    lines = ["# Tiles on more than one core", "", describe_machine(info), ""]
+    import os
+
+    lines = ["# Tiles on more than one core", "", describe_machine(info),
+             f"Load average at the end: {[round(v, 2) for v in os.getloadavg()]} (the machine is shared: other "
+             f"work ran on the same 2 cores during these runs, so the figures are upper bounds).", ""]
     if threads:
         ratio = threads["threads_2"] / threads["threads_1"]
         tiles_ratio = threads["tiles_in_2_threads"] / threads["threads_1"]
@@ -208,7 +215,7 @@ def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | N
         rate = n / cluster["seconds"] / workers
         lines.append(ESTIMATES.format(
             per_site=per_site, rate=rate, mem_gib=per_site * 1.016e6 / 2**30,
-            h9=1e9 / rate / 3600, h10=1e10 / rate / 3600, pending=cluster["pending_after"][0], n=n,
+            h8=1e8 / rate / 3600 / workers, h9=1e9 / rate / 3600, h10=1e10 / rate / 3600, pending=cluster["pending_after"][0], n=n,
         ))
     return "\n".join(lines) + "\n"
 
