@@ -157,8 +157,8 @@ cells, WKB and the Arrow table of its part), and builds about {rate:,.0f} sites 
 | 10^9 | 1,000 | {mem_gib:.1f} GiB | 1.6% (16 million) | about 24 GB (x, y, row: 24 bytes a site) | {h9:.1f} |
 | 10^10 | 10,000 | {mem_gib:.1f} GiB | 1.6% (160 million) | about 240 GB | {h10:.0f} |
 
-- Tasks: one per tile and round; the second and later rounds hold only the tiles with uncertified cells
-  (the sparse corners: {pending} of {n:,} cells after the first round here), so they cost a few percent.
+- Tasks: one per tile in the first round; then one per group of uncertified cells (box corners and
+  edges, sparse places: {pending} of {n:,} cells after the first round here), each a few thousand sites.
   With ~10^6 sites a tile, memory per task stays at the figure above whatever n: a cluster of workers with
   2-4 GiB each, one task per core, suffices; the output is written by the tasks (one part each).
 - Halos: a halo of 4 site spacings around a square tile of 10^6 sites (1,000 spacings a side) adds
