@@ -133,12 +133,16 @@ def test_geojsonseq_parts(client, tmp_path):
 def test_bad_input_is_named(client, tmp_path):
     pts = generate("uniform", 1_000, seed=1)
     pts[700] = np.nan
-    with pytest.raises(TvoronoiError, match=r"partition \d, row \d+ \(index 700\): the point \(nan, nan\) is not finite"):
+    with pytest.raises(TvoronoiError, match=r"partition \d, row \d+ \(index 700\): x is nan, not a finite number"):
         voronoi(frame_of(pts, 4), client=client, tiles=2)
     with pytest.raises(TvoronoiError, match="Dask DataFrame or a Dask array"):
         voronoi(pts, client=client)
     with pytest.raises(TvoronoiError, match="no column names the y coordinate"):
         voronoi(dd.from_pandas(pd.DataFrame({"x": [1.0], "height": [2.0]}), npartitions=1), client=client)
+    # a failure while the parts are written leaves no directory behind
+    with pytest.raises(TvoronoiError, match="cannot be written as JSON"):
+        voronoi(frame_of(pts[:100], 2, z=np.arange(100) * 1j), client=client, to=tmp_path / "seq", format="geojsonseq")
+    assert not (tmp_path / "seq").exists()
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "old.parquet").write_bytes(b"x")
     with pytest.raises(TvoronoiError, match="not empty"):
@@ -221,3 +225,14 @@ def test_cli_errors_are_named(tmp_path, capsys, argv, message):
     write_csv_parts(tmp_path, generate("uniform", 100, seed=1), 1)
     assert main(["batch", str(tmp_path / "points-0.csv"), "-o", str(tmp_path / "out"), *argv]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_cli_names_a_value_that_is_not_a_number_and_writes_nothing(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    (tmp_path / "bad.csv").write_text("x,y\n1,2\n3,abc\n5,6\n")
+    out = tmp_path / "cells"
+    assert main(["batch", str(tmp_path / "bad.csv"), "-o", str(out), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert "bad.csv: partition 0, row 1 (index 1): y is 'abc', not a finite number" in err
+    assert "Traceback" not in err and not out.exists()

@@ -130,7 +130,7 @@ def client_for(spec: str):
 
     where, workers = parse_dask(spec)
     if where == "local":
-        return local_client(workers)
+        return local_client(workers, quiet=True)
     return connect(where, timeout=CONNECT_TIMEOUT)
 
 
@@ -156,6 +156,11 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
     try:
         result = voronoi(frame, client=client, bbox=bbox, tiles=args.tiles, to=args.output, format=output_format,
                          clip=region, engine=args.engine, x=x, y=y, crs=args.crs)
+    except TvoronoiError as exc:
+        if str(exc).startswith(("partition ", "the points cannot be read")):
+            # partitions are numbered through the files in sorted order (a CSV file may hold several)
+            raise TvoronoiError(f"{args.input}: {exc}") from None
+        raise
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()

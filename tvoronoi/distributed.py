@@ -109,17 +109,25 @@ def _as_frame(points, x: str | None, y: str | None):
     return points, chosen[0], chosen[1]
 
 
+def _coordinates(part, column: str) -> np.ndarray:
+    """A coordinate column as float64, NaN where a value is not a number."""
+    import pandas as pd
+
+    return pd.to_numeric(part[column], errors="coerce").to_numpy(np.float64, na_value=np.nan)
+
+
 def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) -> dict:
     """One partition's row count, the extent of its sites (inside the clip region) and a sample of them."""
-    xs = np.asarray(part[x], np.float64)
-    ys = np.asarray(part[y], np.float64)
+    xs, ys = _coordinates(part, x), _coordinates(part, y)
     bad = ~(np.isfinite(xs) & np.isfinite(ys))
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
+        column = x if not np.isfinite(xs[row]) else y
+        value = part[column].iloc[row]
+        value = float(value) if isinstance(value, (float, np.floating)) else value
         raise TvoronoiError(
-            f"partition {number}, row {row} (index {part.index[row]!r}): the point ({float(xs[row])!r}, "
-            f"{float(ys[row])!r}) is not finite "
-            f"({int(bad.sum())} such point(s) in this partition); drop or fix those rows"
+            f"partition {number}, row {row} (index {part.index[row]!r}): {column} is {value!r}, not a finite "
+            f"number ({int(bad.sum())} such row(s) in this partition); drop or fix those rows"
         )
     out: dict = {"n": len(part), "extent_all": _extent(xs, ys)}
     if clip is not None:
@@ -152,8 +160,7 @@ def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str
     """The rows of one partition whose site lies in the closed ``region``, with their input rows."""
     import pandas as pd
 
-    xs = np.asarray(part[x], np.float64)
-    ys = np.asarray(part[y], np.float64)
+    xs, ys = _coordinates(part, x), _coordinates(part, y)
     rows = np.flatnonzero(in_region(xs, ys, region))
     frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
     inside = np.ones(len(rows), bool)
@@ -348,9 +355,14 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     # one pass: counts, extent, sample
     n_tiles_guess = tiles if tiles is not None else 4 * workers
     per_part = max(1, (SAMPLE_PER_TILE * n_tiles_guess) // max(1, len(parts)))
-    summaries = client.gather(client.compute(
-        [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k) for k, p in enumerate(parts)]
-    ))
+    try:
+        summaries = client.gather(client.compute(
+            [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k) for k, p in enumerate(parts)]
+        ))
+    except TvoronoiError:
+        raise
+    except (ValueError, TypeError, OSError) as exc:          # a partition that cannot be read
+        raise TvoronoiError(f"the points cannot be read: {exc}") from None
     counts = [s["n"] for s in summaries]
     m = int(sum(s["m"] for s in summaries))
     if m == 0:
@@ -379,6 +391,32 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         to = prepare_directory(to)
     job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs)
 
+    try:
+        outputs, rounds, pending_after = _rounds(client, plan, job, parts, summaries, firsts)
+        if to is not None:
+            from tvoronoi.writers.parts import finish_directory
+
+            names = tuple(client.gather(outputs))
+            finish_directory(to, [name for name in names if name], format, crs)
+    except BaseException:
+        if to is not None:                          # no half-written dataset left behind
+            from tvoronoi.writers.parts import remove_directory
+
+            remove_directory(to)
+        raise
+    if to is not None:
+        return Result(None, rounds, tuple(pending_after), plan.n_tiles, names)
+    import dask.dataframe as dd
+
+    meta = _meta(frame._meta, job)
+    return Result(dd.from_delayed(outputs, meta=meta, verify_meta=False), rounds, tuple(pending_after), plan.n_tiles)
+
+
+def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: np.ndarray):
+    """Run the rounds; return (the tasks' outputs as futures, rounds, cells pending after each round)."""
+    import dask
+
+    xname, yname, properties, clip = job.x, job.y, job.properties, job.clip
     # rounds: every tile in the first; then each group of pending cells (group_reaches) with the box it
     # needs, grown by the tile's halo doubled each round
     units: list[tuple[int, np.ndarray | None, Region | None]] = [(t, None, None) for t in range(plan.n_tiles)]
@@ -406,20 +444,16 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
                  for (t, _, _), (pending, reaches) in zip(units, left)
                  for ids, box_needed in group_reaches(pending, reaches, plan.margin(t, round_))]
         pending_after.append(sum(len(pending) for pending, _ in left))
-    if to is not None:
-        from tvoronoi.writers.parts import finish_directory
-
-        names = tuple(client.gather(outputs))
-        finish_directory(to, [name for name in names if name], format, crs)
-        return Result(None, round_, tuple(pending_after), plan.n_tiles, names)
-    import dask.dataframe as dd
-
-    meta = _meta(frame._meta, job)
-    return Result(dd.from_delayed(outputs, meta=meta, verify_meta=False), round_, tuple(pending_after), plan.n_tiles)
+    return outputs, round_, pending_after
 
 
-def local_client(workers: int | None = None):
-    """A LocalCluster on this machine (one single-threaded worker process per core by default) and its client."""
+def local_client(workers: int | None = None, *, quiet: bool = False):
+    """A LocalCluster on this machine (one single-threaded worker process per core by default) and its client.
+
+    ``quiet`` keeps the cluster's own log lines (a task's failure, told again by the exception) off stderr.
+    """
+    import logging
+
     distributed = require_dask()
     if workers is None:
         try:
@@ -427,7 +461,8 @@ def local_client(workers: int | None = None):
         except AttributeError:
             workers = os.cpu_count() or 1
     cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=":0")
+                                       dashboard_address=":0",
+                                       silence_logs=logging.CRITICAL if quiet else logging.WARN)
     return distributed.Client(cluster)
 
 

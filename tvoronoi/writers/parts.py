@@ -32,6 +32,21 @@ def prepare_directory(path) -> Path:
     return out
 
 
+def remove_directory(path) -> None:
+    """Remove what a failed build wrote: its parts and metadata files, then the directory if it is empty."""
+    out = Path(path)
+    for name in os.listdir(out) if out.is_dir() else ():
+        if name.startswith("part-") or name in (METADATA, COMMON_METADATA):
+            try:
+                os.remove(out / name)
+            except OSError:
+                pass
+    try:
+        out.rmdir()
+    except OSError:
+        pass
+
+
 def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str:
     """Write one task's cells (a frame of ``site`` and properties, and the cells: shapely geometries or
     None, or for GeoParquet closed rings ``(xy, ring_offsets, present)``); return the part's name.
