@@ -51,6 +51,12 @@ output:
   first moves every site N times to the centroid of its cell (within the
   box, or the clip region) and writes the cells of the moved sites.
 
+  --dask local[:WORKERS] or --dask tcp://HOST:PORT builds the cells tile by
+  tile on a Dask cluster (pip install 'tvoronoi[dask]'), the same cells bit
+  for bit: INPUT may then be a CSV/Parquet file, a directory or a glob, and
+  OUTPUT is a new directory of GeoParquet parts (with _metadata) or, with
+  --to geojsonseq, of GeoJSONSeq parts; --tiles N sets the tiles.
+
   A progress display appears on stderr for inputs of 200,000 points or more
   when stderr is a terminal and -q is not given.
 
@@ -155,6 +161,12 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--crs", metavar="AUTH:CODE",
                        help="the CRS of the input coordinates, e.g. EPSG:3857, recorded in GeoParquet "
                             "(default: the input's own, else OGC:CRS84 for lon/lat columns, else unknown)")
+    batch.add_argument("--dask", metavar="local[:WORKERS]|tcp://HOST:PORT",
+                       help="build tile by tile on Dask: a LocalCluster of this machine (local, local:WORKERS) or "
+                            "an existing scheduler; INPUT may be a CSV/Parquet file, a directory or a glob, read "
+                            "in partitions, and OUTPUT a new directory of parts (needs tvoronoi[dask])")
+    batch.add_argument("--tiles", type=int, metavar="N",
+                       help="with --dask: tiles, one task each per round (default: from the points and workers)")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress display and no warnings")
     batch.add_argument("--force", action="store_true", help="replace an existing OUTPUT or --delaunay FILE")
     return parser
@@ -277,6 +289,16 @@ def _batch_run(args, phases: Phases) -> int:
 
         region = as_region(read_region(args.clip), what=f"--clip {args.clip}")
         options["clip"] = region
+    if args.dask is not None:
+        from tvoronoi import cli_distributed
+
+        if args.output == STDIO:
+            raise TvoronoiError('with --dask, OUTPUT is a new directory of parts, not "-"')
+        fmt = args.to or OUTPUT_EXTENSIONS.get(os.path.splitext(args.output)[1].lower(), "parquet")
+        cli_distributed.run(args, fmt, bbox, region, args.quiet)
+        return EXIT_OK
+    if args.tiles is not None:
+        raise TvoronoiError("--tiles goes with --dask (tiles on a cluster); without it the build is one diagram")
 
     outputs = {}
     try:

@@ -169,11 +169,19 @@ def _rows_of(inner: Diagram, pts: np.ndarray, rows: np.ndarray) -> dict:
 
 def _cut_cells(diagram: Diagram, region) -> tuple[np.ndarray, np.ndarray]:
     """Each cell cut to the region: (clipped, reshaped) as in ClippedDiagram."""
-    import shapely
-
     from tvoronoi.shapes import cell_polygons
 
-    cells = cell_polygons(diagram)
+    return cut_polygons(cell_polygons(diagram), region)
+
+
+def cut_polygons(cells: np.ndarray, region) -> tuple[np.ndarray, np.ndarray]:
+    """Cells (shapely Polygons, None for no cell) cut to the region: (clipped, reshaped) as in ClippedDiagram.
+
+    A cell inside the region is kept as it is, so the cut depends on the cell alone: tiles on a cluster
+    (tvoronoi.distributed) cut their cells to the same geometries as one process.
+    """
+    import shapely
+
     has = cells != None  # noqa: E711 (elementwise on an object array)
     shapely.prepare(region)
     # cells inside the region are kept as they are; only those crossing its boundary are cut

@@ -1,0 +1,238 @@
+"""Tiles on a Dask LocalCluster (two worker processes): every cell equal, bit for bit, to one process's build."""
+
+import subprocess
+import sys
+
+import dask.array as da
+import dask.dataframe as dd
+import numpy as np
+import pandas as pd
+import pytest
+import shapely
+
+import tvoronoi
+from tvoronoi.distributed import local_client, voronoi
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.generators import generate
+
+# The issue's proof runs 200,000 sites per distribution; the special cases (a 1e-9 cluster, a grid, a clip
+# region) run on fewer, enough for several tiles of thousands of sites each.
+N = 200_000
+N_SMALL = 40_000
+
+
+@pytest.fixture(scope="module")
+def client():
+    c = local_client(2)
+    yield c
+    c.close()
+    c.cluster.close()
+
+
+def frame_of(pts: np.ndarray, partitions: int = 6, **columns) -> dd.DataFrame:
+    return dd.from_pandas(pd.DataFrame({"x": pts[:, 0], "y": pts[:, 1], **columns}), npartitions=partitions)
+
+
+def cells_of(result) -> pd.DataFrame:
+    return result.cells.compute().sort_values("site").reset_index(drop=True)
+
+
+def assert_same_cells(cells: pd.DataFrame, geoms: np.ndarray) -> None:
+    """Every input row once, and each row's WKB (the exact doubles of its ring) equal to one process's."""
+    assert cells["site"].to_numpy().tolist() == list(range(len(geoms)))
+    got = cells["geometry"].to_numpy(dtype=object, na_value=None)
+    want = shapely.to_wkb(geoms)
+    bad = [i for i in range(len(geoms)) if got[i] != want[i]]
+    assert not bad, f"{len(bad)} cells differ, first at site {bad[:5]}"
+
+
+@pytest.mark.parametrize("distribution", ["uniform", "gaussian", "clustered"])
+def test_distributions_equal_one_process(client, distribution):
+    pts = generate(distribution, N, seed=12)
+    result = voronoi(frame_of(pts), client=client, tiles=8)
+    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    assert result.rounds == len(result.pending_after) and result.pending_after[-1] == 0
+    if distribution == "gaussian":
+        # the sparse corners of a gaussian cloud need a second round
+        assert result.rounds > 1 and result.pending_after[0] > 0
+
+
+def test_a_1e9_cluster_with_repeats_equals_one_process(client):
+    rng = np.random.default_rng(3)
+    cluster = 0.5 + 1e-9 * rng.random((N_SMALL, 2))
+    pts = np.concatenate([cluster, cluster[rng.integers(0, N_SMALL, 2_000)], generate("uniform", 2_000, seed=3)])
+    result = voronoi(frame_of(pts), client=client, tiles=6)
+    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+
+
+def test_a_grid_with_a_tight_halo_needs_a_second_round_and_equals_one_process(client):
+    side = 200
+    pts = np.stack(np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float)), -1).reshape(-1, 2)
+    result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1)
+    assert result.rounds > 1 and result.pending_after[0] > 0
+    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+
+
+def test_a_clip_region_equals_one_process(client):
+    pts = generate("uniform", N_SMALL, seed=5, bounds=(0, 0, 10, 10))
+    region = shapely.Polygon([(1, 1), (9, 2), (8, 9), (2, 7)], holes=[[(4, 4), (6, 4), (5, 6)]])
+    result = voronoi(frame_of(pts, id=np.arange(N_SMALL) * 3), client=client, tiles=6, clip=region)
+    cells = cells_of(result)
+    assert_same_cells(cells, tvoronoi.voronoi(pts, clip=region, threads=1).to_shapely())
+    # properties travel with their sites
+    assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
+
+
+def test_a_dask_array_and_a_user_box(client):
+    pts = generate("gaussian", N_SMALL, seed=7)
+    bbox = (-1.0, -1.0, 2.0, 2.0)
+    result = voronoi(da.from_array(pts, chunks=(7_000, 2)), client=client, bbox=bbox, tiles=4)
+    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, bbox=bbox, threads=1).to_shapely())
+
+
+def test_geoparquet_directory_reads_as_one_table(client, tmp_path):
+    import geopandas
+    import pyarrow.dataset as ds
+    import pyarrow.parquet as pq
+
+    pts = generate("clustered", N_SMALL - 500, seed=9)
+    pts = np.concatenate([pts, pts[:500]])          # repeated points: rows without a cell (null)
+    names = np.array([f"p{i}" for i in range(N_SMALL)], object)
+    out = tmp_path / "cells"
+    result = voronoi(frame_of(pts, name=names), client=client, tiles=4, to=out)
+    assert result.cells is None and len([p for p in result.parts if p]) >= 4
+    frame = geopandas.read_parquet(out).sort_values("site").reset_index(drop=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert frame["site"].tolist() == list(range(N_SMALL))
+    assert (frame["name"].to_numpy() == names).all()
+    want = full.to_shapely()
+    assert frame.geometry.isna().to_numpy().tolist() == [g is None for g in want]
+    present = ~frame.geometry.isna().to_numpy()
+    assert shapely.equals_exact(frame.geometry.to_numpy()[present], want[present], tolerance=0).all()
+    # _metadata alone opens every part, and the common schema carries the dataset's geo metadata
+    assert ds.parquet_dataset(str(out / "_metadata")).to_table().num_rows == N_SMALL
+    geo = pq.read_schema(out / "_common_metadata").metadata[b"geo"]
+    assert b'"geometry_types":["Polygon"]' in geo
+
+
+def test_geojsonseq_parts(client, tmp_path):
+    import orjson
+
+    pts = generate("uniform", 5_000, seed=2)
+    out = tmp_path / "seq"
+    voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq")
+    features = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(out.iterdir()) for line in part.read_bytes().splitlines()]
+    features.sort(key=lambda f: f["properties"]["site"])
+    assert [f["properties"]["site"] for f in features] == list(range(5_000))
+    full = tvoronoi.voronoi(pts, threads=1)
+    for f in features[::97]:
+        ring = np.array(f["geometry"]["coordinates"][0][:-1])
+        assert np.array_equal(ring, full.cell_polygon(f["properties"]["site"]))
+
+
+def test_bad_input_is_named(client, tmp_path):
+    pts = generate("uniform", 1_000, seed=1)
+    pts[700] = np.nan
+    with pytest.raises(TvoronoiError, match=r"partition \d, row \d+ \(index 700\): x is nan, not a finite number"):
+        voronoi(frame_of(pts, 4), client=client, tiles=2)
+    with pytest.raises(TvoronoiError, match="Dask DataFrame or a Dask array"):
+        voronoi(pts, client=client)
+    with pytest.raises(TvoronoiError, match="no column names the y coordinate"):
+        voronoi(dd.from_pandas(pd.DataFrame({"x": [1.0], "height": [2.0]}), npartitions=1), client=client)
+    # a failure while the parts are written leaves no directory behind
+    with pytest.raises(TvoronoiError, match="cannot be written as JSON"):
+        voronoi(frame_of(pts[:100], 2, z=np.arange(100) * 1j), client=client, to=tmp_path / "seq", format="geojsonseq")
+    assert not (tmp_path / "seq").exists()
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "old.parquet").write_bytes(b"x")
+    with pytest.raises(TvoronoiError, match="not empty"):
+        voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "full")
+
+
+def test_the_core_package_works_without_dask():
+    code = (
+        "import sys; sys.modules['dask'] = None; sys.modules['distributed'] = None\n"
+        "import tvoronoi, tvoronoi.distributed as d\n"
+        "assert tvoronoi.voronoi([[0, 0], [1, 0], [0, 1]]).n_vertices == 1\n"
+        "try:\n    d.require_dask()\nexcept tvoronoi.TvoronoiError as e:\n    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert "pip install 'tvoronoi[dask]'" in out
+
+
+# ---------------------------------------------------------------------------------------------
+# the command line: tvoronoi batch INPUT -o DIR --dask ...
+
+
+def write_csv_parts(directory, pts: np.ndarray, parts: int) -> None:
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), parts)):
+        pd.DataFrame({"label": [f"r{i}" for i in chunk], "x": pts[chunk, 0], "y": pts[chunk, 1]}).to_csv(
+            directory / f"points-{k}.csv", index=False)
+
+
+def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, capsys):
+    import geopandas
+
+    from tvoronoi.cli import main
+
+    pts = generate("gaussian", 20_000, seed=4)
+    write_csv_parts(tmp_path, pts, 3)
+    out = tmp_path / "cells.parquet"
+    status = main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", client.scheduler.address,
+                   "--tiles", "5"])
+    assert status == 0, capsys.readouterr().err
+    assert "3 file(s)" in capsys.readouterr().err
+    frame = geopandas.read_parquet(out).sort_values("site").reset_index(drop=True)
+    assert frame["label"].tolist() == [f"r{i}" for i in range(len(pts))]
+    assert shapely.equals_exact(frame.geometry.to_numpy(), tvoronoi.voronoi(pts).to_shapely(), tolerance=0).all()
+
+
+def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path):
+    import geopandas
+
+    from tvoronoi.cli import main
+
+    pts = generate("clustered", 10_000, seed=6)
+    source = tmp_path / "points"
+    source.mkdir()
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), 2)):
+        geopandas.GeoDataFrame({"w": chunk * 2.0}, geometry=geopandas.points_from_xy(*pts[chunk].T)).to_parquet(
+            source / f"part{k}.parquet")
+    out = tmp_path / "cells"
+    assert main(["batch", str(source), "-o", str(out), "--dask", "local:2", "--to", "geojsonseq", "-q"]) == 0
+    import orjson
+
+    features = [orjson.loads(line.lstrip(b"\x1e")) for part in out.iterdir() for line in part.read_bytes().splitlines()]
+    assert sorted(f["properties"]["site"] for f in features) == list(range(len(pts)))
+    full = tvoronoi.voronoi(pts)
+    for f in features[::50]:
+        i = f["properties"]["site"]
+        assert f["properties"]["w"] == 2.0 * i
+        assert np.array_equal(np.array(f["geometry"]["coordinates"][0][:-1]), full.cell_polygon(i))
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--dask", "loc"], "--dask 'loc': give local"),
+    (["--dask", "local:0"], "needs at least one worker"),
+    (["--dask", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+    (["--tiles", "3"], "--tiles goes with --dask"),
+    (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
+    (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
+])
+def test_cli_errors_are_named(tmp_path, capsys, argv, message):
+    from tvoronoi.cli import main
+
+    write_csv_parts(tmp_path, generate("uniform", 100, seed=1), 1)
+    assert main(["batch", str(tmp_path / "points-0.csv"), "-o", str(tmp_path / "out"), *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_cli_names_a_value_that_is_not_a_number_and_writes_nothing(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    (tmp_path / "bad.csv").write_text("x,y\n1,2\n3,abc\n5,6\n")
+    out = tmp_path / "cells"
+    assert main(["batch", str(tmp_path / "bad.csv"), "-o", str(out), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert "bad.csv: partition 0, row 1 (index 1): y is 'abc', not a finite number" in err
+    assert "Traceback" not in err and not out.exists()

@@ -1,0 +1,185 @@
+"""Tiles without Dask: k-d cuts, halos, certification, and cells built tile by tile equal to one build, bit for bit."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import tvoronoi
+from adversarial import FAMILIES, make
+from conftest import DATASETS
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.generators import generate
+from tvoronoi.tiles import (
+    build_tile,
+    certified,
+    extent_of,
+    group_reaches,
+    grown,
+    in_region,
+    kd_rects,
+    tile_of,
+    tiled_cells,
+)
+
+
+def assert_same_cells(tiled, full) -> None:
+    """Every row has exactly one cell, and (site, ring) pairs equal the whole build's, bit for bit."""
+    n = full.n_sites
+    assert np.array_equal(tiled.ids, np.arange(n))
+    assert np.array_equal(np.diff(tiled.offsets), np.diff(full.cell_offsets))
+    whole = full.cell_points[full.cell_vertices]
+    assert tiled.ring_xy.shape == whole.shape
+    # bit for bit: the same doubles (-0.0 and 0.0 told apart)
+    assert np.array_equal(tiled.ring_xy.view(np.int64), whole.view(np.int64))
+
+
+def test_kd_rects_partition_the_plane_into_balanced_tiles():
+    pts = generate("clustered", 20_000, seed=4)
+    rects = kd_rects(pts, 7)
+    owner = tile_of(pts[:, 0], pts[:, 1], rects)
+    # each point in exactly one tile
+    hits = sum(((pts[:, 0] >= x0) & (pts[:, 0] < x1) & (pts[:, 1] >= y0) & (pts[:, 1] < y1)).astype(int)
+               for x0, y0, x1, y1 in rects)
+    assert (hits == 1).all() and (owner >= 0).all()
+    counts = np.bincount(owner, minlength=7)
+    assert counts.min() >= 0.8 * len(pts) / 7 and counts.max() <= 1.2 * len(pts) / 7
+
+
+def test_kd_rects_refuse_a_bad_tile_count():
+    with pytest.raises(TvoronoiError, match="tiles must be a positive integer"):
+        kd_rects(np.zeros((3, 2)), 0)
+
+
+@pytest.mark.parametrize("name", sorted(DATASETS))
+@pytest.mark.parametrize("tiles", [2, 5])
+def test_small_datasets_tile_to_the_same_cells(name, tiles):
+    pts = DATASETS[name]
+    assert_same_cells(tiled_cells(pts, tiles=tiles, halo_scale=0.3), tvoronoi.voronoi(pts, threads=1))
+
+
+@pytest.mark.parametrize("distribution", ["uniform", "gaussian", "clustered"])
+def test_distributions_tile_to_the_same_cells(distribution):
+    pts = generate(distribution, 30_000, seed=11)
+    tiled = tiled_cells(pts, tiles=6)
+    assert_same_cells(tiled, tvoronoi.voronoi(pts, threads=1))
+    # the pending counts fall to zero, one per round; the reach of the first round's leftovers suffices
+    assert len(tiled.pending_after) == tiled.rounds and tiled.pending_after[-1] == 0
+    assert tiled.rounds <= 2
+
+
+def test_sparse_corners_need_more_rounds_and_a_tight_box_fewer():
+    pts = generate("gaussian", 20_000, seed=3)
+    tiled = tiled_cells(pts, tiles=8)
+    assert tiled.rounds > 1 and tiled.pending_after[0] > 0
+    assert_same_cells(tiled, tvoronoi.voronoi(pts, threads=1))
+
+
+@pytest.mark.parametrize("bbox", [(-50.0, -50.0, 50.0, 50.0), (0.2, 0.3, 0.7, 0.6)])
+def test_a_user_box_far_or_cutting_tiles_to_the_same_cells(bbox):
+    pts = generate("uniform", 5_000, seed=5)
+    assert_same_cells(tiled_cells(pts, tiles=4, bbox=bbox), tvoronoi.voronoi(pts, bbox=bbox, threads=1))
+
+
+def test_a_1e9_cluster_and_repeated_points_tile_to_the_same_cells():
+    rng = np.random.default_rng(8)
+    cluster = 1.0 + 1e-9 * rng.random((4_000, 2))
+    pts = np.concatenate([cluster, cluster[rng.integers(0, 4_000, 500)], generate("uniform", 1_000, seed=8)])
+    assert_same_cells(tiled_cells(pts, tiles=5), tvoronoi.voronoi(pts, threads=1))
+
+
+@pytest.mark.parametrize("family", sorted(FAMILIES))
+def test_adversarial_families_tile_to_the_same_cells(family):
+    case = make(family, 1)
+    pts = case.points[:3000]
+    full = tvoronoi.voronoi(pts, bbox=case.bbox, threads=1)
+    assert_same_cells(tiled_cells(pts, tiles=4, bbox=case.bbox, halo_scale=0.5), full)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1, 300),
+    tiles=st.integers(1, 9),
+    decimals=st.integers(0, 3),
+    halo=st.sampled_from([0.05, 0.3, 1.0]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_hunt_rounded_points_tile_to_the_same_cells(n, tiles, decimals, halo, seed):
+    # rounded coordinates: repeats, collinear runs and cocircular quadruples at tile edges
+    pts = np.round(np.random.default_rng(seed).random((n, 2)) * 10, decimals)
+    assert_same_cells(tiled_cells(pts, tiles=tiles, halo_scale=halo, seed=seed),
+                      tvoronoi.voronoi(pts, threads=1))
+
+
+def test_certification_refuses_a_cell_a_hidden_site_cuts():
+    # the local diagram of three sites; a fourth, outside the region, cuts the middle cell
+    seen = np.array([[0.0, 0.0], [-1.0, 0.0], [1.0, 0.0]])
+    hidden = np.array([[0.0, 0.9]])
+    box = (-2.0, -2.0, 2.0, 2.0)
+    region = (-1.5, -1.5, 1.5, 0.5)                 # y <= 0.5: the hidden site is outside
+    assert not in_region(hidden[:, 0], hidden[:, 1], region).any()
+    cells = build_tile(seen, np.arange(3), np.array([True, False, False]), region, box)
+    assert cells.ids.size == 0 and cells.pending.tolist() == [0]
+    # once the region holds it, the cell is certified and is the cell of all four sites
+    everything = np.concatenate([seen, hidden])
+    cells = build_tile(everything, np.arange(4), np.array([True, False, False, False]),
+                       grown(extent_of(everything), 10.0), box)
+    assert cells.ids.tolist() == [0]
+    assert np.array_equal(cells.ring_xy, tvoronoi.voronoi(everything, bbox=box).cell_polygon(0))
+
+
+def test_certification_is_exact_at_the_margin():
+    # a ring point at distance r from the site: a side exactly r away is not enough room (rounding margin),
+    # a side safely farther is
+    site = np.array([[0.0, 0.0]])
+    ring = np.array([[1.0, 0.0]])
+    offsets = np.array([0, 1])
+    assert not certified(ring, offsets, site, (-10.0, -10.0, 2.0, 10.0))[0]
+    assert certified(ring, offsets, site, (-10.0, -10.0, 2.0 + 1e-9, 10.0))[0]
+    assert certified(ring, offsets, site, (-math.inf, -math.inf, math.inf, math.inf))[0]
+    # a non-finite distance is never certified
+    assert not certified(np.array([[1e308, 0.0]]), offsets, np.array([[-1e308, 0.0]]), (-math.inf, -1, math.inf, 1))[0]
+    # an empty ring (a cell that misses the box) stays out whatever the hidden sites
+    assert certified(np.empty((0, 2)), np.array([0, 0]), site, (0.0, 0.0, 0.0, 0.0))[0]
+
+
+@settings(max_examples=200, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), k=st.integers(3, 40))
+def test_hunt_certified_cells_are_final(seed, k):
+    # random local subsets of random sites: every cell the test certifies equals the whole diagram's cell
+    rng = np.random.default_rng(seed)
+    pts = np.round(rng.random((k + 20, 2)), int(rng.integers(1, 6)))
+    box = (-0.5, -0.5, 1.5, 1.5)
+    cx, cy, half = rng.random(), rng.random(), 0.1 + 0.5 * rng.random()
+    region = (cx - half, cy - half, cx + half, cy + half)
+    seen = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+    if len(seen) == 0:
+        return
+    cells = build_tile(pts[seen], seen.astype(np.int64), np.ones(len(seen), bool), region, box)
+    full = tvoronoi.voronoi(pts, bbox=box, threads=1)
+    for i, ring in cells.rings():
+        assert np.array_equal(ring, full.cell_polygon(i))
+    if len(cells.pending) == 0:
+        return
+    # the reach of each group of pending cells, grown by a margin, is enough: a second build certifies them
+    groups = group_reaches(cells.pending, cells.reaches, 1e-6)
+    assert sorted(np.concatenate([g for g, _ in groups]).tolist()) == sorted(cells.pending.tolist())
+    for group, reach in groups:
+        region = grown(reach, 1e-6)
+        seen = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+        again = build_tile(pts[seen], seen.astype(np.int64), np.isin(seen, group), region, box)
+        assert len(again.pending) == 0 and sorted(again.ids.tolist()) == sorted(group.tolist())
+        for i, ring in again.rings():
+            assert np.array_equal(ring, full.cell_polygon(i))
+
+
+def test_group_reaches_keeps_far_cells_apart_and_joins_overlapping_ones():
+    pending = np.array([7, 3, 9])
+    reaches = np.array([[0.0, 0.0, 1.0, 1.0], [0.9, 0.9, 2.0, 2.0], [10.0, 10.0, 11.0, 11.0]])
+    groups = group_reaches(pending, reaches, 0.05)
+    assert sorted((g.tolist(), box) for g, box in groups) == [
+        ([3, 7], (0.0, 0.0, 2.0, 2.0)), ([9], (10.0, 10.0, 11.0, 11.0))]
+    # a margin that bridges the gap joins all three
+    assert [g.tolist() for g, _ in group_reaches(pending, reaches, 5.0)] == [[3, 7, 9]]

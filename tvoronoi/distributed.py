@@ -1,0 +1,478 @@
+"""The same exact cells on a Dask cluster: tiles with halos (tvoronoi.tiles), one task per tile and round.
+
+``voronoi(points, client=...)`` takes a Dask DataFrame (x/y columns and properties) or a Dask array of
+shape (n, 2). One pass over the partitions counts the rows (their order numbers the sites, as in
+``tvoronoi.voronoi``), finds the sites' extent and draws a sample, from which the tiles are cut. Then
+each round runs one task per tile that still has cells to emit: it gathers the sites of its region from
+every partition, builds their diagram, and emits the certified cells of its own sites with their
+properties (or writes them: ``to=``). No process ever holds the whole input or output.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from tvoronoi.errors import TvoronoiError
+from tvoronoi.tiles import (
+    MAX_ROUNDS,
+    SAMPLE_PER_TILE,
+    Plan,
+    Region,
+    build_tile,
+    default_tiles,
+    group_reaches,
+    in_region,
+    plan_tiles,
+    tile_of,
+)
+
+INSTALL_HINT = "pip install 'tvoronoi[dask]' (or pip install 'dask[distributed,dataframe]')"
+# the columns of the sites inside tasks: the input row, and the coordinates
+ID, X, Y = "__tvoronoi_site", "__tvoronoi_x", "__tvoronoi_y"
+# the cell columns tvoronoi adds; a property of the same name is renamed
+SITE, GEOMETRY = "site", "geometry"
+FORMATS = ("parquet", "geojsonseq")
+
+
+def require_dask():
+    """Import dask.dataframe and distributed, or say how to install them."""
+    try:
+        import dask.dataframe  # noqa: F401
+        import distributed
+    except ImportError:
+        raise TvoronoiError(f"running on Dask needs dask and distributed, which are not installed: {INSTALL_HINT}") from None
+    return distributed
+
+
+@dataclass(frozen=True)
+class Job:
+    """What every task of one build shares: the columns, the plan, the box, the clip region and the output."""
+
+    x: str
+    y: str
+    properties: tuple[str, ...]
+    renames: dict
+    plan: Plan
+    engine: str
+    clip: object = None
+    to: str | None = None
+    format: str = "parquet"
+    crs: object = None
+
+
+@dataclass(frozen=True)
+class Result:
+    """What ``voronoi`` did: the cells (a Dask DataFrame, or None when written), rounds, parts written."""
+
+    cells: object
+    rounds: int
+    pending_after: tuple[int, ...]
+    n_tiles: int
+    parts: tuple[str, ...] = ()
+
+
+# ---------------------------------------------------------------------------------------------
+# the points: a Dask DataFrame or array
+
+
+def _as_frame(points, x: str | None, y: str | None):
+    """(frame, x, y): a Dask DataFrame and the names of its coordinate columns."""
+    import dask.array as da
+    import dask.dataframe as dd
+
+    from tvoronoi.coordinate_names import named_column
+
+    if isinstance(points, da.Array):
+        if points.ndim != 2 or points.shape[1] != 2:
+            raise TvoronoiError(f"a Dask array of points must have shape (n, 2), got {points.shape}")
+        return dd.from_dask_array(points.astype(np.float64), columns=["x", "y"]), "x", "y"
+    if not isinstance(points, dd.DataFrame):
+        raise TvoronoiError(
+            f"points must be a Dask DataFrame or a Dask array of shape (n, 2), got {type(points).__name__}; "
+            f"for points in memory call tvoronoi.voronoi"
+        )
+    names = [str(c) for c in points.columns]
+    chosen = []
+    for role, given in (("x", x), ("y", y)):
+        if given is not None:
+            if given not in names:
+                raise TvoronoiError(f"no column {given!r} for {role}: the columns are {', '.join(names)}")
+            chosen.append(given)
+            continue
+        j = named_column(names, role)
+        if j is None:
+            raise TvoronoiError(f"no column names the {role} coordinate among {', '.join(names)}; pass {role}=NAME")
+        chosen.append(names[j])
+    return points, chosen[0], chosen[1]
+
+
+def _coordinates(part, column: str) -> np.ndarray:
+    """A coordinate column as float64, NaN where a value is not a number."""
+    import pandas as pd
+
+    return pd.to_numeric(part[column], errors="coerce").to_numpy(np.float64, na_value=np.nan)
+
+
+def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) -> dict:
+    """One partition's row count, the extent of its sites (inside the clip region) and a sample of them."""
+    xs, ys = _coordinates(part, x), _coordinates(part, y)
+    bad = ~(np.isfinite(xs) & np.isfinite(ys))
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        column = x if not np.isfinite(xs[row]) else y
+        value = part[column].iloc[row]
+        value = float(value) if isinstance(value, (float, np.floating)) else value
+        raise TvoronoiError(
+            f"partition {number}, row {row} (index {part.index[row]!r}): {column} is {value!r}, not a finite "
+            f"number ({int(bad.sum())} such row(s) in this partition); drop or fix those rows"
+        )
+    out: dict = {"n": len(part), "extent_all": _extent(xs, ys)}
+    if clip is not None:
+        from tvoronoi.region import sites_inside
+
+        keep = sites_inside(np.column_stack([xs, ys]), clip)
+        xs, ys = xs[keep], ys[keep]
+    out.update(m=len(xs), extent=None, sample=np.empty((0, 2)))
+    if len(xs):
+        out["extent"] = _extent(xs, ys)
+        rng = np.random.default_rng([seed, number])
+        take = rng.choice(len(xs), min(len(xs), n_sample), replace=False) if len(xs) > n_sample else slice(None)
+        out["sample"] = np.column_stack([xs[take], ys[take]])
+    return out
+
+
+def _extent(xs: np.ndarray, ys: np.ndarray) -> Region | None:
+    if len(xs) == 0:
+        return None
+    return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+
+
+def _meets(extent: Region | None, region: Region) -> bool:
+    """Whether a partition's sites (their extent) can lie in the closed region."""
+    return extent is not None and not (extent[2] < region[0] or extent[0] > region[2] or extent[3] < region[1]
+                                       or extent[1] > region[3])
+
+
+def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str], clip):
+    """The rows of one partition whose site lies in the closed ``region``, with their input rows."""
+    import pandas as pd
+
+    xs, ys = _coordinates(part, x), _coordinates(part, y)
+    rows = np.flatnonzero(in_region(xs, ys, region))
+    frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
+    inside = np.ones(len(rows), bool)
+    if clip is not None and len(rows):
+        from tvoronoi.region import sites_inside
+
+        inside = sites_inside(np.column_stack([xs[rows], ys[rows]]), clip)
+    frame["__tvoronoi_inside"] = inside
+    for name in keep:
+        frame[name] = part[name].to_numpy()[rows]
+    return frame
+
+
+# ---------------------------------------------------------------------------------------------
+# one tile, one round (runs on a worker)
+
+
+def _run_tile(pieces: list, t: int, region: Region, group, job: Job, round_: int, name: str):
+    """Build a region of tile t for its own sites (``group``: those of a group of pending cells only);
+    return (cells frame or part name, (pending ids, their reaches))."""
+    import pandas as pd
+
+    sites = pd.concat(pieces, ignore_index=True) if pieces else pd.DataFrame()
+    plan = job.plan
+    xs, ys = sites[X].to_numpy(), sites[Y].to_numpy()
+    ids = sites[ID].to_numpy(np.int64)
+    own = tile_of(xs, ys, plan.rects[t:t + 1]) == 0 if len(sites) else np.zeros(0, bool)
+    if group is not None:
+        own &= np.isin(ids, group)
+    inside = sites["__tvoronoi_inside"].to_numpy(bool)
+    built = np.flatnonzero(inside)
+    pts = np.column_stack([xs[built], ys[built]])
+    cells = build_tile(pts, ids[built], own[built], region, plan.box,
+                       everything=plan.sees_everything(region), engine=job.engine)
+    # the tile's own sites outside the clip region get no cell: written once, in the first round
+    outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
+    left = (cells.pending, cells.reaches)
+    if job.to is None:
+        return _cells_frame(sites, ids, cells, outside, job), left
+    from tvoronoi.writers.parts import write_part
+
+    frame, geoms = _cells_frame(sites, ids, cells, outside, job)
+    return write_part(frame, geoms, job.to, name, job.format, job.crs), left
+
+
+def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
+    """The emitted rows in site order: ``site``, the properties, ``geometry`` (WKB; None without a cell).
+
+    When the cells are written (``job.to``), the frame has no geometry column and the shapely cells come
+    beside it: (frame, geometries); the writer takes them as they are.
+    """
+    import pandas as pd
+    import shapely
+
+    lengths = np.diff(cells.offsets)
+    has = lengths >= 3                              # fewer points: no area (a cell touching the box)
+    if job.to is not None and job.format == "parquet" and job.clip is None:
+        # rings straight to WKB in bulk (writers.geoparquet), no shapely geometry per cell
+        return _rings_frame(sites, ids, cells, has, job)
+    geoms = np.full(len(cells.ids), None, object)
+    if has.any():
+        keep = np.repeat(has, lengths)
+        xy = cells.ring_xy[keep]
+        index = np.repeat(np.arange(int(has.sum())), lengths[has])
+        geoms[has] = shapely.polygons(shapely.linearrings(xy, indices=index))
+    if job.clip is not None and has.any():
+        from tvoronoi.region import cut_polygons
+
+        geoms, _ = cut_polygons(geoms, job.clip)
+    site = np.concatenate([cells.ids, ids[outside]])
+    geoms = np.concatenate([geoms, np.full(len(outside), None, object)])
+    order = np.argsort(site, kind="stable")
+    position = np.searchsorted(ids, site[order])
+    out = {SITE: site[order]}
+    for name in job.properties:
+        out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
+    if job.to is not None:
+        return pd.DataFrame(out), geoms[order]
+    wkb = shapely.to_wkb(geoms[order]) if len(order) else np.empty(0, object)
+    out[GEOMETRY] = pd.array(wkb, dtype=_binary_dtype())
+    return pd.DataFrame(out)
+
+
+def _rings_frame(sites, ids: np.ndarray, cells, has: np.ndarray, job: Job):
+    """(frame, rings): the frame as ``_cells_frame`` writes it, and the cells as closed rings
+    ``(xy, ring_offsets, present)`` for ``writers.geoparquet``'s bulk WKB (cells.ids is ascending)."""
+    import pandas as pd
+
+    lengths = np.diff(cells.offsets)
+    keep = np.repeat(has, lengths)
+    ring = cells.ring_xy[keep]
+    kept = lengths[has]
+    stops = np.cumsum(kept)
+    starts = stops - kept
+    xy = np.insert(ring, stops, ring[starts], axis=0)           # each ring's first point again at its end
+    ring_offsets = np.zeros(len(kept) + 1, np.int64)
+    np.cumsum(kept + 1, out=ring_offsets[1:])
+    position = np.searchsorted(ids, cells.ids)
+    out = {SITE: cells.ids}
+    for name in job.properties:
+        out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
+    return pd.DataFrame(out), (np.ascontiguousarray(xy), ring_offsets, has)
+
+
+def _binary_dtype():
+    """WKB as Arrow binary: Dask would take a column of Python bytes for text and decode it."""
+    import pandas as pd
+    import pyarrow as pa
+
+    return pd.ArrowDtype(pa.binary())
+
+
+def _meta(frame_meta, job: Job):
+    import pandas as pd
+
+    cols = {SITE: pd.Series(dtype="int64")}
+    for name in job.properties:
+        cols[job.renames.get(name, name)] = frame_meta[name]
+    cols[GEOMETRY] = pd.Series(dtype=_binary_dtype())
+    return pd.DataFrame(cols)
+
+
+# ---------------------------------------------------------------------------------------------
+# the public entry
+
+
+def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None, format: str = "parquet",
+            clip=None, engine: str = "incremental", x: str | None = None, y: str | None = None, crs=None,
+            seed: int = 0, halo_scale: float = 1.0) -> Result:
+    """The clipped Voronoi cells of a Dask DataFrame or array of points, built tile by tile on a cluster.
+
+    Every cell equals, bit for bit, the cell ``tvoronoi.voronoi`` gives the same row (see tvoronoi.tiles).
+
+    Parameters
+    ----------
+    points : dask.dataframe.DataFrame or dask.array.Array of shape (n, 2)
+        A DataFrame's x/y columns are found by name (x/y, lon/lat, easting/northing...) unless ``x`` and
+        ``y`` name them; its other columns are properties, carried with their sites.
+    client : distributed.Client, optional
+        The cluster; by default the current client.
+    bbox : (xmin, ymin, xmax, ymax), optional
+        The box of the cells; by default the sites' bounding box grown by 10% (as ``tvoronoi.voronoi``).
+    tiles : int, optional
+        Tiles (tasks per round); by default from n and the workers.
+    to : str, optional
+        A directory to write the cells to, one part per task: GeoParquet parts with ``_metadata`` and
+        ``_common_metadata`` (pyarrow and geopandas read the directory as one table), or GeoJSONSeq parts.
+    format : {"parquet", "geojsonseq"}
+        The parts' format with ``to``.
+    clip : shapely Polygon or MultiPolygon, optional
+        As in ``tvoronoi.voronoi``: the cells of the sites inside, cut to the region.
+    engine : {"incremental", "fortune"}
+    crs : optional
+        The coordinates' CRS, recorded in the GeoParquet metadata.
+    halo_scale : float
+        Multiplies the first halos (tests use a small one to force more rounds).
+
+    Returns
+    -------
+    Result
+        ``cells``: a Dask DataFrame with one row per input row, in row order within each part:
+        ``site`` (the input row), the properties, ``geometry`` (WKB polygon; None for a repeated point,
+        a cell that misses the box, a site outside ``clip``); None when written with ``to``. Also the
+        rounds run and the cells still pending after each.
+
+    Raises
+    ------
+    TvoronoiError
+        Dask not installed, bad points, box, engine, tiles or output.
+    """
+    distributed = require_dask()
+    import dask
+
+    from tvoronoi.api import as_bbox, check_engine, default_bbox
+
+    check_engine(engine)
+    if format not in FORMATS:
+        raise TvoronoiError(f"unknown format {format!r}: choose one of {', '.join(FORMATS)}")
+    if clip is not None:
+        from tvoronoi.region import as_region
+
+        clip = as_region(clip)
+    client = client if client is not None else distributed.get_client()
+    frame, xname, yname = _as_frame(points, x, y)
+    properties = tuple(str(c) for c in frame.columns if str(c) not in (xname, yname))
+    from tvoronoi.writers.geojson_diagram import property_renames
+
+    renames = {**property_renames(list(properties)), **({GEOMETRY: GEOMETRY + "_2"} if GEOMETRY in properties else {})}
+    parts = frame.to_delayed()
+    workers = max(1, len(client.scheduler_info(n_workers=-1).get("workers", {})) if hasattr(client, "scheduler_info") else 1)
+
+    # one pass: counts, extent, sample
+    n_tiles_guess = tiles if tiles is not None else 4 * workers
+    per_part = max(1, (SAMPLE_PER_TILE * n_tiles_guess) // max(1, len(parts)))
+    try:
+        summaries = client.gather(client.compute(
+            [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k) for k, p in enumerate(parts)]
+        ))
+    except TvoronoiError:
+        raise
+    except (ValueError, TypeError, OSError) as exc:          # a partition that cannot be read
+        raise TvoronoiError(f"the points cannot be read: {exc}") from None
+    counts = [s["n"] for s in summaries]
+    m = int(sum(s["m"] for s in summaries))
+    if m == 0:
+        where = "inside the clip region" if clip is not None else "in the input"
+        raise TvoronoiError(f"no points {where}: nothing to build")
+    if tiles is None:
+        tiles = default_tiles(m, workers)
+    extents = np.array([s["extent"] for s in summaries if s["extent"] is not None])
+    extent = (float(extents[:, 0].min()), float(extents[:, 1].min()), float(extents[:, 2].max()),
+              float(extents[:, 3].max()))
+    if bbox is not None:
+        box = as_bbox(bbox)
+    elif clip is not None:
+        from tvoronoi.region import region_box
+
+        box = region_box(clip)
+    else:
+        box = default_bbox(np.array([extent[:2], extent[2:]]))
+    sample = np.concatenate([s["sample"] for s in summaries])
+    plan = plan_tiles(sample, tiles, extent, box, m)
+    plan = Plan(plan.rects, plan.halos * halo_scale, plan.extent, plan.box)
+    firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    if to is not None:
+        from tvoronoi.writers.parts import prepare_directory
+
+        to = prepare_directory(to)
+    job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs)
+
+    try:
+        outputs, rounds, pending_after = _rounds(client, plan, job, parts, summaries, firsts)
+        if to is not None:
+            from tvoronoi.writers.parts import finish_directory
+
+            names = tuple(client.gather(outputs))
+            finish_directory(to, [name for name in names if name], format, crs)
+    except BaseException:
+        if to is not None:                          # no half-written dataset left behind
+            from tvoronoi.writers.parts import remove_directory
+
+            remove_directory(to)
+        raise
+    if to is not None:
+        return Result(None, rounds, tuple(pending_after), plan.n_tiles, names)
+    import dask.dataframe as dd
+
+    meta = _meta(frame._meta, job)
+    return Result(dd.from_delayed(outputs, meta=meta, verify_meta=False), rounds, tuple(pending_after), plan.n_tiles)
+
+
+def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: np.ndarray):
+    """Run the rounds; return (the tasks' outputs as futures, rounds, cells pending after each round)."""
+    import dask
+
+    xname, yname, properties, clip = job.x, job.y, job.properties, job.clip
+    # rounds: every tile in the first; then each group of pending cells (group_reaches) with the box it
+    # needs, grown by the tile's halo doubled each round
+    units: list[tuple[int, np.ndarray | None, Region | None]] = [(t, None, None) for t in range(plan.n_tiles)]
+    outputs = []
+    pending_after = []
+    round_ = 0
+    while units:
+        round_ += 1
+        if round_ > MAX_ROUNDS:
+            raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
+        tasks = []
+        for g, (t, group, box_needed) in enumerate(units):
+            region = plan.region(t, round_, box_needed)
+            # only the partitions whose sites reach the region (all of them for shuffled input; a few for
+            # input sorted in space); one piece at least, so that the task knows the columns
+            reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
+            pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
+                      for k in reach]
+            name = f"part-r{round_:02d}-t{t:05d}" + ("" if group is None else f"-g{g:05d}")
+            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, region, group, job, round_, name))
+        futures = client.compute([task[0] for task in tasks] + [task[1] for task in tasks])
+        cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
+        outputs.extend(cells)
+        units = [(t, ids, box_needed)
+                 for (t, _, _), (pending, reaches) in zip(units, left)
+                 for ids, box_needed in group_reaches(pending, reaches, plan.margin(t, round_))]
+        pending_after.append(sum(len(pending) for pending, _ in left))
+    return outputs, round_, pending_after
+
+
+def local_client(workers: int | None = None, *, quiet: bool = False):
+    """A LocalCluster on this machine (one single-threaded worker process per core by default) and its client.
+
+    ``quiet`` keeps the cluster's own log lines (a task's failure, told again by the exception) off stderr.
+    """
+    import logging
+
+    distributed = require_dask()
+    if workers is None:
+        try:
+            workers = len(os.sched_getaffinity(0))
+        except AttributeError:
+            workers = os.cpu_count() or 1
+    cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0",
+                                       silence_logs=logging.CRITICAL if quiet else logging.WARN)
+    return distributed.Client(cluster)
+
+
+def connect(address: str, timeout: float = 10.0):
+    """A client of the scheduler at ``address`` (tcp://HOST:PORT), or a TvoronoiError naming it."""
+    distributed = require_dask()
+    try:
+        return distributed.Client(address, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise TvoronoiError(
+            f"cannot reach the Dask scheduler at {address} ({exc.__class__.__name__}: {exc}); start one with "
+            f"`dask scheduler` and workers with `dask worker {address}`, or use --dask local"
+        ) from None
