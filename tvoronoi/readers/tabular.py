@@ -38,6 +38,8 @@ COMMENT = "#"
 DELIMITERS = (",", ";", "\t", "|")
 # rows the separator is guessed from
 SNIFF_ROWS = 20
+# a CSV text without quotes is split this many characters (about 100,000 rows) at a time
+BLOCK_CHARS = 4 << 20
 
 
 @dataclass(frozen=True)
@@ -320,6 +322,63 @@ def fast_table(body: str, kind: str, layout: _Layout):
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
+        columns: list | None = _unquoted_columns(body, layout.delimiter, n_cols) if kind == "csv" else None
+    if columns is None:
+        columns = _row_columns(body, kind, layout)
+        if columns is None:
+            return None
+    xy = np.empty((len(columns[0]), 2), dtype=np.float64)
+    for k, j in enumerate((ix, iy)):
+        values = _decimal_points(columns[j], layout.delimiter)
+        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
+        columns[j] = []  # the coordinates' text is not needed any more
+    if not np.isfinite(xy).all():
+        return None
+    return xy, _extras(columns, layout, body)
+
+
+def _unquoted_columns(body: str, delimiter: str, n_cols: int) -> list[list[str]] | None:
+    """The columns of a CSV text without quotes, split in bulk a block of lines at a time.
+
+    None when the text needs the csv module (quotes, carriage returns, NUL, a separator
+    that is not ASCII) or a line does not hold ``n_cols`` fields (blank lines, a short
+    row): the csv reader, and then the row walk, take over there.
+    """
+    if not body or QUOTE in body or "\0" in body or not delimiter.isascii():
+        return None
+    if "\r" in body:
+        body = body.replace("\r\n", "\n")  # Windows line ends
+        if "\r" in body:
+            return None  # a line ending in a lone CR (old Mac)
+    columns: list[list[str]] = [[] for _ in range(n_cols)]
+    separator = ord(delimiter)
+    start, end = 0, len(body)
+    while start < end:
+        stop = body.find("\n", start + BLOCK_CHARS)
+        stop = end if stop < 0 else stop + 1
+        block = body[start:stop].removesuffix("\n")
+        start = stop
+        # every line holds n_cols - 1 separators: count them between line breaks
+        raw = np.frombuffer(block.encode(), np.uint8)
+        breaks = np.flatnonzero(raw == ord("\n"))
+        seps = np.flatnonzero(raw == separator)
+        if len(seps) != (len(breaks) + 1) * (n_cols - 1):
+            return None
+        if len(breaks) and not np.array_equal(np.searchsorted(seps, breaks),
+                                              np.arange(1, len(breaks) + 1) * (n_cols - 1)):
+            return None
+        fields = block.replace("\n", delimiter).split(delimiter)
+        del block, raw
+        for j, column in enumerate(columns):
+            column.extend(fields[j::n_cols])
+    return columns
+
+
+def _row_columns(body: str, kind: str, layout: _Layout) -> list | None:
+    """The columns of a table read row by row in bulk (the csv module, or whitespace splits);
+    None when the rows do not all hold the header's number of fields."""
+    n_cols = len(layout.names)
+    with gc_paused():
         if kind == "csv":
             rows = list(csv.reader(io.StringIO(body, newline=""), delimiter=layout.delimiter))
         else:
@@ -336,13 +395,7 @@ def fast_table(body: str, kind: str, layout: _Layout):
                 return None
         columns = list(zip(*rows))
         del rows
-    xy = np.empty((len(columns[0]), 2), dtype=np.float64)
-    for k, j in enumerate((ix, iy)):
-        values = _decimal_points(columns[j], layout.delimiter)
-        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
-    if not np.isfinite(xy).all():
-        return None
-    return xy, _extras(columns, layout, body)
+    return columns
 
 
 def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
