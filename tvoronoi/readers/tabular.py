@@ -27,7 +27,7 @@ from .columns import (
 )
 from tvoronoi.fileio import gc_paused
 
-from .pointset import PointSet, convert_column
+from .pointset import CATEGORY_SAMPLE, PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
 # a table text up to this size is kept to name the line of a site in a later message
@@ -322,28 +322,39 @@ def fast_table(body: str, kind: str, layout: _Layout):
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
-        columns: list | None = _unquoted_columns(body, layout.delimiter, n_cols) if kind == "csv" else None
-    if columns is None:
+        split = _unquoted_columns(body, layout, n_cols) if kind == "csv" else None
+    if split is not None:
+        xy, columns = split
+    else:
         columns = _row_columns(body, kind, layout)
         if columns is None:
             return None
-    xy = np.empty((len(columns[0]), 2), dtype=np.float64)
-    for k, j in enumerate((ix, iy)):
-        values = _decimal_points(columns[j], layout.delimiter)
-        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
-        columns[j] = []  # the coordinates' text is not needed any more
+        xy = _coordinates(columns, layout)
+        columns[ix] = columns[iy] = []  # the coordinates' text is not needed any more
     if not np.isfinite(xy).all():
         return None
     return xy, _extras(columns, layout, body)
 
 
-def _unquoted_columns(body: str, delimiter: str, n_cols: int) -> list[list[str]] | None:
-    """The columns of a CSV text without quotes, split in bulk a block of lines at a time.
+def _coordinates(columns, layout: _Layout) -> np.ndarray:
+    """The x and y columns of a table's text as an (n, 2) array; ValueError at a value that is not a number."""
+    xy = np.empty((len(columns[layout.ix]), 2), dtype=np.float64)
+    for k, j in enumerate((layout.ix, layout.iy)):
+        values = _decimal_points(columns[j], layout.delimiter)
+        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
+    return xy
 
-    None when the text needs the csv module (quotes, carriage returns, NUL, a separator
+
+def _unquoted_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of a CSV text without quotes, split in bulk a block of
+    lines at a time (the coordinates' text of a block is converted and dropped before the next).
+
+    None when the text needs the csv module (quotes, a lone carriage return, NUL, a separator
     that is not ASCII) or a line does not hold ``n_cols`` fields (blank lines, a short
-    row): the csv reader, and then the row walk, take over there.
+    row): the csv reader, and then the row walk, take over there. ValueError at a coordinate
+    that is not a number.
     """
+    delimiter = layout.delimiter
     if not body or QUOTE in body or "\0" in body or not delimiter.isascii():
         return None
     if "\r" in body:
@@ -351,6 +362,9 @@ def _unquoted_columns(body: str, delimiter: str, n_cols: int) -> list[list[str]]
         if "\r" in body:
             return None  # a line ending in a lone CR (old Mac)
     columns: list[list[str]] = [[] for _ in range(n_cols)]
+    blocks: list[np.ndarray] = []
+    # one object per distinct value of a column that repeats its values (a category)
+    canonical: list[dict[str, str]] = [{} for _ in range(n_cols)]
     separator = ord(delimiter)
     start, end = 0, len(body)
     while start < end:
@@ -369,9 +383,18 @@ def _unquoted_columns(body: str, delimiter: str, n_cols: int) -> list[list[str]]
             return None
         fields = block.replace("\n", delimiter).split(delimiter)
         del block, raw
+        block_columns = [fields[j::n_cols] for j in range(n_cols)]
+        del fields
+        blocks.append(_coordinates(block_columns, layout))
         for j, column in enumerate(columns):
-            column.extend(fields[j::n_cols])
-    return columns
+            if j in (layout.ix, layout.iy):
+                continue
+            values = block_columns[j]
+            if len(set(values[:CATEGORY_SAMPLE])) * 2 <= min(len(values), CATEGORY_SAMPLE):
+                memo = canonical[j]
+                values = [memo.setdefault(v, v) for v in values]
+            column.extend(values)
+    return np.concatenate(blocks), columns
 
 
 def _row_columns(body: str, kind: str, layout: _Layout) -> list | None:
