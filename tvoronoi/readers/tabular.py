@@ -326,9 +326,10 @@ def fast_table(body: str, kind: str, layout: _Layout):
     if split is not None:
         xy, columns = split
     else:
-        columns = _row_columns(body, kind, layout)
-        if columns is None:
+        rows = _row_columns(body, kind, layout)
+        if rows is None:
             return None
+        columns = rows
         xy = _coordinates(columns, layout)
         columns[ix] = columns[iy] = []  # the coordinates' text is not needed any more
     if not np.isfinite(xy).all():
