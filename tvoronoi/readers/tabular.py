@@ -6,6 +6,7 @@ import csv
 import io
 import json
 import math
+import sys
 import warnings
 from dataclasses import dataclass
 from typing import Iterator
@@ -40,6 +41,8 @@ DELIMITERS = (",", ";", "\t", "|")
 SNIFF_ROWS = 20
 # a CSV text without quotes is split this many characters (about 100,000 rows) at a time
 BLOCK_CHARS = 4 << 20
+# a CSV text at least this long is read by pyarrow's reader when pyarrow is loaded
+ARROW_MIN_CHARS = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -322,7 +325,11 @@ def fast_table(body: str, kind: str, layout: _Layout):
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
-        split = _unquoted_columns(body, layout, n_cols) if kind == "csv" else None
+        split = None
+        if kind == "csv" and len(body) >= ARROW_MIN_CHARS:
+            split = _arrow_columns(body, layout, n_cols)
+        if split is None and kind == "csv":
+            split = _unquoted_columns(body, layout, n_cols)
     if split is not None:
         xy, columns = split
     else:
@@ -344,6 +351,64 @@ def _coordinates(columns, layout: _Layout) -> np.ndarray:
         values = _decimal_points(columns[j], layout.delimiter)
         xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
     return xy
+
+
+def _arrow_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
+    """What :func:`_unquoted_columns` gives, read by pyarrow's CSV reader (on every core) when
+    pyarrow is already loaded (a GeoParquet output loads it first); None when it is not, or the
+    text needs a closer look. Loading pyarrow only to read would cost more memory (its libraries)
+    than the time it saves.
+
+    Every field is read as text, so that the columns are typed as the other paths type them;
+    the coordinates are converted by Arrow, which accepts a subset of what ``float`` accepts
+    (no spaces or "_"), with the same correctly rounded result: a value it refuses sends the
+    file to the other paths, which read it or name its line.
+    """
+    if "pyarrow" not in sys.modules or QUOTE in body or "\0" in body or "\r" in body or not layout.delimiter.isascii():
+        return None
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.csv as pacsv
+
+    names = [f"c{j}" for j in range(n_cols)]
+    # the system allocator hands the table's memory back once it is dropped
+    pool = pa.system_memory_pool()
+    try:
+        table = pacsv.read_csv(
+            pa.py_buffer(body.encode()),
+            read_options=pacsv.ReadOptions(column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=layout.delimiter, quote_char=False,
+                                             double_quote=False, escape_char=False, newlines_in_values=False,
+                                             ignore_empty_lines=False),
+            convert_options=pacsv.ConvertOptions(column_types={name: pa.string() for name in names},
+                                                 strings_can_be_null=False, quoted_strings_can_be_null=False),
+            memory_pool=pool,
+        )
+    except (pa.ArrowInvalid, pa.ArrowTypeError):
+        return None  # a row with another number of fields, a blank line
+    xy = np.empty((table.num_rows, 2), np.float64)
+    for k, j in enumerate((layout.ix, layout.iy)):
+        text = table.column(j)
+        if layout.delimiter == ";":
+            text = pc.replace_substring(text, ",", ".", memory_pool=pool)  # decimal commas
+        try:
+            xy[:, k] = pc.cast(text, pa.float64(), memory_pool=pool).to_numpy()
+        except (pa.ArrowInvalid, pa.ArrowTypeError):
+            return None
+    columns: list = [[] if j in (layout.ix, layout.iy) else _arrow_texts(pa, pc, table.column(j), pool)
+                     for j in range(n_cols)]
+    return xy, columns
+
+
+def _arrow_texts(pa, pc, column, pool) -> list[str]:
+    """An Arrow text column as a list of str; a column that repeats its values (a category,
+    judged from its first rows) holds one object per distinct value."""
+    head = column.slice(0, CATEGORY_SAMPLE)
+    if pc.count_distinct(head).as_py() * 2 > min(len(column), CATEGORY_SAMPLE):
+        return column.to_pylist()
+    encoded = pc.dictionary_encode(column, memory_pool=pool).combine_chunks(memory_pool=pool)
+    values = np.array(encoded.dictionary.to_pylist() + [None], dtype=object)
+    return values[encoded.indices.to_numpy()].tolist()
 
 
 def _unquoted_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
