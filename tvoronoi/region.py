@@ -109,7 +109,24 @@ def as_region(clip, *, what: str = "clip"):
         )
     if not clip.area > 0:
         raise TvoronoiError(f"{what} has no area to clip to")
+    _check_region_range(clip, what)
     return clip
+
+
+def _check_region_range(clip, what: str) -> None:
+    """Refuse a region whose coordinates spread over more than the points may (2^170 around the
+    largest): the overlays that cut the cells lose their way among subnormal or tiny values."""
+    import shapely
+
+    from tvoronoi.api import check_range
+    from tvoronoi.engines import scale_exponent
+    from tvoronoi.errors import CoordinateRangeError
+
+    coords = shapely.get_coordinates(clip)
+    try:
+        check_range(coords, scale_exponent(coords), what="vertex")
+    except CoordinateRangeError as e:
+        raise TvoronoiError(f"{what}: {e.explain(lambda i: f'vertex {i}')}") from None
 
 
 def region_box(region) -> tuple[float, float, float, float]:
