@@ -24,7 +24,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.common import atomic_write, describe_machine, machine, parse_sizes, subprocess_env  # noqa: E402
+from benchmarks.common import (  # noqa: E402
+    atomic_write,
+    describe_machine,
+    machine,
+    parse_sizes,
+    subprocess_env,
+    write_csv,
+)
 
 PANDAS_SHAPELY = """
 import sys
@@ -48,21 +55,23 @@ def write_points(path: Path, n: int) -> None:
             f.write("".join(f"{xy[i, 0]:.6f},{xy[i, 1]:.6f},site {i},{kinds[i]}\n" for i in block))
 
 
-def run(cmd: list[str]) -> tuple[float, float]:
-    """Wall seconds and peak MiB of one whole process (its own peak, from wait4)."""
+def run(cmd: list[str]) -> tuple[float, float, float]:
+    """Wall seconds, peak MiB and CPU seconds (user + system, all threads) of one whole process,
+    its own peak and CPU from wait4. CPU time shows the work where other processes share the cores."""
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, env=subprocess_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
     if status != 0:
         raise RuntimeError(f"{cmd} failed: {proc.stderr.read().decode()[-2000:]}")
-    return wall, usage.ru_maxrss / 1024
+    return wall, usage.ru_maxrss / 1024, usage.ru_utime + usage.ru_stime
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", default="1M")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--only-tvoronoi", action="store_true", help="leave out the pandas + shapely pipeline")
     ap.add_argument("--out", default="benchmarks/results/batch")
     args = ap.parse_args(argv)
     n = parse_sizes(args.n)[0]
@@ -79,20 +88,28 @@ def main(argv=None) -> None:
             "pandas + shapely.voronoi_polygons + to_file (GeoJSON)": [
                 sys.executable, "-c", PANDAS_SHAPELY, str(src), str(Path(tmp) / "shapely.geojson")],
         }
-        rows = {name: [] for name in cases}
+        if args.only_tvoronoi:
+            cases = {name: cmd for name, cmd in cases.items() if name.startswith("tvoronoi")}
+        rows: dict[str, list] = {name: [] for name in cases}
         for _ in range(args.repeats):            # interleaved rounds
             for name, cmd in cases.items():
                 rows[name].append(run(cmd))
-                print(f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB", flush=True)
+                print(f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB, "
+                      f"{rows[name][-1][2]:.2f} s CPU", flush=True)
         sizes = {name: (Path(cmd[-1]).stat().st_size if Path(cmd[-1]).exists() else 0) for name, cmd in cases.items()}
     lines = ["# Batch end to end", "", f"Machine: {describe_machine(info)}", "",
              f"{n:,} points in a CSV (x, y and two text columns), cells out; whole processes, start-up included; "
-             f"median of {args.repeats} interleaved runs, peak resident memory of the process.", "",
-             "| pipeline | wall s | peak MiB | output MB |", "|---|---:|---:|---:|"]
+             f"median of {args.repeats} interleaved runs, peak resident memory of the process; CPU is user + "
+             f"system time of all its threads (the work done, whatever else runs on the machine).", "",
+             "| pipeline | wall s | CPU s | peak MiB | output MB |", "|---|---:|---:|---:|---:|"]
+    table = []
     for name, runs in rows.items():
-        lines.append(f"| {name} | {statistics.median(r[0] for r in runs):.2f} | "
-                     f"{statistics.median(r[1] for r in runs):.0f} | {sizes[name] / 1e6:.0f} |")
+        wall, peak, cpu = (statistics.median(r[k] for r in runs) for k in range(3))
+        lines.append(f"| {name} | {wall:.2f} | {cpu:.2f} | {peak:.0f} | {sizes[name] / 1e6:.0f} |")
+        table.append({"pipeline": name, "n": n, "repeats": len(runs), "wall_s": round(wall, 3),
+                      "cpu_s": round(cpu, 3), "peak_mib": round(peak, 1), "output_bytes": sizes[name]})
     atomic_write(out_dir / "batch.md", "\n".join(lines) + "\n")
+    write_csv(out_dir / "batch.csv", table, columns=list(table[0]))
     print(f"# wrote {out_dir / 'batch.md'}")
 
 

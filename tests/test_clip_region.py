@@ -12,7 +12,10 @@ from hypothesis import strategies as st
 
 import tvoronoi
 from tvoronoi import cli
-from tvoronoi.region import ClippedDiagram
+from tvoronoi import region as region_module
+from tvoronoi.generators import coastline
+from tvoronoi.region import ClippedDiagram, local_intersection, region_box
+from tvoronoi.shapes import cell_polygons
 
 L_SHAPE = shapely.Polygon([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
 WITH_HOLES = shapely.Polygon(
@@ -63,6 +66,75 @@ def test_cells_tile_the_region(rng, region, engine):
     kept = np.flatnonzero(~d.reshaped)
     for i in kept[:50]:
         assert d.to_shapely()[i].equals_exact(shapely.Polygon(d.cell_polygon(i)), 0)
+
+
+# a coastline family: detailed, spiky outlines with lakes and islands (tvoronoi.generators.coastline)
+COASTS = [coastline(600, spikes=80, lakes=3, islands=4, seed=seed) for seed in (1, 2)] + [
+    coastline(1500, spikes=200, seed=3)]
+
+
+@pytest.mark.parametrize("region", COASTS, ids=["coast600-1", "coast600-2", "coast1500"])
+@pytest.mark.parametrize("grid", [False, True], ids=["tested", "grid"])
+def test_spiky_coastlines_are_tiled(rng, region, grid, monkeypatch):
+    """Cells cut against local pieces of a spiky outline (and, with the grid, sites and cells placed
+    by tiles first) still tile the outline exactly."""
+    if grid:
+        monkeypatch.setattr(region_module, "GRID_MIN_SITES", 0)
+        monkeypatch.setattr(region_module, "GRID_TILES", 16)
+    xmin, ymin, xmax, ymax = region.bounds
+    pts = rng.uniform([xmin, ymin], [xmax, ymax], (4000, 2))
+    d = tvoronoi.voronoi(pts, clip=region)
+    check_tiles(d, region)
+    assert np.array_equal(d.inside, shapely.intersects_xy(region, pts[:, 0], pts[:, 1]))
+    # the cells left whole are those the region contains
+    cells = cell_polygons(d)
+    whole = np.flatnonzero(~d.reshaped)
+    assert shapely.contains_properly(region, cells[whole]).all()
+    cut = np.flatnonzero(d.reshaped & (cells != None))  # noqa: E711
+    assert not shapely.contains_properly(region, cells[cut]).any()
+
+
+@pytest.mark.parametrize("spikes", [0, 200])
+def test_local_pieces_give_the_whole_intersection(rng, spikes):
+    """Each cell cut against its piece of the outline is the cell cut against the whole outline:
+    exactly when no edge is longer than the pieces' reach, up to rounding where long edges (the
+    spikes) were split for every cell alike."""
+    region = coastline(1500, spikes=spikes, seed=6)
+    xmin, ymin, xmax, ymax = region.bounds
+    d = tvoronoi.voronoi(rng.uniform([xmin, ymin], [xmax, ymax], (3000, 2)), bbox=region_box(region))
+    cells = cell_polygons(d)
+    cells = cells[~shapely.contains_properly(region, cells)]
+    local = local_intersection(cells, region)
+    whole = shapely.intersection(cells, region)
+    assert len(cells) > 100
+    same = shapely.equals_exact(shapely.normalize(local), shapely.normalize(whole), 0)
+    if spikes == 0:
+        assert same.all()
+    else:
+        assert not same.all(), "the long spike edges were split"
+        assert (shapely.area(shapely.symmetric_difference(local, whole)) <= 1e-12 * shapely.area(cells)).all()
+    assert shapely.coverage_is_valid(local[shapely.area(local) > 0])
+
+
+def test_grid_places_sites_as_the_region_does(monkeypatch):
+    """Sites on tile edges, on the outline's vertices and edges, and in every kind of tile."""
+    region = COASTS[0]
+    monkeypatch.setattr(region_module, "GRID_TILES", 8)
+    grid = region_module._Grid(region)
+    xmin, ymin, xmax, ymax = region.bounds
+    edges_x = xmin + np.arange(9) * grid.step[0]
+    vertices = shapely.get_coordinates(region)
+    midpoints = (vertices[:-1] + vertices[1:]) / 2
+    rng = np.random.default_rng(8)
+    pts = np.concatenate([
+        rng.uniform([xmin - 0.1, ymin - 0.1], [xmax + 0.1, ymax + 0.1], (20000, 2)),
+        vertices, midpoints,
+        np.c_[np.repeat(edges_x, 50), rng.uniform(ymin, ymax, 9 * 50)],
+    ])
+    monkeypatch.setattr(region_module, "GRID_MIN_SITES", 0)
+    got = region_module.sites_inside(pts, region, grid)
+    assert np.array_equal(got, shapely.intersects_xy(region, pts[:, 0], pts[:, 1]))
+    assert grid.inside.any() and grid.outside.any() and not (grid.inside | grid.outside).all()
 
 
 def test_inner_diagram_is_that_of_the_inside_sites(rng):
@@ -159,7 +231,25 @@ def test_random_regions_are_tiled(geometry, seed):
     xmin, ymin, xmax, ymax = region.bounds
     pts = rng.uniform([xmin, ymin], [xmax, ymax], (80, 2))
     pts = np.vstack([pts, region.representative_point().coords])
-    check_tiles(tvoronoi.voronoi(pts, clip=region), region)
+    try:
+        d = tvoronoi.voronoi(pts, clip=region)
+    except tvoronoi.TvoronoiError as e:
+        # the defined answer when the points or the region spread over more than 2^170 (a subnormal
+        # or tiny coordinate next to ordinary ones): refused, naming the value
+        assert "exact arithmetic covers a range of 2^170" in str(e)
+        for coords in (pts, shapely.get_coordinates(region)):
+            magnitude = np.abs(coords[coords != 0])
+            if np.log2(magnitude.max()) - np.log2(magnitude.min()) > 169:
+                return
+        raise AssertionError(f"refused within the range: {e}") from None
+    check_tiles(d, region)
+
+
+def test_region_beyond_the_exact_range_is_refused():
+    """A subnormal vertex next to ordinary ones (GEOS's overlays lose area there) is named."""
+    region = shapely.Polygon([(1.0, 0.0), (5e-324, 0.0), (5e-324, 1.0)])
+    with pytest.raises(tvoronoi.TvoronoiError, match=r"clip: vertex 1: coordinate 5e-324 is over 1e51 times smaller"):
+        tvoronoi.voronoi([[0.2, 0.2], [0.5, 0.1]], clip=region)
 
 
 # --- the batch option

@@ -208,3 +208,33 @@ def test_parquet_input_binary_and_decimal_columns(tmp_path):
     doc = json.loads((tmp_path / "c.geojson").read_text())
     assert [f["properties"] for f in doc["features"]] == [
         {"site": 0, "price": 1.25}, {"site": 1, "price": None}, {"site": 2, "price": 3.0}]
+
+
+def test_geoparquet_row_groups_hold_the_same_rows(tmp_path, monkeypatch):
+    """Written a row group at a time (seams with repeated sites and a cell that misses the box),
+    the file reads back as the one-group file does, and its geometries are the cells'."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    import tvoronoi
+    from tvoronoi.readers import PointSet
+    from tvoronoi.writers import geoparquet
+
+    base = DATASETS["clustered"][:40]
+    sites = np.concatenate([base, base[[5, 6, 7]], [[1e6, 1e6]]])
+    box = (base.min() - 1, base.min() - 1, base.max() + 1, base.max() + 1)
+    d = tvoronoi.voronoi(sites, bbox=box)
+    points = PointSet(sites, "t.csv", {"name": [f"s{i}" for i in range(len(sites))]})
+    geoparquet.write_cells_parquet(d, points, str(tmp_path / "one.parquet"))
+    monkeypatch.setattr(geoparquet, "ROW_GROUP", 6)
+    geoparquet.write_cells_parquet(d, points, str(tmp_path / "many.parquet"))
+    one, many = pq.read_table(tmp_path / "one.parquet"), pq.read_table(tmp_path / "many.parquet")
+    assert pq.ParquetFile(tmp_path / "many.parquet").num_row_groups == -(-len(one) // 6) > 1
+    assert many.equals(one) and many.schema.metadata == one.schema.metadata
+    polygons = shapely.from_wkb(many["geometry"].to_numpy(zero_copy_only=False))
+    sites_kept = many["site"].to_pylist()
+    assert sites_kept == list(range(40)) + [len(sites) - 1]
+    assert polygons[-1] is None
+    expected = d.to_shapely()[sites_kept[:-1]]
+    assert all(shapely.equals_exact(p, q, 0.0) for p, q in zip(polygons[:-1], expected))
+    assert many["duplicates"].to_pylist()[5:8] == [[40], [41], [42]]
+    geo = json.loads(many.schema.metadata[b"geo"])
+    assert geo["columns"]["geometry"]["bbox"] == list(shapely.total_bounds(polygons))

@@ -143,6 +143,46 @@ def test_properties_travel_and_clashing_names_are_renamed():
         assert props["name"] == f"p{i}" and props["site_2"] == 100 + i and props["w"] == 0.5
 
 
+AWKWARD_TEXT = ["plain", "", "a, b", 'say "hi"', "back\\slash", "tab\there", "é ü 中", "%d %b %%", "\u2028", '","']
+
+
+@pytest.mark.parametrize("chunk", [3, 10_000])
+def test_properties_in_bulk_match_each_row(monkeypatch, chunk):
+    """Columns serialized a chunk at a time give each row's values as json.dumps writes them:
+    ints, floats, nulls, and strings with quotes, commas, backslashes, control characters,
+    non-ASCII text and % signs, in chunks with and without a repeated site."""
+    rng = np.random.default_rng(5)
+    sites = DATASETS["uniform"][:40]
+    sites = np.concatenate([sites, sites[[4]]])  # row 40 repeats row 4: its chunk is written row by row
+    n_sites = len(sites)
+    columns = {
+        "int": rng.integers(-(2**62), 2**62, n_sites).tolist(),
+        "float": [None if i % 7 == 0 else float(v) for i, v in enumerate(rng.normal(size=n_sites) * 1e300)],
+        "text": [AWKWARD_TEXT[i % len(AWKWARD_TEXT)] for i in range(n_sites)],
+        "plain": [f"p{i}" for i in range(n_sites)],
+        "mixed text": [None if i % 3 == 0 else f"v{i}" for i in range(n_sites)],
+        'key "%s"': [[i, "x"] if i % 2 else i for i in range(n_sites)],
+    }
+    points = PointSet(sites, "t.csv", columns)
+    monkeypatch.setattr(geojson_diagram, "CHUNK_FEATURES", chunk)
+    text = to_bytes(write_cells, tvoronoi.voronoi(sites), points)
+    features = load(text)["features"]
+    assert len(features) == n_sites - 1
+    for feature in features:
+        props = feature["properties"]
+        i = props.pop("site")
+        props.pop("duplicates", None)
+        assert props == {name: values[i] for name, values in columns.items()}
+        assert json.dumps(props, ensure_ascii=False) == json.dumps(points.properties(i), ensure_ascii=False)
+
+
+def test_json_texts_cut_where_json_dumps_does():
+    values = [1, None, 2.5, True, *AWKWARD_TEXT, [1, "a,b"], {"k": "v,w"}]
+    assert [json.loads(t) for t in geojson_diagram.json_texts(values)] == values
+    for part in (values[:4], AWKWARD_TEXT, [[1, 2], [3]]):
+        assert [json.loads(t) for t in geojson_diagram.json_texts(part)] == part
+
+
 def test_geojson_records_travel():
     sites = np.array([[0.0, 0.0], [1.0, 0.2], [0.3, 1.0], [0.9, 0.8]])
     records = [{"id": "a", "tags": [1, 2]}, {}, {"id": "c", "duplicates": "x"}, {"nested": {"k": None}}]

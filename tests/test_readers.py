@@ -542,6 +542,46 @@ def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
             assert not (type(value) is float and not math.isfinite(value))
 
 
+@settings(max_examples=100, deadline=None)
+@given(
+    xy=st.lists(st.tuples(FLOATS, FLOATS), min_size=1, max_size=12),
+    n_extra=st.integers(0, 3),
+    delimiter=st.sampled_from([",", ";", "\t"]),
+    blank_line=st.booleans(),
+    data=st.data(),
+)
+def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line, data):
+    """pyarrow's CSV reader (used when pyarrow is loaded) gives the sites and typed columns the
+    bulk split and the row walk give, or steps aside; ";" files with decimal commas included."""
+    pytest.importorskip("pyarrow")
+    from tvoronoi.readers import tabular
+
+    cells = st.one_of(CELL_TEXT.filter(lambda c: delimiter not in c), CELLS.filter(lambda c: delimiter not in c))
+    rows = [[repr(a), repr(b), *[data.draw(cells) for _ in range(n_extra)]] for a, b in xy]
+    if delimiter == ";":
+        rows = [[r[0].replace(".", ","), *r[1:]] for r in rows]
+    lines = [delimiter.join(["x", "y", *[f"e{j}" for j in range(n_extra)]])] + [delimiter.join(r) for r in rows]
+    if blank_line:
+        lines.insert(2, "")
+    text = "\n".join(lines) + "\n"
+    layout = readers.table_layout(text, "t", "csv", None, None, delimiter)
+    body = text[readers.line_offset(text, layout.header_lines):]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tabular, "ARROW_MIN_CHARS", 1 << 60)
+        try:
+            other = readers.fast_table(body, "csv", layout)
+        except ValueError:
+            other = None
+        patch.setattr(tabular, "ARROW_MIN_CHARS", 0)
+        arrow = tabular._arrow_columns(body, layout, len(layout.names))
+        if arrow is None:
+            return
+        assert other is not None, "Arrow read a table the other paths refuse"
+        fast = readers.fast_table(body, "csv", layout)
+    np.testing.assert_array_equal(fast[0], other[0])
+    assert fast[1] == other[1]
+
+
 # ---------------------------------------------------------------------------
 # errors: each names the file, the place and the fix
 

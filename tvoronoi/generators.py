@@ -244,3 +244,43 @@ def _check_bounds(bounds) -> tuple[float, float, float, float]:
             f"bounds {bounds!r} is an empty box; give (xmin, ymin, xmax, ymax) with xmin < xmax and ymin < ymax"
         )
     return xmin, ymin, xmax, ymax
+
+
+def coastline(n_vertices: int = 4000, *, spikes: int = 300, lakes: int = 6, islands: int = 10,
+              seed: int | None = 0):
+    """A country-like clip region: a wiggly coast with thin spikes (fjords and capes), lakes and islands.
+
+    The coast is a star-shaped ring of ``n_vertices`` vertices around the origin (radius about 1,
+    forty harmonics and some noise); ``spikes`` of its vertices are pushed 25% out or in, each
+    making a spike one vertex wide. ``lakes`` small polygons are cut out of it as holes and
+    ``islands`` small polygons lie off the coast. It exercises clipping at scale: a detailed,
+    concave boundary with holes and several parts.
+
+    Returns
+    -------
+    shapely.MultiPolygon or shapely.Polygon
+        Valid (repaired with ``shapely.make_valid`` where the noise folds the ring).
+    """
+    import shapely
+
+    n_vertices = _check_count(n_vertices, "n_vertices", minimum=3)
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0, 2 * np.pi, n_vertices))
+    r = 1.0 + sum(rng.normal(0, 0.12 / k) * np.cos(k * t + rng.uniform(0, 2 * np.pi)) for k in range(1, 40))
+    r = r + rng.normal(0, 0.004, n_vertices)
+    pushed = rng.choice(n_vertices, min(spikes, n_vertices), replace=False)
+    r[pushed] *= rng.choice([0.75, 1.25], len(pushed))
+    land = shapely.make_valid(shapely.Polygon(np.c_[r * np.cos(t), r * np.sin(t)]))
+
+    def blob(centre, size, k=24):
+        a = np.linspace(0, 2 * np.pi, k, endpoint=False)
+        rr = size * (1 + 0.3 * rng.uniform(-1, 1, k))
+        return shapely.Polygon(np.c_[centre[0] + rr * np.cos(a), centre[1] + rr * np.sin(a)])
+
+    for _ in range(lakes):
+        angle, dist = rng.uniform(0, 2 * np.pi), rng.uniform(0, 0.5)
+        land = land.difference(blob((dist * np.cos(angle), dist * np.sin(angle)), rng.uniform(0.02, 0.06)))
+    for _ in range(islands):
+        angle, dist = rng.uniform(0, 2 * np.pi), rng.uniform(1.4, 1.6)
+        land = land.union(blob((dist * np.cos(angle), dist * np.sin(angle)), rng.uniform(0.02, 0.08)))
+    return shapely.make_valid(land)

@@ -136,7 +136,9 @@ def read_points(
         return read_parquet(data, source, x, y)
     if fmt == "geojson":
         return read_geojson(data, source, x, y, _loads_json)
-    return read_table(_decode(data, source), source, fmt, x, y, delimiter)
+    text = _decode(data, source)
+    del data  # the bytes are not needed once decoded (a large file is not held twice)
+    return read_table(text, source, fmt, x, y, delimiter)
 
 
 def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:

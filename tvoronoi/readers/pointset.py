@@ -102,6 +102,8 @@ class PointSet:
 # JSON-ready values: from the text of a table field, from a numpy column
 
 
+# rows from which a text column is judged to be a category (few values, each repeated)
+CATEGORY_SAMPLE = 1000
 _LEADING_ZERO = re.compile(r"^\s*[+-]?0[0-9]", re.MULTILINE)
 
 
@@ -136,6 +138,10 @@ def convert_column(values, plain: bool) -> list:
     """
     if not values:
         return []
+    first = next((v for v in values if v.strip()), None)
+    if first is not None and _is_text((first,)):
+        # the first value already makes it a text column
+        return _text_column(values)
     if plain and not _LEADING_ZERO.search("\n".join(values)):
         try:
             ints = list(map(int, values))
@@ -156,11 +162,7 @@ def convert_column(values, plain: bool) -> list:
             return out
     distinct = set(values)
     if _is_text(distinct):
-        # a text column: as written, empty values null
-        blank = [v for v in distinct if not v.strip()]
-        if not blank:
-            return list(values)
-        return [None if not v.strip() else v for v in values]
+        return _text_column(values)
     # numbers and empty values: convert each distinct value once, then settle the column's type
     memo = {v: _convert_value(v) for v in distinct}
     kinds = {type(value) for value in memo.values()} - {type(None)}
@@ -171,6 +173,18 @@ def convert_column(values, plain: bool) -> list:
     else:
         memo = {v: None if not v.strip() else v for v in memo}
     return list(map(memo.__getitem__, values))
+
+
+def _text_column(values) -> list:
+    """A text column as written, empty values None; a value that repeats (a category, judged
+    from the first rows) is held once, not once per row."""
+    head = len(set(values[:CATEGORY_SAMPLE]))
+    if head * 2 <= min(len(values), CATEGORY_SAMPLE):
+        memo = {v: None if not v.strip() else v for v in set(values)}
+        return list(map(memo.__getitem__, values))
+    if "" in values or any(map(str.isspace, values)):
+        return [None if not v.strip() else v for v in values]
+    return list(values)
 
 
 def _is_text(distinct) -> bool:

@@ -6,6 +6,7 @@ import csv
 import io
 import json
 import math
+import sys
 import warnings
 from dataclasses import dataclass
 from typing import Iterator
@@ -27,7 +28,7 @@ from .columns import (
 )
 from tvoronoi.fileio import gc_paused
 
-from .pointset import PointSet, convert_column
+from .pointset import CATEGORY_SAMPLE, PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
 # a table text up to this size is kept to name the line of a site in a later message
@@ -38,6 +39,10 @@ COMMENT = "#"
 DELIMITERS = (",", ";", "\t", "|")
 # rows the separator is guessed from
 SNIFF_ROWS = 20
+# a CSV text without quotes is split this many characters (about 100,000 rows) at a time
+BLOCK_CHARS = 4 << 20
+# a CSV text at least this long is read by pyarrow's reader when pyarrow is loaded
+ARROW_MIN_CHARS = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -320,6 +325,149 @@ def fast_table(body: str, kind: str, layout: _Layout):
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
+        split = None
+        if kind == "csv" and len(body) >= ARROW_MIN_CHARS:
+            split = _arrow_columns(body, layout, n_cols)
+        if split is None and kind == "csv":
+            split = _unquoted_columns(body, layout, n_cols)
+    if split is not None:
+        xy, columns = split
+    else:
+        rows = _row_columns(body, kind, layout)
+        if rows is None:
+            return None
+        columns = rows
+        xy = _coordinates(columns, layout)
+        columns[ix] = columns[iy] = []  # the coordinates' text is not needed any more
+    if not np.isfinite(xy).all():
+        return None
+    return xy, _extras(columns, layout, body)
+
+
+def _coordinates(columns, layout: _Layout) -> np.ndarray:
+    """The x and y columns of a table's text as an (n, 2) array; ValueError at a value that is not a number."""
+    xy = np.empty((len(columns[layout.ix]), 2), dtype=np.float64)
+    for k, j in enumerate((layout.ix, layout.iy)):
+        values = _decimal_points(columns[j], layout.delimiter)
+        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
+    return xy
+
+
+def _arrow_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
+    """What :func:`_unquoted_columns` gives, read by pyarrow's CSV reader (on every core) when
+    pyarrow is already loaded (a GeoParquet output loads it first); None when it is not, or the
+    text needs a closer look. Loading pyarrow only to read would cost more memory (its libraries)
+    than the time it saves.
+
+    Every field is read as text, so that the columns are typed as the other paths type them;
+    the coordinates are converted by Arrow, which accepts a subset of what ``float`` accepts
+    (no spaces or "_"), with the same correctly rounded result: a value it refuses sends the
+    file to the other paths, which read it or name its line.
+    """
+    if "pyarrow" not in sys.modules or QUOTE in body or "\0" in body or "\r" in body or not layout.delimiter.isascii():
+        return None
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.csv as pacsv
+
+    names = [f"c{j}" for j in range(n_cols)]
+    # the system allocator hands the table's memory back once it is dropped
+    pool = pa.system_memory_pool()
+    try:
+        table = pacsv.read_csv(
+            pa.py_buffer(body.encode()),
+            read_options=pacsv.ReadOptions(column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=layout.delimiter, quote_char=False,
+                                             double_quote=False, escape_char=False, newlines_in_values=False,
+                                             ignore_empty_lines=False),
+            convert_options=pacsv.ConvertOptions(column_types={name: pa.string() for name in names},
+                                                 strings_can_be_null=False, quoted_strings_can_be_null=False),
+            memory_pool=pool,
+        )
+    except (pa.ArrowInvalid, pa.ArrowTypeError):
+        return None  # a row with another number of fields, a blank line
+    xy = np.empty((table.num_rows, 2), np.float64)
+    for k, j in enumerate((layout.ix, layout.iy)):
+        text = table.column(j)
+        if layout.delimiter == ";":
+            text = pc.replace_substring(text, ",", ".", memory_pool=pool)  # decimal commas
+        try:
+            xy[:, k] = pc.cast(text, pa.float64(), memory_pool=pool).to_numpy()
+        except (pa.ArrowInvalid, pa.ArrowTypeError):
+            return None
+    columns: list = [[] if j in (layout.ix, layout.iy) else _arrow_texts(pa, pc, table.column(j), pool)
+                     for j in range(n_cols)]
+    return xy, columns
+
+
+def _arrow_texts(pa, pc, column, pool) -> list[str]:
+    """An Arrow text column as a list of str; a column that repeats its values (a category,
+    judged from its first rows) holds one object per distinct value."""
+    head = column.slice(0, CATEGORY_SAMPLE)
+    if pc.count_distinct(head).as_py() * 2 > min(len(column), CATEGORY_SAMPLE):
+        return column.to_pylist()
+    encoded = pc.dictionary_encode(column, memory_pool=pool).combine_chunks(memory_pool=pool)
+    values = np.array(encoded.dictionary.to_pylist() + [None], dtype=object)
+    return values[encoded.indices.to_numpy()].tolist()
+
+
+def _unquoted_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of a CSV text without quotes, split in bulk a block of
+    lines at a time (the coordinates' text of a block is converted and dropped before the next).
+
+    None when the text needs the csv module (quotes, a lone carriage return, NUL, a separator
+    that is not ASCII) or a line does not hold ``n_cols`` fields (blank lines, a short
+    row): the csv reader, and then the row walk, take over there. ValueError at a coordinate
+    that is not a number.
+    """
+    delimiter = layout.delimiter
+    if not body or QUOTE in body or "\0" in body or not delimiter.isascii():
+        return None
+    if "\r" in body:
+        body = body.replace("\r\n", "\n")  # Windows line ends
+        if "\r" in body:
+            return None  # a line ending in a lone CR (old Mac)
+    columns: list[list[str]] = [[] for _ in range(n_cols)]
+    blocks: list[np.ndarray] = []
+    # one object per distinct value of a column that repeats its values (a category)
+    canonical: list[dict[str, str]] = [{} for _ in range(n_cols)]
+    separator = ord(delimiter)
+    start, end = 0, len(body)
+    while start < end:
+        stop = body.find("\n", start + BLOCK_CHARS)
+        stop = end if stop < 0 else stop + 1
+        block = body[start:stop].removesuffix("\n")
+        start = stop
+        # every line holds n_cols - 1 separators: count them between line breaks
+        raw = np.frombuffer(block.encode(), np.uint8)
+        breaks = np.flatnonzero(raw == ord("\n"))
+        seps = np.flatnonzero(raw == separator)
+        if len(seps) != (len(breaks) + 1) * (n_cols - 1):
+            return None
+        if len(breaks) and not np.array_equal(np.searchsorted(seps, breaks),
+                                              np.arange(1, len(breaks) + 1) * (n_cols - 1)):
+            return None
+        fields = block.replace("\n", delimiter).split(delimiter)
+        del block, raw
+        block_columns = [fields[j::n_cols] for j in range(n_cols)]
+        del fields
+        blocks.append(_coordinates(block_columns, layout))
+        for j, column in enumerate(columns):
+            if j in (layout.ix, layout.iy):
+                continue
+            values = block_columns[j]
+            if len(set(values[:CATEGORY_SAMPLE])) * 2 <= min(len(values), CATEGORY_SAMPLE):
+                memo = canonical[j]
+                values = [memo.setdefault(v, v) for v in values]
+            column.extend(values)
+    return np.concatenate(blocks), columns
+
+
+def _row_columns(body: str, kind: str, layout: _Layout) -> list | None:
+    """The columns of a table read row by row in bulk (the csv module, or whitespace splits);
+    None when the rows do not all hold the header's number of fields."""
+    n_cols = len(layout.names)
+    with gc_paused():
         if kind == "csv":
             rows = list(csv.reader(io.StringIO(body, newline=""), delimiter=layout.delimiter))
         else:
@@ -336,13 +484,7 @@ def fast_table(body: str, kind: str, layout: _Layout):
                 return None
         columns = list(zip(*rows))
         del rows
-    xy = np.empty((len(columns[0]), 2), dtype=np.float64)
-    for k, j in enumerate((ix, iy)):
-        values = _decimal_points(columns[j], layout.delimiter)
-        xy[:, k] = np.fromiter(map(float, values), dtype=np.float64, count=len(xy))
-    if not np.isfinite(xy).all():
-        return None
-    return xy, _extras(columns, layout, body)
+    return columns
 
 
 def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:

@@ -31,6 +31,8 @@ _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
 _GEOMETRY = b'{"type":"Feature","geometry":%b,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
+# the text of a NaN row between two rings (see ring_list)
+_RING_BREAK = b",[null,null],"
 # GeoJSON text sequences (RFC 8142): each feature opens with a record separator and ends a line
 RS = b"\x1e"
 # how features are framed: a FeatureCollection, an RFC 8142 sequence, or one feature per line
@@ -98,6 +100,19 @@ def _ring_texts(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> tuple[me
         open_[0] = 1
         open_[1:] = close[:-1] + 2  # after "],"
     return memoryview(text), open_[first].tolist(), (close[last] + 1).tolist()
+
+
+def ring_list(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> list[bytes]:
+    """Closed rings as JSON texts ``[x,y],...,[x,y]``, one per ring, in one orjson call.
+
+    Ring k is ``xy[first[k]:last[k] + 1]`` and the rings follow each other. A row of NaN
+    (written ``[null,null]``) between two rings marks where the text is cut.
+    """
+    if not len(first):
+        return []
+    marked = np.insert(np.ascontiguousarray(xy, dtype=np.float64), last[:-1] + 1, np.nan, axis=0)
+    text = orjson.dumps(marked, option=_OPT_NUMPY)
+    return text[1:-1].split(_RING_BREAK)
 
 
 def closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -185,23 +200,99 @@ def property_renames(names: list[str]) -> dict[str, str]:
     return renames
 
 
-def _properties_writer(diagram, points) -> Callable[[int], bytes]:
+def json_texts(values) -> list[bytes]:
+    """The JSON text of each of a list of JSON-ready values, serialized in one orjson call.
+
+    The list is written as one JSON array and cut at the commas between its values
+    (the commas outside strings; a quote escaped as ``\\"`` does not end a string).
+    Values that hold commas of their own (lists, objects) are written one by one.
+
+    >>> json_texts([1, None, "a, \\"b\\"", 2.5])
+    [b'1', b'null', b'"a, \\\\"b\\\\""', b'2.5']
+    """
+    if not len(values):
+        return []
+    text = orjson.dumps(values, option=_OPT_NUMPY)[1:-1]
+    if b'"' not in text:
+        parts = text.split(b",")
+        if len(parts) == len(values):
+            return parts
+    else:
+        # "\\" is an escaped backslash: blank it out, and a quote after a backslash is escaped
+        raw = np.frombuffer(text.replace(b"\\\\", b"__") if b"\\" in text else text, np.uint8)
+        quote = raw == ord('"')
+        quote[1:] &= raw[:-1] != ord("\\")
+        # a comma with an even number of quotes before it lies between two values
+        outside = (np.cumsum(quote, dtype=np.int64) & 1) == 0
+        cuts = np.flatnonzero((raw == ord(",")) & outside)
+        if len(cuts) == len(values) - 1:
+            starts = [0, *(cuts + 1).tolist()]
+            stops = [*cuts.tolist(), len(text)]
+            return [text[a:b] for a, b in zip(starts, stops)]
+    return [orjson.dumps(v, option=_OPT_NUMPY) for v in values]
+
+
+def _string_contents(values) -> list[bytes] | None:
+    """The UTF-8 text of each of a list of strings that JSON writes between quotes as they are
+    (no quote, backslash or control character), in one orjson call; None for other lists."""
+    if not len(values) or type(values[0]) is not str:
+        return None
+    text = orjson.dumps(values)
+    if b"\\" in text:
+        return None
+    parts = text[2:-2].split(b'","')
+    return parts if len(parts) == len(values) else None
+
+
+class _Properties:
+    """The JSON text of the features' properties: row by row, or in bulk for a run of rows."""
+
+    def __init__(self, diagram, points):
+        self.duplicates = diagram.duplicates()
+        self.columns: list = []
+        self.records = None
+        renames: dict[str, str] = {}
+        if points is not None:
+            if len(points) != diagram.n_sites:
+                raise TvoronoiError(
+                    f"the point set has {len(points)} rows but the diagram has {diagram.n_sites} sites; "
+                    f"pass the points the diagram was built from"
+                )
+            renames = property_renames(points.property_names)
+            if points.records is not None:
+                self.records = points.records
+            else:
+                self.columns = [(renames.get(name, name), values) for name, values in points.columns.items()]
+        self.row = _properties_writer(self.duplicates, self.columns, self.records, renames)
+        self.repeated = np.array(sorted(self.duplicates), np.int64)
+        # a feature whose ring is the %b and whose properties follow: "site" and the columns
+        self.columns = [(b",%b:" % orjson.dumps(name).replace(b"%", b"%%"), values) for name, values in self.columns]
+        # a feature whose ring is the first %b, then "site" and the columns (see ring_features)
+        self.ring_feature = _POLYGON.replace(b"%b}", b"") + b'{"site":%d'
+
+    def bulk(self, a: int, b: int) -> bool:
+        """Whether rows a..b-1 can be written by :meth:`ring_features` (table columns, no repeats)."""
+        repeats = np.searchsorted(self.repeated, [a, b])
+        return self.records is None and repeats[0] == repeats[1]
+
+    def ring_features(self, rings: list, a: int, b: int) -> list[bytes]:
+        """The features of rows a..b-1, each with its ring, the column values serialized in bulk."""
+        texts, keys = [], []
+        try:
+            for key, values in self.columns:
+                chunk = values[a:b]
+                contents = _string_contents(chunk)
+                texts.append(json_texts(chunk) if contents is None else contents)
+                keys.append(key + (b"%b" if contents is None else b'"%b"'))
+        except orjson.JSONEncodeError:
+            # the message names the row: written one by one
+            return [_POLYGON % (ring, self.row(i)) for ring, i in zip(rings, range(a, b))]
+        template = self.ring_feature + b"".join(keys) + b"}}"
+        return [template % args for args in zip(rings, range(a, b), *texts)]
+
+
+def _properties_writer(duplicates, columns, records, renames) -> Callable[[int], bytes]:
     """A function of a row giving the JSON text of its feature's properties."""
-    duplicates = diagram.duplicates()
-    columns: list = []
-    records = None
-    renames: dict[str, str] = {}
-    if points is not None:
-        if len(points) != diagram.n_sites:
-            raise TvoronoiError(
-                f"the point set has {len(points)} rows but the diagram has {diagram.n_sites} sites; "
-                f"pass the points the diagram was built from"
-            )
-        renames = property_renames(points.property_names)
-        if points.records is not None:
-            records = points.records
-        else:
-            columns = [(renames.get(name, name), values) for name, values in points.columns.items()]
 
     def properties(i: int) -> bytes:
         repeats = duplicates.get(i)
@@ -288,7 +379,8 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     OSError
         If writing fails (an existing file at ``out`` is then left untouched).
     """
-    properties = _properties_writer(diagram, points)
+    props = _Properties(diagram, points)
+    properties = props.row
     n_sites = diagram.n_sites
     rows = np.arange(n_sites)
     distinct = diagram.site_of == rows
@@ -305,6 +397,14 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
             xy, first, last = closed_rings(diagram, a, b, keep)
+            if b - a == len(first) and props.bulk(a, b):
+                # every row of the chunk is a distinct site with a ring: in bulk
+                features = props.ring_features(ring_list(_rounded(xy, precision), first, last), a, b)
+                frame.write(features)
+                done += len(features)
+                if progress is not None:
+                    progress(done, total)
+                continue
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
             cut = iter(cut_geometries(diagram, rows[a:b][has_cut[a:b]], precision) if has_cut[a:b].any() else ())

@@ -14,6 +14,10 @@ __all__ = ["write_cells_parquet", "write_delaunay_parquet", "require_pyarrow", "
 GEOPARQUET_VERSION = "1.1.0"
 # bytes before the points of a one-ring polygon's WKB: byte order, type, ring count, point count
 WKB_HEADER = 13
+# cells per row group of a GeoParquet file: a row group's polygons are laid out at a time
+ROW_GROUP = 1 << 17
+# polygons laid out per numpy pass (bounds the temporary masks to a few megabytes)
+WKB_CHUNK = 1 << 15
 INSTALL_HINT = "pip install 'tvoronoi[parquet]' (or pip install pyarrow pyproj)"
 # OGC:CRS84, lon/lat on WGS 84, as the GeoParquet specification spells it
 CRS84_PROJJSON = {
@@ -142,18 +146,20 @@ def _wkb_polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray):
     np.cumsum(sizes, out=offsets[1:])
     total = int(offsets[-1])
     data = np.empty(total, np.uint8)
-    header = np.empty((len(counts), WKB_HEADER), np.uint8)
-    header[:, :9] = np.frombuffer(b"\x01\x03\x00\x00\x00\x01\x00\x00\x00", np.uint8)
-    header[:, 9:] = counts.astype("<u4").view(np.uint8).reshape(-1, 4)
-    positions = (offsets[:-1, None] + np.arange(WKB_HEADER)).ravel()
-    data[positions] = header.ravel()
-    del header
-    # every byte that is not a header's holds the points, in order
-    in_points = np.ones(total, bool)
-    in_points[positions] = False
-    del positions
-    data[in_points] = np.ascontiguousarray(xy, "<f8").view(np.uint8).ravel()
-    del in_points
+    points = np.ascontiguousarray(xy, "<f8").view(np.uint8).ravel()
+    # a run of polygons at a time: the masks below stay a few megabytes
+    for a in range(0, len(counts), WKB_CHUNK):
+        b = min(a + WKB_CHUNK, len(counts))
+        chunk = data[offsets[a] : offsets[b]]
+        header = np.empty((b - a, WKB_HEADER), np.uint8)
+        header[:, :9] = np.frombuffer(b"\x01\x03\x00\x00\x00\x01\x00\x00\x00", np.uint8)
+        header[:, 9:] = counts[a:b].astype("<u4").view(np.uint8).reshape(-1, 4)
+        positions = ((offsets[a:b] - offsets[a])[:, None] + np.arange(WKB_HEADER)).ravel()
+        chunk[positions] = header.ravel()
+        # every byte that is not a header's holds the points, in order
+        in_points = np.ones(len(chunk), bool)
+        in_points[positions] = False
+        chunk[in_points] = points[16 * ring_offsets[a] : 16 * ring_offsets[b]]
     kind, index = (pa.binary(), np.int32) if total < 2**31 else (pa.large_binary(), np.int64)
     return pa.Array.from_buffers(kind, len(counts), [None, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)])
 
@@ -173,9 +179,10 @@ def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray)
         starts = ring_offsets[:-1]
         mins[present] = np.minimum.reduceat(xy, starts, axis=0)
         maxs[present] = np.maximum.reduceat(xy, starts, axis=0)
-    mask = ~present
+    mask = None if present.all() else ~present
     bbox = pa.StructArray.from_arrays(
-        [pa.array(v, pa.float64(), mask=mask) for v in (mins[:, 0], mins[:, 1], maxs[:, 0], maxs[:, 1])],
+        [pa.array(np.ascontiguousarray(v), pa.float64(), mask=mask)
+         for v in (mins[:, 0], mins[:, 1], maxs[:, 0], maxs[:, 1])],
         names=["xmin", "ymin", "xmax", "ymax"],
     )
     extent = None
@@ -199,6 +206,15 @@ def _shapely_cells(pa, geoms: np.ndarray):
     names = {shapely.GeometryType.POLYGON: "Polygon", shapely.GeometryType.MULTIPOLYGON: "MultiPolygon"}
     types = sorted({names[int(t)] for t in np.unique(shapely.get_type_id(geoms[present]))})
     return wkb, bbox, extent, types
+
+
+def _duplicates_column(pa, diagram, kept: np.ndarray):
+    """The later rows at each kept site's place (list of int64), null where the site does not repeat."""
+    repeats = diagram.duplicates()
+    kind = pa.list_(pa.int64())
+    if not repeats:
+        return pa.nulls(len(kept), kind)
+    return pa.array([repeats.get(i) for i in kept.tolist()], kind)
 
 
 def _write(pa, table, out, overwrite: bool) -> None:
@@ -239,13 +255,6 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     distinct = diagram.site_of == rows
     has_ring = distinct & (np.diff(diagram.cell_offsets) >= MIN_RING_POINTS)
     types = ["Polygon"]
-    if getattr(diagram, "clipped", None) is not None:
-        # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
-        geometry, bbox, extent, types = _shapely_cells(pa, diagram.clipped[distinct])
-    else:
-        xy, first, last = closed_rings(diagram, 0, n_sites, has_ring)
-        ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
-        geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(xy), ring_offsets, has_ring[distinct])
     kept = rows[distinct]
     columns = {"site": pa.array(kept, pa.int64())}
     if points is not None:
@@ -262,13 +271,56 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
                 values = points.columns[name]
                 values = values if len(kept) == n_sites else [values[i] for i in kept.tolist()]
             columns[renames.get(name, name)] = _typed_column(pa, values)
-    repeats = diagram.duplicates()
-    columns["duplicates"] = pa.array([repeats.get(i) for i in kept.tolist()], pa.list_(pa.int64()))
-    columns["geometry"] = geometry
-    columns["bbox"] = bbox
-    table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, types, crs)})
-    _write(pa, table, out, overwrite)
+    columns["duplicates"] = _duplicates_column(pa, diagram, kept)
+    if getattr(diagram, "clipped", None) is not None:
+        # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
+        geometry, bbox, extent, types = _shapely_cells(pa, diagram.clipped[distinct])
+        columns["geometry"] = geometry
+        columns["bbox"] = bbox
+        table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, types, crs)})
+        _write(pa, table, out, overwrite)
+        return len(kept)
+    # the polygons a row group at a time: no whole copy of the rings or of their WKB
+    present = has_ring[distinct]
+    schema = pa.schema([pa.field(name, column.type) for name, column in columns.items()]
+                       + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))])
+    schema = schema.with_metadata({b"geo": _geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
+    import pyarrow.parquet as pq
+
+    with open_output(out, overwrite=overwrite) as stream:
+        with pq.ParquetWriter(pa.PythonFile(stream, mode="w"), schema, compression="zstd") as writer:
+            for a in range(0, max(len(kept), 1), ROW_GROUP):
+                b = min(a + ROW_GROUP, len(kept))
+                if a == b:
+                    writer.write_table(schema.empty_table())
+                    break
+                # rows ra..rb-1 hold the kept rows a..b-1 and the repeats between them (no ring)
+                ra, rb = int(kept[a]), int(kept[b - 1]) + 1
+                xy, first, last = closed_rings(diagram, ra, rb, has_ring[ra:rb])
+                ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
+                geometry, bbox, _ = _polygons(pa, xy, ring_offsets, present[a:b])
+                del xy
+                group = {name: column.slice(a, b - a) for name, column in columns.items()}
+                group["geometry"], group["bbox"] = geometry, bbox
+                writer.write_table(pa.table(group, schema=schema))
     return len(kept)
+
+
+def _BBOX_TYPE(pa):
+    return pa.struct([pa.field(k, pa.float64()) for k in ("xmin", "ymin", "xmax", "ymax")])
+
+
+def _rings_extent(diagram, has_ring: np.ndarray) -> list[float] | None:
+    """(xmin, ymin, xmax, ymax) of the cells written from their rings; None when there is none."""
+    offsets = diagram.cell_offsets
+    lengths = np.diff(offsets)
+    ring = diagram.cell_vertices[np.repeat(has_ring, lengths)] if not has_ring.all() else diagram.cell_vertices
+    if not len(ring):
+        return None
+    used = np.zeros(len(diagram.cell_points), bool)
+    used[ring] = True
+    xy = diagram.cell_points[used]
+    return [*xy.min(axis=0).tolist(), *xy.max(axis=0).tolist()]
 
 
 def write_delaunay_parquet(diagram, out, *, overwrite: bool = True, crs=None) -> int:
