@@ -96,23 +96,23 @@ def test_spiky_coastlines_are_tiled(rng, region, grid, monkeypatch):
 
 @pytest.mark.parametrize("spikes", [0, 200])
 def test_local_pieces_give_the_whole_intersection(rng, spikes):
-    """Each cell cut against its piece of the outline is the cell cut against the whole outline:
-    exactly when no edge is longer than the pieces' reach, up to rounding where long edges (the
-    spikes) were split for every cell alike."""
+    """Each cell cut against its piece of the outline is the cell cut against the whole outline (with its
+    long edges split, as for every cell alike): exactly; and against the outline as given, up to rounding
+    where long edges (the spikes) were split."""
     region = coastline(1500, spikes=spikes, seed=6)
     xmin, ymin, xmax, ymax = region.bounds
     d = tvoronoi.voronoi(rng.uniform([xmin, ymin], [xmax, ymax], (3000, 2)), bbox=region_box(region))
     cells = cell_polygons(d)
     cells = cells[~shapely.contains_properly(region, cells)]
     local = local_intersection(cells, region)
-    whole = shapely.intersection(cells, region)
+    split, _ = region_module._short_edged(region)
     assert len(cells) > 100
-    same = shapely.equals_exact(shapely.normalize(local), shapely.normalize(whole), 0)
-    if spikes == 0:
-        assert same.all()
-    else:
+    assert shapely.equals_exact(shapely.normalize(local), shapely.normalize(shapely.intersection(cells, split)), 0).all()
+    whole = shapely.intersection(cells, region)
+    if spikes:
+        same = shapely.equals_exact(shapely.normalize(local), shapely.normalize(whole), 0)
         assert not same.all(), "the long spike edges were split"
-        assert (shapely.area(shapely.symmetric_difference(local, whole)) <= 1e-12 * shapely.area(cells)).all()
+    assert (shapely.area(shapely.symmetric_difference(local, whole)) <= 1e-12 * shapely.area(cells)).all()
     assert shapely.coverage_is_valid(local[shapely.area(local) > 0])
 
 
@@ -306,3 +306,23 @@ def test_batch_clip_missing_file(tmp_path, capsys):
     src.write_text("x,y\n0.5,0.5\n")
     status = cli.main(["batch", str(src), "-o", "-", "--clip", str(tmp_path / "nope.geojson")])
     assert status == 2 and "--clip" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("spikes", [0, 200])
+def test_a_cells_cut_depends_on_it_and_the_region_alone(rng, spikes):
+    """The cut of a crossing cell is the same, to the bit, whether it is cut among all the cells or among
+    any subset (as the tiles of a distributed build cut theirs): the outline's long edges are split by a
+    length of its own, and the pieces only choose where each cut runs."""
+    from tvoronoi.region import cut_polygons
+
+    region = coastline(1500, spikes=spikes, seed=7)
+    xmin, ymin, xmax, ymax = region.bounds
+    d = tvoronoi.voronoi(rng.uniform([xmin, ymin], [xmax, ymax], (4000, 2)), bbox=region_box(region))
+    cells = cell_polygons(d)
+    whole, reshaped = cut_polygons(cells, region)
+    assert reshaped.sum() > 100
+    areas = shapely.area(cells)
+    for part in (np.flatnonzero(rng.random(len(cells)) < 0.3), np.arange(len(cells) // 2),
+                 np.flatnonzero(reshaped)[:9], np.flatnonzero(areas < np.nanmedian(areas))):
+        sub, _ = cut_polygons(cells[part], region)
+        assert (shapely.to_wkb(sub) == shapely.to_wkb(whole[part])).all()

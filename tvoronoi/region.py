@@ -27,6 +27,9 @@ LOCAL_MIN_CELLS = 8
 # the margin of the pieces' boxes: 1.5 times the size of the largest cell of a tier; a tier holds
 # cells whose sizes (the larger side of their bounds) are within this factor, from the median size
 TIER_RATIO = 2.0
+# an outline's edges longer than this many times its median edge (a coast's spikes) are split before
+# the cut, so that pieces need not reach far beyond their cells
+EDGE_SPLIT = 4.0
 # a piece's box reaches this fraction beyond the edges it must hold whole, so that the cut (its new
 # vertices, rounded) stays clear of them
 PIECE_BOX_GROWTH = 0.01
@@ -246,14 +249,15 @@ def _cut_cells(diagram: Diagram, region, grid: _Grid | None = None) -> tuple[np.
     """Each cell cut to the region: (clipped, reshaped) as in ClippedDiagram."""
     from tvoronoi.shapes import cell_polygons
 
-    return cut_polygons(cell_polygons(diagram), region)
+    return cut_polygons(cell_polygons(diagram), region, grid)
 
 
-def cut_polygons(cells: np.ndarray, region) -> tuple[np.ndarray, np.ndarray]:
+def cut_polygons(cells: np.ndarray, region, grid: _Grid | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Cells (shapely Polygons, None for no cell) cut to the region: (clipped, reshaped) as in ClippedDiagram.
 
-    A cell inside the region is kept as it is, so the cut depends on the cell alone: tiles on a cluster
-    (tvoronoi.distributed) cut their cells to the same geometries as one process.
+    A cell inside the region is kept as it is, and a crossing cell's cut depends on that cell and the
+    region alone, never on the other cells: tiles on a cluster (tvoronoi.distributed) cut their cells
+    to the same geometries as one process. ``grid`` (a _Grid of the region) only makes it faster.
     """
     import shapely
 
@@ -308,18 +312,20 @@ def local_intersection(cells: np.ndarray, region) -> np.ndarray:
     """
     import shapely
 
-    if shapely.get_num_coordinates(region) <= PIECE_VERTICES or len(cells) < LOCAL_MIN_CELLS:
+    if shapely.get_num_coordinates(region) <= PIECE_VERTICES:
+        return shapely.intersection(cells, region)
+    # the outline's long edges split by a length of its own (never one taken from the cells, so that
+    # any subset of cells is cut as in the whole set): the pieces' reach
+    region, reach = _short_edged(region)
+    if len(cells) < LOCAL_MIN_CELLS:
         return shapely.intersection(cells, region)
     bounds = shapely.bounds(cells)
     sizes = np.maximum(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1])
     # cells in tiers of similar sizes (a factor TIER_RATIO apart), each tier with a margin a little
-    # above its largest cell
+    # above its largest cell: which piece a cell is cut against, not what the cut gives
     tier = np.floor(np.log(np.maximum(sizes / np.median(sizes), 1.0)) / np.log(TIER_RATIO)).astype(np.int64)
     tiers = [np.flatnonzero(tier == k) for k in np.unique(tier).tolist()]
     margins = [1.5 * float(sizes[rows].max()) for rows in tiers]
-    reach = margins[0]
-    if _longest_edge(region) > reach:
-        region = shapely.segmentize(region, reach)
     out = np.empty(len(cells), dtype=object)
     for rows, margin in zip(tiers, margins):
         out[rows] = _cut_locally(cells[rows], bounds[rows], region, margin, reach)
@@ -364,15 +370,30 @@ def _cut_locally(cells: np.ndarray, bounds: np.ndarray, region, margin: float, r
     return out
 
 
-def _longest_edge(region) -> float:
-    """The largest extent (the larger side of its bounds) of an edge of the region's rings."""
+def _edge_extents(region) -> np.ndarray:
+    """The extent (the larger side of its bounds) of each edge of the region's rings."""
     import shapely
 
     rings = shapely.get_rings(shapely.get_parts(region))
     coords, index = shapely.get_coordinates(rings, return_index=True)
     same_ring = index[1:] == index[:-1]
-    extent = np.abs(coords[1:] - coords[:-1])[same_ring]
-    return float(extent.max()) if len(extent) else 0.0
+    return np.abs(coords[1:] - coords[:-1])[same_ring].max(axis=1)
+
+
+def _short_edged(region):
+    """(region, reach): the region with its edges longer than EDGE_SPLIT times its median edge split
+    (``shapely.segmentize``), and its longest edge's extent then. A function of the region alone."""
+    import shapely
+
+    extents = _edge_extents(region)
+    if len(extents) == 0:
+        return region, 0.0
+    longest, length = float(extents.max()), EDGE_SPLIT * float(np.median(extents))
+    if length > 0 and longest > length:
+        region = shapely.segmentize(region, length)
+        extents = _edge_extents(region)
+        longest = float(extents.max())
+    return region, longest
 
 
 def _polygonal(geoms: np.ndarray) -> np.ndarray:
