@@ -4,7 +4,8 @@ Fortune: the sweep line, the beach line's arcs, pending circle events,
 growing edges, the event just handled, the sites not reached yet; the cells
 behind the beach line (which are final) are filled. Incremental: the diagram
 of the sites inserted so far, the new site, its conflict region and the cells
-it took area from.
+it took area from, and the location walk that found it (the triangles
+visited, and the hull edge it ended beyond when the site lies outside).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from tvoronoi.tui.raster import (
     SPARSE_SITES_PER_CHAR,
     SWEEP,
     TINTED,
+    WALK,
     Painter,
     Scene,
     View,
@@ -63,6 +65,21 @@ def _triangle_segments(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     a = points[triangles.ravel()]
     b = points[triangles[:, [1, 2, 0]].ravel()]
     return np.hstack([a, b]) if len(a) else _empty_segments()
+
+
+def walk_segments(points: np.ndarray, walk: np.ndarray) -> np.ndarray:
+    """The sides of the triangles a location walk visited (w, 3 point rows, -1 at infinity), each
+    once: the finite triangles whole, of an infinite one its finite side (the hull edge)."""
+    walk = np.asarray(walk, np.int64).reshape(-1, 3)
+    if not len(walk):
+        return _empty_segments()
+    a, b = walk.ravel(), walk[:, [1, 2, 0]].ravel()
+    keep = (a >= 0) & (b >= 0)
+    a, b = a[keep], b[keep]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    _, first = np.unique(lo * len(points) + hi, return_index=True)
+    first = np.sort(first)
+    return np.hstack([points[a[first]], points[b[first]]])
 
 
 def _inside_triangles(xs: np.ndarray, ys: np.ndarray, corners: np.ndarray) -> np.ndarray:
@@ -250,11 +267,13 @@ class IncrementalOverlay:
     new_edges: np.ndarray       # (e, 4) Delaunay edges of the new triangles
     stolen_rows: np.ndarray     # rows of scene.sites whose cells lost area
     bbox: tuple
+    walk: np.ndarray = dataclasses.field(default_factory=_empty_segments)  # (w, 4) sides visited
 
     def draw(self, paint: Painter) -> None:
         sparse = per_char(len(self.points), self, paint.view) < SPARSE_SITES_PER_CHAR
         paint.points(FUTURE, self.future, block=sparse)
         paint.segments(GROWING, self.new_edges, dash=DASH)
+        paint.segments(WALK, self.walk)
         corners = self.conflict
         if len(corners):
             sides = np.concatenate([np.hstack([corners[:, k], corners[:, (k + 1) % 3]]) for k in range(3)])
@@ -354,6 +373,7 @@ def incremental_picture(step, points: np.ndarray, colours: np.ndarray) -> tuple[
         new_edges=_triangle_segments(points, new_tri),
         stolen_rows=np.flatnonzero(np.isin(rows, step.stolen_from)),
         bbox=full.bbox,
+        walk=walk_segments(points, step.walk),
     )
     return scene, overlay
 

@@ -22,9 +22,9 @@ from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, braille_text, pack_braille, po
 # GROWING, CONFLICT, CIRCLE, BEACH, SWEEP and EVENT belong to algorithm playback,
 # CURSOR to editing: the lowest, so that a site or edge under the keyboard cursor
 # keeps its colour (the cursor's characters are lit up by their fill instead).
-(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, CONFLICT, CIRCLE, BEACH, SWEEP,
- VERTEX, SITE, EVENT) = range(13)
-N_MARKS = 13
+(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, WALK, CONFLICT, CIRCLE, BEACH, SWEEP,
+ VERTEX, SITE, EVENT) = range(14)
+N_MARKS = 14
 # Fills: -1 none, 0 .. N_FILLS - 1 the cell colours, TINTED + c the tinted
 # colour c, CONFLICT_FILL the inside of a conflict region, HIGHLIGHTED + c the
 # colour c under the keyboard cursor.
@@ -475,6 +475,7 @@ def style_table(palette: Palette) -> tuple[Style, ...]:
         DELAUNAY: (palette.delaunay, False),
         EDGE: (palette.edge, True),
         GROWING: (palette.growing, True),
+        WALK: (palette.walk, True),
         CONFLICT: (palette.conflict, True),
         CIRCLE: (palette.circle, False),
         BEACH: (palette.beach, True),
