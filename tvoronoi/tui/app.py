@@ -526,8 +526,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self.drop_editing()
 
     def _diagram_shown(self) -> None:
-        """A new whole diagram is on screen: make it ready for editing."""
+        """A new whole diagram is on screen: make it ready for editing; a file's ambiguous columns
+        are asked about."""
         self.prepare_editing()
+        self.offer_columns()
 
     def action_help(self) -> None:
         """List every key."""

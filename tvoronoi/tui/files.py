@@ -12,7 +12,7 @@ from textual.widgets import ProgressBar
 import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.colours import palette_for
-from tvoronoi.tui.screens import OpenDialog, OpenRequest, PathDialog
+from tvoronoi.tui.screens import ColumnsDialog, OpenDialog, OpenRequest, PathDialog
 
 DEFAULT_SAVE_NAME = "cells.geojson"
 DEFAULT_EXPORT_NAME = "view.svg"
@@ -61,8 +61,11 @@ class FilesMixin:
     _saving = False
     # the last export's path, offered again
     _last_export: str = DEFAULT_EXPORT_NAME
-    # the last file asked for, to offer it again
+    # the last file asked for, to offer it again, and its folder, where the Open dialog's tree starts
     _last_open: OpenRequest | None = None
+    _last_folder: Path | None = None
+    # a file opened without x and y columns given: once read, ask which columns if that was ambiguous
+    _columns_pending: OpenRequest | None = None
 
     def action_open(self) -> None:
         """Ask for a point file and show its diagram."""
@@ -72,6 +75,7 @@ class FilesMixin:
                 "Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv",
                 value="" if last is None else str(last.path),
                 x=None if last is None else last.x, y=None if last is None else last.y,
+                folder=self._last_folder,
             ),
             self._open_path,
         )
@@ -81,6 +85,10 @@ class FilesMixin:
         if request is None:
             return
         self._last_open = request
+        folder = request.path.expanduser().parent
+        if folder.is_dir():
+            self._last_folder = folder.resolve()
+        self._columns_pending = request if request.x is None and request.y is None else None
 
         def read():
             from tvoronoi.readers import read_points
@@ -91,6 +99,23 @@ class FilesMixin:
                 raise ReadFailed(ui_advice(str(exc))) from exc
 
         self._request_build(lambda: None, source=request.path.name, size=None, read=read)
+
+    def offer_columns(self) -> None:
+        """A file was just shown: if its x and y columns were taken by position among several
+        numeric ones, ask which columns are x and y (the reader's choice stays unless changed)."""
+        request, self._columns_pending = self._columns_pending, None
+        built = self.built
+        point_set = None if built is None else built.point_set
+        if request is None or point_set is None or not getattr(point_set, "candidates", ()):
+            return
+        chosen = point_set.xy_columns
+
+        def chosen_columns(columns: tuple[str, str] | None) -> None:
+            self.canvas.focus()
+            if columns is not None and tuple(columns) != tuple(chosen):
+                self._open_path(OpenRequest(request.path, *columns))
+
+        self.push_screen(ColumnsDialog(request.path.name, point_set.candidates, chosen), chosen_columns)
 
     def action_save(self) -> None:
         """Ask for a path and write the cells there as GeoJSON."""
