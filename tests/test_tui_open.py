@@ -1,6 +1,8 @@
 """The Open dialog browses (a directory tree, path completion, the last folder remembered) and asks
 which columns are x and y when a table leaves that ambiguous."""
 
+from pathlib import Path
+
 import numpy as np
 from textual.widgets import Button, DirectoryTree, Input, Select
 
@@ -145,3 +147,35 @@ async def test_the_same_column_twice_is_refused_in_the_dialog(tmp_path):
         assert app.screen is dialog
         assert "must differ" in str(dialog.query_one("#dialog-hint").render())
 
+
+
+DATA = Path(__file__).resolve().parent.parent / "data"
+
+
+def test_snapshot_open_dialog_browsing_at_80x24(snap_compare):
+    """80 x 24, the Open dialog after a file of data/ was opened: the path field (completion
+    offered as typed), below it the directory tree of data/ (folders and point files only),
+    the x and y column fields and the hint, all within the terminal."""
+
+    async def open_dialog(pilot):
+        pilot.app._last_folder = DATA
+        await pilot.press("o")
+        tree = pilot.app.screen.query_one(DirectoryTree)
+        for _ in range(50):
+            await pilot.pause(0.02)
+            if tree.root.children:
+                break
+
+    assert snap_compare(make_app(), run_before=open_dialog, terminal_size=(80, 24))
+
+
+def test_snapshot_columns_dialog(snap_compare, tmp_path):
+    """A table of three numeric columns named neither x/y nor lon/lat, just opened: the dialog
+    says which two were taken and offers each column for x and for y, with a Use button."""
+    path = tmp_path / "table.csv"
+    path.write_text(AMBIGUOUS)
+
+    async def open_table(pilot):
+        await open_file(pilot.app, pilot, path)
+
+    assert snap_compare(make_app(), run_before=open_table, terminal_size=SIZE)
