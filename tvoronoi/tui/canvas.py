@@ -20,6 +20,7 @@ from tvoronoi.tui.follow import follow_view
 from tvoronoi.tui.raster import (
     CURSOR_ARM,
     Frame,
+    LayerCache,
     Scene,
     View,
     frame_lines,
@@ -133,6 +134,8 @@ class DiagramCanvas(Widget, can_focus=True):
         self._frame_key: tuple | None = None
         self._lines: list[list[Segment]] = []
         self._frame: Frame | None = None
+        # the diagram's layers of the last frame, for a frame that differs only in others
+        self._layers = LayerCache()
         self._base_key: tuple | None = None
         self._frame_version = 0
         self._frame_cursor: tuple[float, float] | None = None
@@ -375,7 +378,7 @@ class DiagramCanvas(Widget, can_focus=True):
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
-                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled,
+                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled, layers=self._layers,
             )
             self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base

@@ -327,8 +327,9 @@ class Painter:
     layer with a dot in it.
     """
 
-    def __init__(self, view: View, cols: int, rows: int) -> None:
+    def __init__(self, view: View, cols: int, rows: int, cache: "LayerCache | None" = None) -> None:
         self.view, self.cols, self.rows = view, cols, rows
+        self.cache = cache
         self.shape = (rows * DOT_ROWS, cols * DOT_COLS)
         self.codes = np.zeros((rows, cols), np.uint8)
         self.mark = np.zeros((rows, cols), np.uint8)
@@ -353,35 +354,54 @@ class Painter:
     def new_dots(self) -> np.ndarray:
         return np.zeros(self.shape, bool)
 
-    def lay(self, layer: int, dots: np.ndarray) -> None:
-        """Merge a layer's dots into the frame."""
+    def lay(self, layer: int, dots: np.ndarray) -> np.ndarray:
+        """Merge a layer's dots into the frame; returns their bit patterns per character."""
         packed = pack_braille(dots)
+        self.lay_packed(layer, packed)
+        return packed
+
+    def lay_packed(self, layer: int, packed: np.ndarray) -> None:
+        """Merge a layer's bit patterns (rows, cols) into the frame."""
         self.codes |= packed
         np.maximum(self.mark, np.where(packed != 0, np.uint8(layer), np.uint8(0)), out=self.mark)
+
+    def from_cache(self, layer: int, key) -> bool:
+        """Lay a layer drawn before for this key (see ``LayerCache``); False if there is none."""
+        packed = None if self.cache is None or key is None else self.cache.get(key, self)
+        if packed is None:
+            return False
+        self.lay_packed(layer, packed)
+        return True
+
+    def _keep(self, key, packed: np.ndarray) -> None:
+        if self.cache is not None and key is not None:
+            self.cache.put(key, self, packed)
 
     def to_dots(self, xs, ys):
         return self.view.to_dots(xs, ys, self.cols, self.rows)
 
-    def segments(self, layer: int, seg: np.ndarray, *, dash: int = 0) -> None:
-        """World segments (k, 4) as x0, y0, x1, y1."""
+    def segments(self, layer: int, seg: np.ndarray, *, dash: int = 0, key=None) -> None:
+        """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache."""
+        if self.from_cache(layer, key):
+            return
         seg = self._visible_segments(np.asarray(seg, np.float64).reshape(-1, 4))
-        if not len(seg):
-            return
         dots = self.new_dots()
-        u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
-        u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
-        segment_dots(dots, u0, v0, u1, v1, dash=dash)
-        self.lay(layer, dots)
+        if len(seg):
+            u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
+            u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
+            segment_dots(dots, u0, v0, u1, v1, dash=dash)
+        self._keep(key, self.lay(layer, dots))
 
-    def points(self, layer: int, xy: np.ndarray, *, block: bool = False) -> None:
-        """World points (k, 2)."""
-        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
-        if not len(xy):
+    def points(self, layer: int, xy: np.ndarray, *, block: bool = False, key=None) -> None:
+        """World points (k, 2); ``key`` names them for the layer cache."""
+        if self.from_cache(layer, key):
             return
+        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
         dots = self.new_dots()
-        u, v = self.to_dots(xy[:, 0], xy[:, 1])
-        point_dots(dots, u, v, block=block)
-        self.lay(layer, dots)
+        if len(xy):
+            u, v = self.to_dots(xy[:, 0], xy[:, 1])
+            point_dots(dots, u, v, block=block)
+        self._keep(key, self.lay(layer, dots))
 
     def cross(self, layer: int, x: float, y: float) -> np.ndarray:
         """A small cross centred on the world point (x, y); the (rows, cols) mask of its characters."""
@@ -392,6 +412,40 @@ class Painter:
                      [v, v + CURSOR_ARM + 1])
         self.lay(layer, dots)
         return pack_braille(dots) != 0
+
+
+class LayerCache:
+    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last frames, as bit
+    patterns per character, so that a frame that differs only in another layer (Delaunay shown or
+    hidden, vertices, an overlay) does not draw them again.
+
+    An entry holds its scene (so its id cannot be reused while the entry lives) and is found only
+    for the same scene, version, view and size; ``rasterize`` keeps the entries the last frame used.
+    """
+
+    def __init__(self) -> None:
+        self._entries: dict = {}
+        self._used: dict = {}
+
+    def _full_key(self, key, paint: "Painter"):
+        scene, rest = key
+        return (id(scene), getattr(scene, "version", 0), paint.view, paint.cols, paint.rows, rest)
+
+    def get(self, key, paint: "Painter") -> np.ndarray | None:
+        full = self._full_key(key, paint)
+        entry = self._entries.get(full)
+        if entry is None or entry[0] is not key[0]:
+            return None
+        self._used[full] = entry
+        return entry[1]
+
+    def put(self, key, paint: "Painter", packed: np.ndarray) -> None:
+        full = self._full_key(key, paint)
+        self._entries[full] = self._used[full] = (key[0], packed)
+
+    def frame_done(self) -> None:
+        """Keep what this frame used (the previous frames' other entries go)."""
+        self._entries, self._used = self._used, {}
 
 
 def rasterize(
@@ -406,6 +460,7 @@ def rasterize(
     cursor: tuple[float, float] | None = None,
     owner: np.ndarray | None = None,
     site_blocks: bool = False,
+    layers: LayerCache | None = None,
 ) -> Frame:
     """Draw a scene into a frame of ``cols x rows`` characters.
 
@@ -414,17 +469,20 @@ def rasterize(
     ``cursor`` is a world point marked with a cross; ``owner`` is the
     ``cell_owner`` of this scene and view when the caller already has it;
     ``site_blocks`` draws every site as a block of dots (else only where
-    sites are sparse), for a picture without fills.
+    sites are sparse), for a picture without fills. ``layers``, if given, keeps the diagram's
+    layers of this frame and gives back those of the last one that are the same.
     """
-    paint = Painter(view, cols, rows)
+    paint = Painter(view, cols, rows, layers)
     if delaunay and len(scene.delaunay):
-        paint.segments(DELAUNAY, scene.delaunay)
-    paint.segments(EDGE, scene.edges)
+        paint.segments(DELAUNAY, scene.delaunay, key=(scene, "delaunay"))
+    paint.segments(EDGE, scene.edges, key=(scene, "edges"))
     if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
-        paint.points(VERTEX, scene.vertices)
+        paint.points(VERTEX, scene.vertices, key=(scene, "vertices"))
     if scene.n_sites:
         sparse = site_blocks or per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
-        paint.points(SITE, scene.sites, block=sparse)
+        paint.points(SITE, scene.sites, block=sparse, key=(scene, ("sites", sparse)))
+    if layers is not None:
+        layers.frame_done()
     if overlay is not None:
         overlay.draw(paint)
     under_cursor = None if cursor is None else paint.cross(CURSOR, *cursor)
