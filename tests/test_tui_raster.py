@@ -340,3 +340,18 @@ def test_the_layer_cache_follows_a_live_scene_edited_in_place():
     fresh = rasterize(live, view, 60, 24)
     assert np.array_equal(after.codes, fresh.codes) and np.array_equal(after.mark, fresh.mark)
     assert not np.array_equal(after.codes, before.codes)
+
+
+def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
+    """The one rings-to-sides routine: each entry's successor is the next of its ring, the last
+    going back to the first, whatever the empty rings between."""
+    from tvoronoi.tui.raster import ring_next, ring_segments
+
+    sizes = [3, 0, 1, 4, 0, 2]
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    expected = np.concatenate([np.roll(np.arange(a, b), -1) for a, b in zip(offsets[:-1], offsets[1:])])
+    assert np.array_equal(ring_next(offsets, offsets[-1]), expected)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    sides = ring_segments(square)
+    assert np.array_equal(sides[:, 2:], np.roll(square, -1, axis=0)) and np.array_equal(sides[:, :2], square)
+    assert ring_segments(square[:1]).shape == (0, 4)

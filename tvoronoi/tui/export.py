@@ -20,7 +20,7 @@ import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.colours import Palette
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-from tvoronoi.tui.raster import View
+from tvoronoi.tui.raster import View, ring_next
 
 # Pixels per braille dot of the canvas: a 120 x 40 canvas (240 x 160 dots) exports at 960 x 640.
 PX_PER_DOT = 4
@@ -98,8 +98,7 @@ def visible_cells(offsets: np.ndarray, xy: np.ndarray, window) -> np.ndarray:
     overlap = ((np.minimum.reduceat(xs, starts) <= x1) & (np.maximum.reduceat(xs, starts) >= x0)
                & (np.minimum.reduceat(ys, starts) <= y1) & (np.maximum.reduceat(ys, starts) >= y0))
     # each side: from a ring point to the next one of its ring (wrapping round)
-    nxt = np.arange(1, len(xy) + 1)
-    nxt[offsets[1:][full] - 1] = starts
+    nxt = ring_next(offsets, len(xy))
     ax, ay, bx, by = xs, ys, xs[nxt], ys[nxt]
     outside = np.ones(len(xy), bool)
     for cx, cy in ((x0, y0), (x1, y0), (x1, y1), (x0, y1)):

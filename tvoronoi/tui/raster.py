@@ -149,6 +149,26 @@ class Window:
 # ---------------------------------------------------------------------------
 # the drawable form of a diagram
 
+def ring_next(offsets: np.ndarray, size: int) -> np.ndarray:
+    """Rings stored one after the other (ring i: entries ``offsets[i]:offsets[i + 1]`` of an array
+    of ``size``): for each entry, the index of the next entry round its ring, so that the sides of
+    every ring run from entry k to entry ``ring_next(...)[k]``. The one routine that turns rings
+    into sides, for the scene, the live scene and the export."""
+    offsets = np.asarray(offsets, np.int64)
+    nxt = np.arange(1, size + 1)
+    full = np.diff(offsets) > 0
+    nxt[offsets[1:][full] - 1] = offsets[:-1][full]
+    return nxt
+
+
+def ring_segments(points: np.ndarray) -> np.ndarray:
+    """The sides of one ring of points (k, 2) as (k, 4) segments, the last back to the first."""
+    points = np.asarray(points, np.float64).reshape(-1, 2)
+    if len(points) < 2:
+        return np.empty((0, 4))
+    return np.hstack([points, points[ring_next([0, len(points)], len(points))]])
+
+
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Undirected pairs (a, b), each once, self pairs dropped."""
     a = np.asarray(a, np.int64)
@@ -221,10 +241,7 @@ class Scene:
         # every clipped cell ring, point to next point (wrapping round)
         offsets = np.asarray(diagram.cell_offsets, np.int64)
         ring = np.asarray(diagram.cell_vertices, np.int64)
-        nxt = np.arange(1, ring.size + 1)
-        sizes = np.diff(offsets)
-        full = sizes > 0
-        nxt[offsets[1:][full] - 1] = offsets[:-1][full]
+        nxt = ring_next(offsets, ring.size)
         points = np.asarray(diagram.cell_points, np.float64)
         # neighbouring cells share point indices: keep each edge once
         a, b = _unique_pairs(ring, ring[nxt] if ring.size else ring, len(points))
