@@ -124,7 +124,7 @@ def _centre_samples(a0, a1, b0, b1, own0, own1, dash: int):
     return a, b
 
 
-def _clip(u0, v0, u1, v1, width: int, height: int):
+def _clip(u0, v0, u1, v1, width: float, height: float):
     """Clip segments to [0, W) x [0, H) (Liang-Barsky, all at once); returns keep, t0, t1, u0, v0, u1, v1."""
     du, dv = u1 - u0, v1 - v0
     t0 = np.zeros_like(u0)

@@ -119,7 +119,7 @@ def picture(scene, view: View, cols: int, rows: int, palette: Palette, *, dark: 
         raise TvoronoiError("there is no diagram to export")
     colours = np.asarray(scene.colours)
     if diagram is None:
-        drawn = scene.drawn() if hasattr(scene, "drawn") else np.arange(len(scene.sites))
+        drawn = scene.drawn()
         diagram = tvoronoi.voronoi(scene.sites[drawn], bbox=scene.bbox)
         ids = np.asarray(drawn, np.int64)
     else:
@@ -141,11 +141,12 @@ def picture(scene, view: View, cols: int, rows: int, palette: Palette, *, dark: 
                 & (np.maximum(links[:, 1], links[:, 3]) >= y0) & (np.minimum(links[:, 1], links[:, 3]) <= y1))
         links = links[keep]
     has_cell = np.diff(offsets) > 0
+    xmin, ymin, xmax, ymax = diagram.bbox
     return ViewPicture(
         rings=rings, colours=ring_colours, sites=sites[shown], delaunay=links, window=window, view=view,
         cols=cols, rows=rows, palette=palette, background=BACKGROUND[dark],
         owners=sites[has_cell], owner_colours=[fills[int(colours[i]) % len(fills)] for i in ids[has_cell]],
-        bbox=tuple(float(c) for c in diagram.bbox),
+        bbox=(float(xmin), float(ymin), float(xmax), float(ymax)),
     )
 
 

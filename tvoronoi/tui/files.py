@@ -106,7 +106,7 @@ class FilesMixin:
         request, self._columns_pending = self._columns_pending, None
         built = self.built
         point_set = None if built is None else built.point_set
-        if request is None or point_set is None or not getattr(point_set, "candidates", ()):
+        if request is None or point_set is None or not point_set.candidates:
             return
         chosen = point_set.xy_columns
 

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 from rich.segment import Segment
 from rich.style import Style
 from scipy.spatial import cKDTree
@@ -146,6 +148,10 @@ class Window:
                                   self.cols, self.rows)
 
 
+# What the rasterizer draws through: a whole canvas's view, or a part of it.
+ViewLike = View | Window
+
+
 # ---------------------------------------------------------------------------
 # the drawable form of a diagram
 
@@ -166,7 +172,7 @@ def ring_segments(points: np.ndarray) -> np.ndarray:
     points = np.asarray(points, np.float64).reshape(-1, 2)
     if len(points) < 2:
         return np.empty((0, 4))
-    return np.hstack([points, points[ring_next([0, len(points)], len(points))]])
+    return np.hstack([points, points[ring_next(np.array([0, len(points)]), len(points))]])
 
 
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -178,6 +184,42 @@ def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.
     if key.size:
         key = key[np.r_[True, key[1:] != key[:-1]]]
     return key // max(n, 1), key % max(n, 1)
+
+
+class Drawable(Protocol):
+    """What the canvas draws and picks in: a ``Scene`` (a whole diagram, or some of its sites
+    during playback) or a ``LiveScene`` (a diagram edited in place).
+
+    ``version`` grows with every change made in place; ``changes_since(version)`` says which
+    sites and what world box changed since then (None: it cannot say, draw everything again),
+    and ``update_owner`` finds the owners of the characters those changes touched.
+    """
+
+    @property
+    def sites(self) -> np.ndarray: ...
+    @property
+    def edges(self) -> np.ndarray: ...
+    @property
+    def delaunay(self) -> np.ndarray: ...
+    @property
+    def vertices(self) -> np.ndarray: ...
+    @property
+    def colours(self) -> np.ndarray: ...
+    @property
+    def bbox(self) -> tuple: ...
+    @property
+    def n_sites(self) -> int: ...
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def version(self) -> int: ...
+
+    def nearest(self, points: np.ndarray) -> np.ndarray: ...
+    def site_ids(self) -> np.ndarray | None: ...
+    def site_near(self, x: float, y: float, radius: float) -> int | None: ...
+    def drawn(self) -> np.ndarray: ...
+    def changes_since(self, version: int) -> tuple[np.ndarray, tuple | None] | None: ...
+    def update_owner(self, old: np.ndarray, ids: np.ndarray, view, cols: int, rows: int) -> np.ndarray: ...
 
 
 @dataclass(eq=False)
@@ -209,6 +251,23 @@ class Scene:
     @property
     def n_sites(self) -> int:
         return len(self.sites)
+
+    @property
+    def version(self) -> int:
+        """A scene is never changed in place."""
+        return 0
+
+    def drawn(self) -> np.ndarray:
+        """Rows of ``sites`` that own a cell: all of them."""
+        return np.arange(len(self.sites))
+
+    def changes_since(self, version: int) -> None:
+        """Never changed in place: nothing to tell."""
+        return None
+
+    def update_owner(self, old: np.ndarray, ids: np.ndarray, view, cols: int, rows: int) -> np.ndarray:
+        """Never changed in place: the owners stay."""
+        return old
 
     @property
     def n_vertices(self) -> int:
@@ -299,7 +358,7 @@ class Frame:
     owner: np.ndarray
 
 
-def char_centres(view: View, cols: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
+def char_centres(view: ViewLike, cols: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
     """World x of each character column's centre (cols,) and y of each row's centre (rows,)."""
     u = (np.arange(cols) + 0.5) * DOT_COLS
     v = (np.arange(rows) + 0.5) * DOT_ROWS
@@ -308,7 +367,7 @@ def char_centres(view: View, cols: int, rows: int) -> tuple[np.ndarray, np.ndarr
     return xs, ys
 
 
-def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
+def cell_owner(scene: Drawable, view: ViewLike, cols: int, rows: int) -> np.ndarray:
     """The row of ``scene.sites`` whose cell holds each character's centre (-1 outside the box).
 
     The nearest site of the centre owns it: that is the Voronoi cell itself,
@@ -329,7 +388,7 @@ def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
     return owner
 
 
-def fill_of(scene: Scene, owner: np.ndarray) -> np.ndarray:
+def fill_of(scene: Drawable, owner: np.ndarray) -> np.ndarray:
     """The palette index of each owner (-1 stays -1)."""
     fill = np.full(owner.shape, -1, np.int16)
     inside = owner >= 0
@@ -344,7 +403,7 @@ class Painter:
     layer with a dot in it.
     """
 
-    def __init__(self, view: View, cols: int, rows: int, cache: "LayerCache | None" = None) -> None:
+    def __init__(self, view: ViewLike, cols: int, rows: int, cache: "LayerCache | None" = None) -> None:
         self.view, self.cols, self.rows = view, cols, rows
         self.cache = cache
         self.shape = (rows * DOT_ROWS, cols * DOT_COLS)
@@ -397,7 +456,7 @@ class Painter:
     def to_dots(self, xs, ys):
         return self.view.to_dots(xs, ys, self.cols, self.rows)
 
-    def segments(self, layer: int, seg: np.ndarray, *, dash: int = 0, key=None) -> None:
+    def segments(self, layer: int, seg: npt.ArrayLike, *, dash: int = 0, key=None) -> None:
         """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache."""
         if self.from_cache(layer, key):
             return
@@ -409,7 +468,7 @@ class Painter:
             segment_dots(dots, u0, v0, u1, v1, dash=dash)
         self._keep(key, self.lay(layer, dots))
 
-    def points(self, layer: int, xy: np.ndarray, *, block: bool = False, key=None) -> None:
+    def points(self, layer: int, xy: npt.ArrayLike, *, block: bool = False, key=None) -> None:
         """World points (k, 2); ``key`` names them for the layer cache."""
         if self.from_cache(layer, key):
             return
@@ -446,7 +505,7 @@ class LayerCache:
 
     def _full_key(self, key, paint: "Painter"):
         scene, rest = key
-        return (id(scene), getattr(scene, "version", 0), paint.view, paint.cols, paint.rows, rest)
+        return (id(scene), scene.version, paint.view, paint.cols, paint.rows, rest)
 
     def get(self, key, paint: "Painter") -> np.ndarray | None:
         full = self._full_key(key, paint)
@@ -466,8 +525,8 @@ class LayerCache:
 
 
 def rasterize(
-    scene: Scene,
-    view: View,
+    scene: Drawable,
+    view: ViewLike,
     cols: int,
     rows: int,
     *,
@@ -530,7 +589,7 @@ def redraw_part(frame: Frame, scene, view: View, cols: int, rows: int, span, *, 
         whole[r0:r1, c0:c1] = piece
 
 
-def per_char(count: int, scene, view: View) -> float:
+def per_char(count: int, scene, view: ViewLike) -> float:
     """About how many of ``count`` marks spread over the box share one character."""
     xmin, ymin, xmax, ymax = scene.bbox
     char_w, char_h = view.scale * DOT_COLS, view.scale * DOT_ROWS

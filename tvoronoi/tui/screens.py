@@ -56,9 +56,6 @@ class HelpScreen(ModalScreen[None]):
             box.border_subtitle = "esc to close"
             yield Static("\n".join(lines), id="help-text")
 
-    def action_dismiss(self) -> None:
-        self.dismiss(None)
-
 
 class PathDialog(ModalScreen[Path | None]):
     """Ask for a file path; dismissed with the path, or None when cancelled.
@@ -306,7 +303,7 @@ class SampleDialog(ModalScreen[str | None]):
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        self.action_choose(event.button.id)
+        self.action_choose(event.button.id or "")
 
     def action_choose(self, choice: str) -> None:
         if choice == "all" and not self.all_allowed:
