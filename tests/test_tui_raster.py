@@ -355,3 +355,24 @@ def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
     sides = ring_segments(square)
     assert np.array_equal(sides[:, 2:], np.roll(square, -1, axis=0)) and np.array_equal(sides[:, :2], square)
     assert ring_segments(square[:1]).shape == (0, 4)
+
+
+@pytest.mark.parametrize("name", sorted(DATASETS))
+def test_scene_edges_are_each_cell_side_once(name):
+    """The scene keeps each side of the cells once (a side between two cells from one of them, a
+    side along the box from its cell): the same set as sorting every side and dropping repeats."""
+    from tvoronoi.tui.raster import _unique_pairs, ring_next
+
+    pts = DATASETS[name]
+    if len(pts) < 2:
+        pytest.skip("no cell sides to share")
+    diagram = tvoronoi.voronoi(pts)
+    offsets = np.asarray(diagram.cell_offsets, np.int64)
+    ring = np.asarray(diagram.cell_vertices, np.int64)
+    points = np.asarray(diagram.cell_points)
+    a, b = _unique_pairs(ring, ring[ring_next(offsets, ring.size)], len(points))
+    expected = {tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in np.hstack([points[a], points[b]])}
+    edges = Scene.from_diagram(diagram).edges
+    got = [tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in edges]
+    assert len(got) == len(set(got)) == len(expected)
+    assert set(got) == expected

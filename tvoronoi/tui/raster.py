@@ -175,6 +175,31 @@ def ring_segments(points: np.ndarray) -> np.ndarray:
     return np.hstack([points, points[ring_next(np.array([0, len(points)]), len(points))]])
 
 
+def _cell_sides(a: np.ndarray, b: np.ndarray, points: np.ndarray, bbox) -> tuple[np.ndarray, np.ndarray]:
+    """The sides a -> b of every cell ring (indices of ``points``), each once.
+
+    Neighbouring cells share point indices and go round counter-clockwise, so a side between two
+    cells comes twice, once each way: the one from the smaller index is kept, and a side along the
+    box (one cell only) always. Should the rings not pair up so (every side inside the box twice),
+    the sides are made unique by sorting instead.
+    """
+    a = np.asarray(a, np.int64)
+    b = np.asarray(b, np.int64)
+    if not a.size:
+        return a, b
+    xmin, ymin, xmax, ymax = bbox
+    # per point, a bit for each side of the box it lies on; a side is along the box if its ends share one
+    sides = ((points[:, 0] == xmin).astype(np.uint8) | ((points[:, 0] == xmax).astype(np.uint8) << 1)
+             | ((points[:, 1] == ymin).astype(np.uint8) << 2) | ((points[:, 1] == ymax).astype(np.uint8) << 3))
+    on_box = (sides[a] & sides[b]) != 0
+    inner = ~on_box & (a != b)
+    first = inner & (a < b)
+    if 2 * int(first.sum()) == int(inner.sum()):
+        keep = first | (on_box & (a != b))
+        return a[keep], b[keep]
+    return _unique_pairs(a, b, len(points))
+
+
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Undirected pairs (a, b), each once, self pairs dropped."""
     a = np.asarray(a, np.int64)
@@ -302,8 +327,7 @@ class Scene:
         ring = np.asarray(diagram.cell_vertices, np.int64)
         nxt = ring_next(offsets, ring.size)
         points = np.asarray(diagram.cell_points, np.float64)
-        # neighbouring cells share point indices: keep each edge once
-        a, b = _unique_pairs(ring, ring[nxt] if ring.size else ring, len(points))
+        a, b = _cell_sides(ring, ring[nxt] if ring.size else ring, points, diagram.bbox)
         edges = np.hstack([points[a], points[b]]) if a.size else np.empty((0, 4))
 
         tri = np.asarray(diagram.delaunay_triangles(), np.int64).reshape(-1, 3)
