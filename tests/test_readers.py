@@ -881,6 +881,27 @@ def test_id_like_columns_are_never_taken_by_position(tmp_path, id_name):
     assert f'"{id_name}"' in points.choice
 
 
+def test_readers_report_the_columns_taken_and_the_candidates_when_ambiguous(tmp_path):
+    # three numeric columns, none named: x and y by position, all three offered
+    points = read(tmp_path, "p.csv", "a,b,c,name\n1,2,3,u\n4,5,6,v\n")
+    assert points.xy_columns == ("a", "b") and points.candidates == ("a", "b", "c")
+    # named, given or only two: nothing to choose
+    assert read(tmp_path, "q.csv", "lon,lat,pop\n1,2,3\n4,5,6\n").candidates == ()
+    given = read(tmp_path, "r.csv", "a,b,c\n1,2,3\n4,5,6\n", x="c", y="a")
+    assert given.xy_columns == ("c", "a") and given.candidates == ()
+    np.testing.assert_array_equal(given.xy, [[3, 1], [6, 4]])
+    assert read(tmp_path, "s.csv", "a,b,name\n1,2,u\n").candidates == ()
+    # a header-less table: the columns by their colN names, which the readers take back
+    bare = read(tmp_path, "t.csv", "1,2,3\n4,5,6\n")
+    assert bare.candidates == ("col1", "col2", "col3")
+    np.testing.assert_array_equal(read(tmp_path, "t.csv", "1,2,3\n4,5,6\n", x="col3", y="col2").xy,
+                                  [[3, 2], [6, 5]])
+    # a structured .npy array of three unnamed numeric fields
+    array = np.array([(1.0, 2.0, 3.0)], dtype=[("p", "f8"), ("q", "f8"), ("r", "i4")])
+    npy = read(tmp_path, "p.npy", npy_bytes(array))
+    assert npy.xy_columns == ("p", "q") and npy.candidates == ("p", "q", "r")
+
+
 def test_only_id_columns_left_is_an_error_naming_them(tmp_path):
     message = error(tmp_path, "p.csv", "id,value,name\n1,5,a\n2,6,b\n")
     assert "id-like columns are not taken: id" in message and "--x/--y" in message

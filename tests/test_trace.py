@@ -1,5 +1,7 @@
 """Step traces of both engines: every state consistent, the last one equal to the full build."""
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
@@ -7,6 +9,8 @@ import tvoronoi
 from conftest import DATASETS
 from test_fortune import assert_same_diagram
 from tvoronoi.generators import uniform
+from tvoronoi.kernels import incremental
+from tvoronoi.trace import visibility_walk
 
 
 def segment_keys(edges):
@@ -112,6 +116,84 @@ def test_incremental_conflict_region(incremental_run):
         # the cells it took area from are its Delaunay neighbours now
         nbrs = {v for t in s.diagram.delaunay_triangles() if s.site in t for v in t} - {s.site}
         assert set(s.stolen_from.tolist()) <= nbrs
+
+
+def _orient(a, b, c) -> int:
+    """Exact sign of the turn a -> b -> c, in rationals."""
+    (ax, ay), (bx, by), (cx, cy) = ([Fraction(float(v)) for v in p] for p in (a, b, c))
+    d = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    return (d > 0) - (d < 0)
+
+
+def check_walk(pts, before, s) -> str:
+    """The walk of step s is a chain of adjacent triangles of the mesh before it, from one of the
+    previous step's new triangles to one holding the site, or beyond a hull edge the site sees;
+    returns how it ended ("inside" or "outside")."""
+    # repeated points: one row stands for each place (the mesh and the walk may name different ones)
+    _, first, inverse = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+    same = np.append(first[inverse.ravel()], -1)  # -1 (infinity) stays -1
+    walk = [tuple(int(same[v]) for v in t) for t in s.walk]
+    assert walk, f"step {s.index}: no walk"
+    mesh = {tuple(sorted(same[t])) for t in before.diagram.delaunay_triangles()}
+    for t in walk[:-1]:
+        assert -1 not in t, f"step {s.index}: the walk went on past an infinite triangle"
+    for t in walk:
+        if -1 not in t:
+            assert tuple(sorted(t)) in mesh, f"step {s.index}: {t} is not a triangle of the mesh"
+    for t, u in zip(walk, walk[1:]):
+        assert len(set(t) & set(u)) == 2, f"step {s.index}: {t} and {u} share no edge"
+    if s.index > 4 and len(before.new_triangles):
+        # it starts where the engine starts: a triangle the previous insertion made
+        assert tuple(sorted(walk[0])) in {tuple(sorted(same[t])) for t in before.new_triangles}
+    p = pts[s.site]
+    last = walk[-1]
+    if -1 in last:
+        k = last.index(-1)
+        a, b = last[(k + 1) % 3], last[(k + 2) % 3]
+        # the hull edge b -> a has the mesh on its left; the site lies strictly on its right
+        assert _orient(pts[a], pts[b], p) > 0, f"step {s.index}: the site does not see the hull edge"
+        return "outside"
+    for k in range(3):
+        a, b = last[k], last[(k + 1) % 3]
+        assert _orient(pts[a], pts[b], p) >= 0, f"step {s.index}: the site is not in {last}"
+    if not any((pts[v] == p).all() for v in last):
+        # the engine found the same triangle: it is in conflict with the site
+        assert tuple(sorted(last)) in {tuple(sorted(same[t])) for t in s.conflict}
+    return "inside"
+
+
+def test_incremental_location_walk_is_a_chain_to_the_site(incremental_run):
+    pts, _, steps = incremental_run
+    ends = [check_walk(pts, before, s) for before, s in zip(steps[3:], steps[4:])]
+    assert {"inside", "outside"} <= set(ends)
+    assert max(len(s.walk) for s in steps) >= 3, "no walk crossed a triangle"
+    assert all(len(s.walk) == 0 for s in steps[:4])
+
+
+@pytest.mark.parametrize("name", ["grid", "duplicates", "circle"])
+def test_incremental_location_walk_on_degenerate_sets(name):
+    pts = DATASETS[name]
+    trace = tvoronoi.steps(pts, engine="incremental")
+    steps = [trace.step(k) for k in range(len(trace) + 1)]
+    for before, s in zip(steps[3:], steps[4:]):
+        check_walk(pts, before, s)
+
+
+def test_visibility_walk_matches_a_brute_force_containment():
+    # on a fixed mesh, the walk from any start ends in the triangle that holds the point
+    pts = uniform(40, seed=3)
+    d = tvoronoi.voronoi(pts)
+    tri = d.delaunay_triangles()
+    res = incremental.triangulate(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]))
+    tv, opp = res[1], res[2]
+    finite = [t for t in range(len(tv) // 3) if (tv[3 * t:3 * t + 3] < len(pts)).all()]
+    assert len(finite) == len(tri)
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(0.2, 0.8, size=(20, 2)):
+        walk = visibility_walk(pts[:, 0].copy(), pts[:, 1].copy(), tv, opp, finite[0], *q)
+        signs = [{_orient(pts[t[k]], pts[t[(k + 1) % 3]], q) for k in range(3)} for t in tri]
+        holding = {tuple(sorted(t)) for t, sg in zip(tri.tolist(), signs) if not {-1, 1} <= sg}
+        assert tuple(sorted(walk[-1].tolist())) in holding
 
 
 def test_incremental_steps_grow_one_site_at_a_time(incremental_run):

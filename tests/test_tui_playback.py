@@ -1,6 +1,7 @@
 """Playback of the engines in the terminal UI: keys, timeline, timer, pictures of steps, snapshots."""
 
 import asyncio
+import dataclasses
 
 import numpy as np
 import pytest
@@ -24,11 +25,13 @@ from tvoronoi.tui.raster import (
     SITE,
     SWEEP,
     TINTED,
+    WALK,
     Scene,
     View,
     frame_lines,
     rasterize,
 )
+from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 
 
 def warning_toasts(app) -> list[str]:
@@ -447,6 +450,34 @@ def test_incremental_picture_shows_the_conflict_region(fortune_case):
     assert not (colours[a] == colours[b]).any()
 
 
+def test_incremental_picture_draws_the_location_walk(fortune_case):
+    """The triangles the walk visited are outlined in the walk's colour, along their sides."""
+    points, diagram, full = fortune_case
+    trace = tvoronoi.incremental_steps(points, bbox=diagram.bbox)
+    k = next(k for k in range(60, len(trace)) if len(trace.step(k).walk) >= 4
+             and (trace.step(k).walk >= 0).all())
+    step = trace.step(k)
+    scene, overlay = incremental_picture(step, points, full.colours)
+    # every side of a visited triangle, each once
+    sides = {tuple(sorted((a, b))) for t in step.walk.tolist() for a, b in zip(t, t[1:] + t[:1])}
+    assert len(overlay.walk) == len(sides)
+    view = View.fit(diagram.bbox, 100, 40)
+    frame = rasterize(scene, view, 100, 40, overlay=overlay)
+    walked = np.argwhere(frame.mark == WALK)
+    assert len(walked) >= 10
+    # each character marked lies on a side of the walk (within a character of one)
+    centres = np.column_stack(view.to_world((walked[:, 1] + 0.5) * DOT_COLS, (walked[:, 0] + 0.5) * DOT_ROWS,
+                                            100, 40))
+    a, b = overlay.walk[:, :2], overlay.walk[:, 2:]
+    ab = b - a
+    t = np.clip(np.einsum("pkd,kd->pk", centres[:, None] - a[None], ab) / np.einsum("kd,kd->k", ab, ab), 0, 1)
+    gap = np.linalg.norm(centres[:, None] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
+    assert (gap <= 2.5 * DOT_ROWS * view.scale).all()
+    # and without the walk, none is
+    bare = rasterize(scene, view, 100, 40, overlay=dataclasses.replace(overlay, walk=np.empty((0, 4))))
+    assert not (bare.mark == WALK).any()
+
+
 def test_the_last_incremental_step_keeps_the_final_colours(fortune_case):
     """At the end of playback the colours are those of the diagram shown before it."""
     points, diagram, full = fortune_case
@@ -558,9 +589,14 @@ async def test_follow_shows_the_cavity_of_an_insertion():
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot)
         await pilot.press(*["full_stop"] * 150)
+        while len(player.step.walk) < 3 and player.step.index < 250:  # a walk across a few triangles
+            await pilot.press("full_stop")
         step = player.step
-        assert len(step.conflict)
+        assert len(step.conflict) and len(step.walk) >= 3
         for x, y in player.points[step.conflict.ravel()]:
+            assert shows(app, x, y)
+        # and the location walk that found the site
+        for x, y in player.points[step.walk[step.walk >= 0]]:
             assert shows(app, x, y)
         assert app.canvas.zoom() > 1.5
 
@@ -731,6 +767,9 @@ async def test_the_panel_shows_the_cavity_and_the_cells_that_lost_area():
         assert f"{len(step.conflict)} triangles in conflict" in text
         assert f"Cells that lost area: {len(step.stolen_from)}" in text
         assert str(step.stolen_from[0]) in text
+        # the location walk: its length and the triangle it ended in
+        assert f"Location walk: {len(step.walk)} triangle" in text
+        assert "▶ " + " ".join(str(v) for v in step.walk[-1]) in text
 
 
 def test_snapshot_legend_of_the_diagram(snap_compare):
@@ -758,8 +797,9 @@ def test_snapshot_fortune_panel_following(snap_compare):
 def test_snapshot_incremental_panel_following(snap_compare):
     """The incremental engine after 150 insertions with the view following: zoomed on the new
     site's cavity (the conflict triangles outlined and filled, the cells that lost area
-    tinted); the panel's Engine state names the site, the cavity's size, the ids of the
-    cells that lost area and the counts so far."""
+    tinted, the triangles the location walk visited outlined in blue); the panel's Engine state
+    names the site, the location walk (its length, its first triangles and the one it ended in),
+    the cavity's size, the ids of the cells that lost area and the counts so far."""
     assert snap_compare(make_app(), press=["t", *["right_square_bracket"] * 5], terminal_size=SIZE)
 
 

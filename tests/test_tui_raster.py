@@ -43,6 +43,52 @@ def test_vertical_and_diagonal_segments_have_no_gaps():
     assert np.diag(dots).all()
 
 
+def reference_dots(shape, u0, v0, u1, v1) -> np.ndarray:
+    """One segment at a time, in plain Python: its ends, and a sample at every dot centre line of
+    its longer axis between them (pulled back onto the segment at its ends)."""
+    dots = np.zeros(shape, bool)
+
+    def put(u, v):
+        if 0 <= u < shape[1] and 0 <= v < shape[0]:
+            dots[int(v), int(u)] = True
+
+    for a in zip(u0, v0, u1, v1):
+        x0, y0, x1, y1 = (float(c) for c in a)
+        put(x0, y0)
+        put(x1, y1)
+        steep = abs(y1 - y0) > abs(x1 - x0)
+        p0, p1 = ((y0, x0), (y1, x1)) if steep else ((x0, y0), (x1, y1))
+        if p1[0] < p0[0]:
+            p0, p1 = p1, p0
+        k0, k1 = int(np.floor(p0[0])), int(np.floor(p1[0]))
+        for k in range(k0, k1 + 1):
+            a = min(max(k + 0.5, p0[0]), p1[0])
+            span = p1[0] - p0[0]
+            b = p0[1] + (a - p0[0]) * ((p1[1] - p0[1]) / span if span > 0 else 0.0)
+            put(b, a) if steep else put(a, b)
+    return dots
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.2, 0.7, 1.5, 6.0]))
+def test_many_short_and_long_segments_set_the_dots_of_each_drawn_alone(seed, length):
+    """Sub-dot edges (most of a zoomed-out view) take a shortcut: the dots must stay those of
+    the segment-by-segment reference."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(0.0, 30.0, (300, 2))
+    q = p + rng.normal(0.0, length, (300, 2))
+    half = rng.random(300) < 0.3  # ends on dot borders and centres too
+    p[half], q[half] = np.round(p[half] * 2) / 2, np.round(q[half] * 2) / 2
+    dots = np.zeros((28, 28), bool)
+    segment_dots(dots, p[:, 0], p[:, 1], q[:, 0], q[:, 1])
+    inside = (np.minimum(p, q) >= 0).all(axis=1) & (np.maximum(p, q) < 28).all(axis=1)
+    expected = reference_dots((28, 28), *p[inside].T, *q[inside].T)
+    alone = np.zeros((28, 28), bool)
+    segment_dots(alone, *p[inside].T, *q[inside].T)
+    assert (alone == expected).all()
+    assert (dots | alone == dots).all()
+
+
 def test_crossing_lines_keep_all_their_dots():
     """Where two lines meet in one character, both keep every dot (bit patterns are OR-ed)."""
     alone_h = np.zeros((8, 8), bool)
@@ -242,3 +288,88 @@ def _with_starts(line):
     for seg in line:
         yield seg, start
         start += len(seg.text)
+
+
+def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(monkeypatch):
+    """Frames drawn through a LayerCache equal frames drawn afresh; a frame that only shows the
+    Delaunay edges again draws no other layer, and another scene, view or size draws all."""
+    from tvoronoi.tui import raster
+    from tvoronoi.tui.raster import LayerCache
+
+    diagram = tvoronoi.voronoi(generate("uniform", 500, seed=3))
+    scene = Scene.from_diagram(diagram)
+    other = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 500, seed=4)))
+    view = View.fit(diagram.bbox, 60, 24)
+    calls = []
+    real = raster.segment_dots
+    monkeypatch.setattr(raster, "segment_dots", lambda *a, **k: (calls.append(len(a[1])), real(*a, **k)))
+    cache = LayerCache()
+    steps = [
+        (scene, view, 60, 24, False),
+        (scene, view, 60, 24, True),      # Delaunay on: only its layer is new
+        (scene, view, 60, 24, False),     # off: nothing to draw
+        (scene, view.panned(3, 0), 60, 24, False),
+        (other, view, 60, 24, False),
+        (other, view, 50, 24, False),
+    ]
+    drawn = []
+    for sc, v, cols, rows, tri in steps:
+        calls.clear()
+        cached = rasterize(sc, v, cols, rows, delaunay=tri, layers=cache)
+        drawn.append(len(calls))
+        fresh = rasterize(sc, v, cols, rows, delaunay=tri)
+        for a, b in ((cached.codes, fresh.codes), (cached.mark, fresh.mark), (cached.fill, fresh.fill)):
+            assert np.array_equal(a, b)
+    # segment_dots calls through the cache: the edges; the Delaunay edges only; none; then the
+    # edges again for a new view, scene and size
+    assert drawn == [1, 1, 0, 1, 1, 1]
+
+
+def test_the_layer_cache_follows_a_live_scene_edited_in_place():
+    from tvoronoi.tui.building import build
+    from tvoronoi.tui.editing import make_live
+    from tvoronoi.tui.raster import LayerCache
+
+    built = build(generate("uniform", 200, seed=5), "incremental", "test", clock=lambda: 0.0)
+    live = make_live(built)
+    view = View.fit(built.diagram.bbox, 60, 24)
+    cache = LayerCache()
+    before = rasterize(live, view, 60, 24, layers=cache)
+    live.insert(0.5, 0.5)
+    after = rasterize(live, view, 60, 24, layers=cache)
+    fresh = rasterize(live, view, 60, 24)
+    assert np.array_equal(after.codes, fresh.codes) and np.array_equal(after.mark, fresh.mark)
+    assert not np.array_equal(after.codes, before.codes)
+
+
+def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
+    """The one rings-to-sides routine: each entry's successor is the next of its ring, the last
+    going back to the first, whatever the empty rings between."""
+    from tvoronoi.tui.raster import ring_next, ring_segments
+
+    sizes = [3, 0, 1, 4, 0, 2]
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    expected = np.concatenate([np.roll(np.arange(a, b), -1) for a, b in zip(offsets[:-1], offsets[1:])])
+    assert np.array_equal(ring_next(offsets, offsets[-1]), expected)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    sides = ring_segments(square)
+    assert np.array_equal(sides[:, 2:], np.roll(square, -1, axis=0)) and np.array_equal(sides[:, :2], square)
+    assert ring_segments(square[:1]).shape == (0, 4)
+
+
+@pytest.mark.parametrize("name", sorted(name for name, pts in DATASETS.items() if len(pts) >= 2))
+def test_scene_edges_are_each_cell_side_once(name):
+    """The scene keeps each side of the cells once (a side between two cells from one of them, a
+    side along the box from its cell): the same set as sorting every side and dropping repeats."""
+    from tvoronoi.tui.raster import _unique_pairs, ring_next
+
+    diagram = tvoronoi.voronoi(DATASETS[name])
+    offsets = np.asarray(diagram.cell_offsets, np.int64)
+    ring = np.asarray(diagram.cell_vertices, np.int64)
+    points = np.asarray(diagram.cell_points)
+    a, b = _unique_pairs(ring, ring[ring_next(offsets, ring.size)], len(points))
+    expected = {tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in np.hstack([points[a], points[b]])}
+    edges = Scene.from_diagram(diagram).edges
+    got = [tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in edges]
+    assert len(got) == len(set(got)) == len(expected)
+    assert set(got) == expected

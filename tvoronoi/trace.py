@@ -7,6 +7,7 @@ millisecond per thousand sites, so a timeline can be scrubbed freely.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -17,6 +18,7 @@ from tvoronoi.api import as_bbox, as_points, check_engine, default_bbox
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
 from tvoronoi.kernels import dual, fortune, incremental
+from tvoronoi.kernels.predicates import orient2d_sign
 
 KIND_NAMES = {0: "site", 1: "circle", 2: "repeat"}
 
@@ -192,6 +194,15 @@ class IncrementalStep:
     conflict region, as (c, 3) input rows), ``stolen_from`` the sites whose
     cells it took area from, and ``diagram`` the Voronoi diagram of the sites
     inserted so far (the others have empty cells).
+
+    ``walk`` is the point location that found the new site: the triangles of
+    the triangulation before the step that the engine's visibility walk
+    visited, in order, as (w, 3) input rows (-1 for the vertex at infinity).
+    It starts at the last finite triangle the previous insertion created (the
+    first triangle for the fourth site), moves across the first edge the site
+    lies strictly right of, and ends in a triangle that contains the site, or
+    in the infinite triangle beyond a hull edge the site sees. Empty for the
+    first three sites, which make the first triangle without a walk.
     """
 
     index: int
@@ -202,6 +213,7 @@ class IncrementalStep:
     stolen_from: np.ndarray
     inserted: np.ndarray
     diagram: Diagram
+    walk: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 3), np.int32))
 
     def describe(self) -> str:
         if self.index == 0:
@@ -266,11 +278,69 @@ class IncrementalTrace:
         stolen = np.unique(cavity[cavity != n])
         stolen = stolen[stolen != new_site]
         to_row = self._perm
+        walk = self._walk(k, new_site) if res[0] == incremental.STATUS_OK and k > 3 else np.empty((0, 3), np.int32)
         return IncrementalStep(
             index=k, n_steps=n, site=int(to_row[new_site]) if new_site >= 0 else -1,
             conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[_finite(fan, n)].reshape(-1, 3),
             stolen_from=to_row[stolen], inserted=np.sort(to_row[present]), diagram=d,
+            walk=np.where(walk == n, -1, to_row[np.minimum(walk, n - 1)]).reshape(-1, 3),
         )
+
+    def _walk(self, k: int, site: int) -> np.ndarray:
+        """The triangles (vertex triples, n for infinity) the engine's walk visits to locate the k-th
+        site (``site``, a kernel index), replayed on the triangulation of the k - 1 sites before it."""
+        res = incremental.triangulate(self._xs, self._ys, stop_after=k - 1)
+        _, tv, opp, _, trace = res
+        start = 0  # the fourth site walks from the first triangle
+        if k - 1 > 3:
+            # the kernel walks from the last finite triangle of the previous fan (fill.pxd: m.last)
+            fan = trace["fan"]
+            finite = fan[(tv[3 * fan] != self.n_steps) & (tv[3 * fan + 1] != self.n_steps)]
+            if len(finite):
+                start = int(finite[-1])
+        return visibility_walk(self._xs, self._ys, tv, opp, start, self._xs[site], self._ys[site])
+
+
+def visibility_walk(xs, ys, tv, opp, start: int, px: float, py: float) -> np.ndarray:
+    """The triangles a visibility walk visits from triangle ``start`` towards the point (px, py).
+
+    The walk of the incremental engine (``location.pxd``'s ``locate``), step for step: in each
+    triangle it tests the edges in order, skipping the one it came through, and crosses the first
+    edge that has p strictly on its right (exact orientation); it stops in a triangle with no such
+    edge (p inside or on it) or on reaching an infinite triangle (beyond a hull edge p sees).
+
+    Parameters
+    ----------
+    xs, ys : (n,) float64
+        The sites; the vertex at infinity is numbered n.
+    tv, opp : (3 t,) int
+        The triangulation: triangle t's vertices ``tv[3t:3t+3]`` counter-clockwise, twin half-edges.
+    start : int
+        A finite triangle.
+
+    Returns
+    -------
+    (w, 3) int32
+        The visited triangles' vertex triples, in order, ``start`` first.
+    """
+    inf = len(xs)
+    tri = np.asarray(tv, np.int64).reshape(-1, 3)
+    t, came = int(start), -1
+    visited = [t]
+    while not (tri[t] == inf).any():
+        for k in range(3):
+            e = 3 * t + k
+            if e == came:
+                continue
+            a, b = tri[t, k], tri[t, (k + 1) % 3]
+            if orient2d_sign(xs[a], ys[a], xs[b], ys[b], px, py) < 0:
+                came = int(opp[e])
+                t = came // 3
+                visited.append(t)
+                break
+        else:
+            break
+    return tri[visited].astype(np.int32)
 
 
 Trace = FortuneTrace | IncrementalTrace

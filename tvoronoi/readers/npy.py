@@ -92,7 +92,10 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     columns = {names[j]: json_column(array[names[j]]) for j in range(len(names)) if j not in (ix, iy)}
     lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
-    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, where=lambda i: f"row {i} (0-based)")
+    every = tuple(name for name in names if array.dtype[name].kind in "iuf" and not array.dtype[name].shape)
+    ambiguous = x is None and y is None and how != "by name" and len(every) > 2
+    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, xy_columns=(names[ix], names[iy]),
+                    candidates=every if ambiguous else (), where=lambda i: f"row {i} (0-based)")
 
 
 def _check_finite_rows(xy: np.ndarray, source: str) -> None:

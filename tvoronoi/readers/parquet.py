@@ -110,7 +110,10 @@ def _xy_table(table, source: str, x, y) -> PointSet:
     columns = _properties(table, [j for j in range(len(names)) if j not in (ix, iy)])
     lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
-    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, where=lambda i: f"row {i} (0-based)")
+    ambiguous = x is None and y is None and how != "by name" and len(numeric) > 2
+    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, xy_columns=(names[ix], names[iy]),
+                    candidates=tuple(names[j] for j in numeric) if ambiguous else (),
+                    where=lambda i: f"row {i} (0-based)")
 
 
 def _check_finite(xy: np.ndarray, source: str) -> None:

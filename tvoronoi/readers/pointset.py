@@ -41,6 +41,14 @@ class PointSet:
     choice : str or None
         Which columns became x and y and why, for tables whose columns were not
         all given by the caller; None otherwise.
+    xy_columns : (str, str) or None
+        The names of the table columns (or fields) that became x and y; None
+        for files without columns (GeoJSON, geometry columns, plain arrays).
+    candidates : tuple of str
+        When x and y were taken by position (the first numeric columns, neither
+        named x/y or lon/lat nor given by the caller) and more than two columns
+        could have been: every numeric column, in file order, for a user to
+        choose from. Empty when the choice was not ambiguous.
     where : callable(int) -> str, optional
         Where site ``i`` is in the file ("line 7", "features[3]", "row 3").
     """
@@ -52,6 +60,8 @@ class PointSet:
     crs: str | dict | None = None
     lonlat: bool = False
     choice: str | None = None
+    xy_columns: tuple[str, str] | None = None
+    candidates: tuple[str, ...] = ()
     where: Callable[[int], str] | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:

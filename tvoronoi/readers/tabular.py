@@ -57,6 +57,7 @@ class _Layout:
     iy: int
     delimiter: str = ","  # of a CSV file
     choice: str | None = None  # which columns became x and y and why, when the caller chose neither
+    candidates: tuple[str, ...] = ()  # the numeric columns, when x and y were taken by position among more
 
 
 def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = None) -> PointSet:
@@ -91,6 +92,8 @@ def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = 
     names = [name.strip().lower() for name in (layout.names[layout.ix], layout.names[layout.iy])]
     points.lonlat = layout.has_header and names[0] in LON_NAMES and names[1] in LAT_NAMES
     points.choice = layout.choice
+    points.xy_columns = (layout.names[layout.ix], layout.names[layout.iy])
+    points.candidates = layout.candidates
     return points
 
 
@@ -227,6 +230,11 @@ def table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") 
     iy = resolve_column(y, "y", names, has_header, source)
     how = "by name" if has_header else "the first two columns"
     skipped: list[str] = []
+    candidates: tuple[str, ...] = ()
+    if ix is None and iy is None:
+        every = [names[j] for j, f in enumerate(first_fields[: len(names)]) if number(f)]
+        if len(every) > 2:
+            candidates = tuple(every)
     if ix is None or iy is None:
         # the first numeric columns of the first data row that are not taken, and not ids
         numeric = [j for j, f in enumerate(first_fields[: len(names)]) if j not in (ix, iy) and number(f)]
@@ -250,7 +258,8 @@ def table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") 
     choice = None
     if x is None or y is None:
         choice = describe_choice(names, ix, iy, how if x is None and y is None else "by option and " + how, skipped)
-    return _Layout(names, has_header, header_lines, first_line, ix, iy, delimiter, choice)
+    return _Layout(names, has_header, header_lines, first_line, ix, iy, delimiter, choice,
+                   candidates if how == "the first numeric columns" else ())
 
 
 def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]], number=_is_number) -> bool:

@@ -119,6 +119,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         Binding("g", "generate", "Generate"),
         Binding("o", "open", "Open", show=False),
         Binding("s", "save", "Save", show=False),
+        Binding("e", "export", "Export", show=False),
         Binding("p", "toggle_panel", "Panel", show=False),
         Binding("r", "relax", "Relax", show=False),
         Binding("escape", "focus_canvas", "Back to the diagram", show=False),
@@ -525,8 +526,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self.drop_editing()
 
     def _diagram_shown(self) -> None:
-        """A new whole diagram is on screen: make it ready for editing."""
+        """A new whole diagram is on screen: make it ready for editing; a file's ambiguous columns
+        are asked about."""
         self.prepare_editing()
+        self.offer_columns()
 
     def action_help(self) -> None:
         """List every key."""
@@ -574,7 +577,9 @@ HELP_TEXT = {
     "generate": "generate points from the panel's settings",
     "open": "open a point file",
     "save": "save the cells as GeoJSON",
+    "export": "export the view as SVG or PNG",
     "toggle_panel": "show / hide the side panel",
+    "relax": "relax: one Lloyd step (each site to its cell's centroid)",
     "toggle_legend": "show / hide the legend of the colours and marks (in the panel)",
     "focus_canvas": "leave a text field, back to the diagram",
     **playback.HELP,

@@ -11,7 +11,9 @@ from textual.message import Message
 from textual.worker import get_current_worker
 
 import tvoronoi
+from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.readers.pointset import PointSet
 from tvoronoi.tui.raster import Scene
 
 # Work on this many sites or more runs in a worker thread; the status line and the panel's
@@ -26,14 +28,15 @@ class Built:
     """A diagram ready to show, with what the status line says about it."""
 
     points: np.ndarray
-    point_set: object | None  # the PointSet read from a file (its properties go into a save)
-    diagram: object
+    point_set: PointSet | None  # read from a file (its properties go into a save), else None
+    diagram: Diagram
     scene: Scene
     engine_ms: float
     source: str
 
 
-def build(points: np.ndarray, engine: str, source: str, clock: Clock, point_set=None, bbox=None) -> Built:
+def build(points: np.ndarray, engine: str, source: str, clock: Clock, point_set: PointSet | None = None,
+          bbox=None) -> Built:
     """Build the diagram of some points and prepare it for drawing (any thread)."""
     start = clock()
     diagram = tvoronoi.voronoi(points, engine=engine, bbox=bbox)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rich.segment import Segment
@@ -19,8 +20,9 @@ from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.follow import follow_view
 from tvoronoi.tui.raster import (
     CURSOR_ARM,
+    Drawable,
     Frame,
-    Scene,
+    LayerCache,
     View,
     frame_lines,
     rasterize,
@@ -51,6 +53,15 @@ def plain_terminal(app) -> bool:
         return True
     # a headless app (tests, snapshots) draws in full colour, whatever TERM says
     return not app.is_headless and app.console.color_system in PLAIN_COLOR_SYSTEMS
+
+
+if TYPE_CHECKING:
+    from tvoronoi.tui.live import LiveScene
+    from tvoronoi.tui.raster import Scene
+
+    def _drawables(scene: Scene, live: LiveScene) -> tuple[Drawable, Drawable]:
+        """For mypy: both kinds of scene are what the canvas draws."""
+        return scene, live
 
 
 PAN = Binding.Group("Pan", compact=True)
@@ -120,7 +131,7 @@ class DiagramCanvas(Widget, can_focus=True):
 
     def __init__(self, *, name: str | None = None, id: str | None = None, classes: str | None = None) -> None:
         super().__init__(name=name, id=id, classes=classes)
-        self.scene: Scene | None = None
+        self.scene: Drawable | None = None
         self.overlay = None
         # the keyboard cursor, a world point (None: hidden)
         self.cursor: tuple[float, float] | None = None
@@ -133,6 +144,8 @@ class DiagramCanvas(Widget, can_focus=True):
         self._frame_key: tuple | None = None
         self._lines: list[list[Segment]] = []
         self._frame: Frame | None = None
+        # the diagram's layers of the last frame, for a frame that differs only in others
+        self._layers = LayerCache()
         self._base_key: tuple | None = None
         self._frame_version = 0
         self._frame_cursor: tuple[float, float] | None = None
@@ -148,7 +161,7 @@ class DiagramCanvas(Widget, can_focus=True):
 
     # -- the scene -----------------------------------------------------------
 
-    def show_scene(self, scene: Scene, *, fit: bool = True, overlay=None) -> None:
+    def show_scene(self, scene: Drawable, *, fit: bool = True, overlay=None) -> None:
         """Draw a new scene (and overlay); fit the view to its box unless told to keep the view."""
         self.scene = scene
         self.overlay = overlay
@@ -156,14 +169,14 @@ class DiagramCanvas(Widget, can_focus=True):
             self.fit()
         self.refresh()
 
-    def adopt_scene(self, scene) -> None:
+    def adopt_scene(self, scene: Drawable) -> None:
         """Show a scene that draws exactly as the one shown (the same diagram in an editable
         form): the frame on screen stays, and later changes of the scene redraw only their part."""
         if self._base_key is None or self._frame_key is None:
             self.show_scene(scene, fit=False)
             return
         self.scene = scene
-        version = getattr(scene, "version", 0)
+        version = scene.version
         self._base_key = (id(scene), *self._base_key[1:])
         self._frame_key = (self._base_key, version, self._frame_key[2])
         self._frame_version = version
@@ -317,6 +330,8 @@ class DiagramCanvas(Widget, can_focus=True):
             self.pointer = None if offset is None else self.world_at(offset.x, offset.y)
             self.post_message(self.TargetChanged())
             return
+        if self._drag_from is None:
+            return
         x0, y0 = self._drag_from
         dx, dy = event.screen_x - x0, event.screen_y - y0
         if not (dx or dy):
@@ -363,7 +378,7 @@ class DiagramCanvas(Widget, can_focus=True):
             self.set_reactive(DiagramCanvas.view, View.fit(self.scene.bbox, size.width, size.height))
         palette = self.palette()
         scene = self.scene
-        version = getattr(scene, "version", 0)
+        version = 0 if scene is None else scene.version
         base = (id(scene), id(self.overlay), self.view, size, self.show_delaunay, self.show_vertices, palette)
         key = (base, version, self.cursor)
         if key == self._frame_key:
@@ -375,7 +390,7 @@ class DiagramCanvas(Widget, can_focus=True):
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
-                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled,
+                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled, layers=self._layers,
             )
             self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
@@ -396,8 +411,8 @@ class DiagramCanvas(Widget, can_focus=True):
         """
         cols, rows = size.width, size.height
         boxes, ids = [], None
-        if getattr(scene, "version", 0) != self._frame_version:
-            changes = scene.changes_since(self._frame_version) if hasattr(scene, "changes_since") else None
+        if scene.version != self._frame_version:
+            changes = scene.changes_since(self._frame_version)
             if changes is None:
                 return False
             ids, box = changes
@@ -408,8 +423,8 @@ class DiagramCanvas(Widget, can_focus=True):
                 if cursor is not None:
                     x, y = cursor
                     boxes.append((x - reach, y - reach, x + reach, y + reach))
-        spans = [self.view.char_span(b, cols, rows) for b in boxes if b is not None]
-        spans = [s for s in spans if s is not None]
+        found = [self.view.char_span(b, cols, rows) for b in boxes if b is not None]
+        spans = [s for s in found if s is not None]
         if not spans:
             return True
         c0, r0 = min(s[0] for s in spans), min(s[1] for s in spans)
@@ -417,6 +432,8 @@ class DiagramCanvas(Widget, can_focus=True):
         if (c1 - c0) * (r1 - r0) > PARTIAL_MAX_FRACTION * cols * rows:
             return False
         frame = self._frame
+        if frame is None:
+            return False
         owner = None
         if ids is not None:
             part_view = self.view.window(c0, r0, cols, rows)

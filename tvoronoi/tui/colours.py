@@ -44,8 +44,8 @@ class Palette:
     sweep line, beach line, pending circle events and growing edges,
     ``event`` for what the current step did (and the site being moved),
     ``conflict`` and ``conflict_fill`` for the triangles an insertion
-    destroyed, ``cursor`` for the keyboard cursor's cross. ``tints`` are the
-    fills of the cells an insertion took area from, ``highlights`` those of
+    destroyed, ``walk`` for those its point location visited, ``cursor``
+    for the keyboard cursor's cross. ``tints`` are the fills of the cells an insertion took area from, ``highlights`` those of
     the characters under the keyboard cursor (the cell's own colour, darker
     on a dark theme and lighter on a light one, so that the site and edges
     under the cursor keep showing).
@@ -66,6 +66,7 @@ class Palette:
     conflict: str
     conflict_fill: str
     cursor: str
+    walk: str
     # False: no cell fills (a terminal without colours, or with only 16)
     filled: bool = True
     # the background of the characters under the keyboard cursor when cells are not filled
@@ -117,6 +118,7 @@ DARK = Palette(
     conflict="#ff5f5f",
     conflict_fill="#870000",
     cursor="#ff87ff",
+    walk="#5fafff",
 )
 
 # Pastel fills: dark edges and deep marks stay readable on each of them.
@@ -145,6 +147,7 @@ LIGHT = Palette(
     conflict="#d70000",
     conflict_fill="#ffafaf",
     cursor="#870087",
+    walk="#005fd7",
 )
 
 
@@ -154,11 +157,11 @@ LIGHT = Palette(
 # in the brightest (darkest) colour there is, which stays the brightest (darkest) grey.
 PLAIN_DARK = replace(
     DARK, filled=False, edge="#808080", site="#ffff00", vertex="#ff0000", delaunay="#008080",
-    cursor="#ff00ff", plain_highlight="#000080",
+    cursor="#ff00ff", walk="#00ffff", plain_highlight="#000080",
 )
 PLAIN_LIGHT = replace(
     LIGHT, filled=False, edge="#808080", site="#000000", vertex="#800000", delaunay="#008080",
-    cursor="#800080", plain_highlight="#c0c0c0",
+    cursor="#800080", walk="#000080", plain_highlight="#c0c0c0",
 )
 
 

@@ -11,6 +11,7 @@ COMMANDS = (
     ("Generate", "Make points from the panel's settings and show their diagram (g)", "app.generate"),
     ("Open", "Open a point file: CSV, GeoJSON, .npy, (Geo)Parquet (o)", "app.open"),
     ("Save", "Save the cells as GeoJSON, GeoJSONSeq or GeoParquet (s)", "app.save"),
+    ("Export", "Export the view (cells, edges, sites shown) as SVG or PNG (e)", "app.export"),
     ("Playback", "Step through the engine's algorithm, event by event (t)", "app.toggle_playback"),
     ("Engine", "Switch between the incremental algorithm and Fortune's sweep", "app.next_engine"),
     ("Delaunay", "Show or hide the Delaunay triangulation (d)", "app.toggle_delaunay"),

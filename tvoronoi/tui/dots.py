@@ -61,6 +61,18 @@ def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0) -> None:
     # depend on the line only, not on where it was cut, so a part of the canvas drawn
     # on its own gets the same dots as the whole
     steep = np.abs(v1 - v0) > np.abs(u1 - u0)
+    if dash <= 0:
+        # a segment of its own ends within one dot along its longer axis has one sample, in the
+        # dot of an end (the same column or row, a height between the ends'): its ends, drawn
+        # below, are all its dots. Most edges of a zoomed-out view are such.
+        short = own0 & own1 & np.where(steep, np.floor(v0) == np.floor(v1), np.floor(u0) == np.floor(u1))
+        if short.any():
+            cols_e = np.concatenate([u0[short], u1[short]])
+            rows_e = np.concatenate([v0[short], v1[short]])
+            long = ~short
+            u0, v0, u1, v1, own0, own1, steep = (u0[long], v0[long], u1[long], v1[long], own0[long],
+                                                 own1[long], steep[long])
+            _set_dots(dots, cols_e, rows_e)
     flat = ~steep
     cols_f, rows_f = _centre_samples(u0[flat], u1[flat], v0[flat], v1[flat], own0[flat], own1[flat], dash)
     rows_s, cols_s = _centre_samples(v0[steep], v1[steep], u0[steep], u1[steep], own0[steep], own1[steep], dash)
@@ -69,11 +81,17 @@ def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0) -> None:
         # the segment's own ends are always drawn
         cols += [u0[own0], u1[own1]]
         rows += [v0[own0], v1[own1]]
-    cols, rows = np.concatenate(cols), np.concatenate(rows)
-    # samples beyond the canvas (rounding, a cut end between two dot centres) belong to no dot here
+    _set_dots(dots, np.concatenate(cols), np.concatenate(rows))
+
+
+def _set_dots(dots: np.ndarray, cols: np.ndarray, rows: np.ndarray) -> None:
+    """Set the dots holding points (cols, rows) in continuous dot coordinates; points beyond the
+    canvas (rounding, a cut end between two dot centres) belong to no dot here."""
+    height, width = dots.shape
     inside = (cols >= 0) & (cols < width) & (rows >= 0) & (rows < height)
-    cols, rows = cols[inside].astype(np.int64), rows[inside].astype(np.int64)
-    dots.ravel()[rows * width + cols] = True
+    if not inside.all():
+        cols, rows = cols[inside], rows[inside]
+    dots.ravel()[rows.astype(np.int64) * width + cols.astype(np.int64)] = True
 
 
 def _centre_samples(a0, a1, b0, b1, own0, own1, dash: int):
@@ -106,7 +124,7 @@ def _centre_samples(a0, a1, b0, b1, own0, own1, dash: int):
     return a, b
 
 
-def _clip(u0, v0, u1, v1, width: int, height: int):
+def _clip(u0, v0, u1, v1, width: float, height: float):
     """Clip segments to [0, W) x [0, H) (Liang-Barsky, all at once); returns keep, t0, t1, u0, v0, u1, v1."""
     du, dv = u1 - u0, v1 - v0
     t0 = np.zeros_like(u0)

@@ -167,10 +167,15 @@ class EditingMixin:
         return True
 
     def _site_under_cursor(self) -> int | None:
-        """The site under the keyboard cursor if it is shown, else under the mouse pointer."""
+        """The site under the keyboard cursor if it is shown, else under the mouse pointer; None
+        (after saying how to put the cursor on one) when there is none."""
         canvas = self.canvas
         where = canvas.cursor if canvas.cursor is not None else canvas.pointer
-        return None if where is None else canvas.site_at(*where)
+        site = None if where is None else canvas.site_at(*where)
+        if site is None:
+            self.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
+                        severity="warning")
+        return site
 
     def _one_char(self) -> tuple[float, float]:
         scale = self.canvas.view.scale
@@ -204,8 +209,6 @@ class EditingMixin:
         """Delete the site under the cursor or the mouse pointer."""
         site = self._site_under_cursor()
         if site is None:
-            self.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
-                        severity="warning")
             return
         if self._moving is not None and self._moving[0] == site:
             self._moving = None
@@ -218,8 +221,6 @@ class EditingMixin:
             return
         site = self._site_under_cursor()
         if site is None:
-            self.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
-                        severity="warning")
             return
         live = self._editor()
         if live is None:

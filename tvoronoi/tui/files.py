@@ -1,4 +1,5 @@
-"""Opening point files and saving cells from the UI; the save runs in a worker thread."""
+"""Opening point files, saving cells and exporting the view from the UI; the save runs in a worker
+thread."""
 
 from __future__ import annotations
 
@@ -10,9 +11,11 @@ from textual.widgets import ProgressBar
 
 import tvoronoi
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.tui.screens import OpenDialog, OpenRequest, PathDialog
+from tvoronoi.tui.colours import palette_for
+from tvoronoi.tui.screens import ColumnsDialog, OpenDialog, OpenRequest, PathDialog
 
 DEFAULT_SAVE_NAME = "cells.geojson"
+DEFAULT_EXPORT_NAME = "view.svg"
 # The readers' messages advise the command line's --x/--y; in the UI the Open
 # dialog's column fields do that job. Replaced in this order (the longer phrases first).
 CLI_ADVICE = (
@@ -56,8 +59,13 @@ class FilesMixin:
     """The App's part that opens point files and saves the cells as GeoJSON."""
 
     _saving = False
-    # the last file asked for, to offer it again
+    # the last export's path, offered again
+    _last_export: str = DEFAULT_EXPORT_NAME
+    # the last file asked for, to offer it again, and its folder, where the Open dialog's tree starts
     _last_open: OpenRequest | None = None
+    _last_folder: Path | None = None
+    # a file opened without x and y columns given: once read, ask which columns if that was ambiguous
+    _columns_pending: OpenRequest | None = None
 
     def action_open(self) -> None:
         """Ask for a point file and show its diagram."""
@@ -67,6 +75,7 @@ class FilesMixin:
                 "Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv",
                 value="" if last is None else str(last.path),
                 x=None if last is None else last.x, y=None if last is None else last.y,
+                folder=self._last_folder,
             ),
             self._open_path,
         )
@@ -76,6 +85,10 @@ class FilesMixin:
         if request is None:
             return
         self._last_open = request
+        folder = request.path.expanduser().parent
+        if folder.is_dir():
+            self._last_folder = folder.resolve()
+        self._columns_pending = request if request.x is None and request.y is None else None
 
         def read():
             from tvoronoi.readers import read_points
@@ -86,6 +99,23 @@ class FilesMixin:
                 raise ReadFailed(ui_advice(str(exc))) from exc
 
         self._request_build(lambda: None, source=request.path.name, size=None, read=read)
+
+    def offer_columns(self) -> None:
+        """A file was just shown: if its x and y columns were taken by position among several
+        numeric ones, ask which columns are x and y (the reader's choice stays unless changed)."""
+        request, self._columns_pending = self._columns_pending, None
+        built = self.built
+        point_set = None if built is None else built.point_set
+        if request is None or point_set is None or not point_set.candidates:
+            return
+        chosen = point_set.xy_columns
+
+        def chosen_columns(columns: tuple[str, str] | None) -> None:
+            self.canvas.focus()
+            if columns is not None and tuple(columns) != tuple(chosen):
+                self._open_path(OpenRequest(request.path, *columns))
+
+        self.push_screen(ColumnsDialog(request.path.name, point_set.candidates, chosen), chosen_columns)
 
     def action_save(self) -> None:
         """Ask for a path and write the cells there as GeoJSON."""
@@ -148,3 +178,46 @@ class FilesMixin:
             self.notify(message.error, title="Not saved", severity="error", timeout=8, markup=False)
         else:
             self.notify(f"{message.count:,} cells written to {message.path}", title="Saved", markup=False)
+
+    # -- exporting the view ----------------------------------------------------
+
+    def action_export(self) -> None:
+        """Ask for a path and write the view there: .svg (vector) or .png."""
+        if self.built is None:
+            self._fail("there is no diagram to export")
+            return
+        self.push_screen(
+            PathDialog("Export the view as SVG or PNG (by the name's ending)", value=self._last_export,
+                       placeholder="view.svg", confirm_overwrite=True),
+            self._export_path,
+        )
+
+    def _export_path(self, path: Path | None) -> None:
+        self.canvas.focus()
+        if path is None or self.built is None:
+            return
+        self._last_export = str(path)
+        canvas = self.canvas
+        size = canvas.content_size
+        scene = canvas.scene
+        # the built diagram's cells are the scene's rows; an edited scene builds its own
+        diagram = self.built.diagram if scene is self.built.scene else None
+        dark = self.current_theme.dark
+        self._export_in_thread(scene, canvas.view, max(size.width, 1), max(size.height, 1), dark,
+                               canvas.show_delaunay, diagram, path)
+
+    @work(thread=True, group="export", exit_on_error=False)
+    def _export_in_thread(self, scene, view, cols: int, rows: int, dark: bool, delaunay: bool, diagram,
+                          path: Path) -> None:
+        from tvoronoi.tui.export import export_view, picture
+
+        try:
+            pic = picture(scene, view, cols, rows, palette_for(dark), dark=dark, delaunay=delaunay,
+                          diagram=diagram)
+            kind = export_view(pic, path)
+        except (TvoronoiError, OSError) as exc:
+            self.call_from_thread(self.notify, str(exc), title="Not exported", severity="error", timeout=8,
+                                  markup=False)
+            return
+        self.call_from_thread(self.notify, f"{len(pic.rings):,} cells and {len(pic.sites):,} sites written "
+                              f"to {path} ({kind})", title="Exported", markup=False)

@@ -31,6 +31,7 @@ FORTUNE = (
 )
 INCREMENTAL = (
     ("dot", "event", "the new site"),
+    ("line", "walk", "location walk"),
     ("line", "conflict", "conflict triangles"),
     ("fill", "conflict_fill", "the cavity"),
     ("dash", "growing", "new Delaunay edges"),

@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tvoronoi.tui.colours import cell_adjacency, repair_colours
-from tvoronoi.tui.raster import char_centres
+from tvoronoi.tui.raster import char_centres, ring_next, ring_segments
 
 # A ring point within this fraction of the box size of a box side lies on it.
 ON_BOX = 1e-9
@@ -93,13 +93,6 @@ class SegmentPool:
         self._start, self._room, self._end = offsets[:-1].copy(), counts.copy(), len(data)
 
 
-def _ring_segments(ring: np.ndarray) -> np.ndarray:
-    ring = np.asarray(ring, np.float64).reshape(-1, 2)
-    if len(ring) < 2:
-        return np.empty((0, 4))
-    return np.hstack([ring, np.roll(ring, -1, axis=0)])
-
-
 @dataclass(frozen=True)
 class Change:
     """One update: the cells it changed and the world box around their old and new shapes."""
@@ -136,9 +129,8 @@ class LiveScene:
         ring = np.asarray(diagram.cell_vertices, np.int64)
         points = np.asarray(diagram.cell_points, np.float64)
         sizes = np.diff(offsets)
-        nxt = np.arange(1, ring.size + 1)
         full = sizes > 0
-        nxt[offsets[1:][full] - 1] = offsets[:-1][full]
+        nxt = ring_next(offsets, ring.size)
         segs = np.hstack([points[ring], points[ring[nxt]]]) if ring.size else np.empty((0, 4))
         owner = np.repeat(np.arange(n), sizes)
         # each side shared by two cells is kept by the smaller id, as the updates do
@@ -281,7 +273,7 @@ class LiveScene:
             near = np.asarray(d.neighbours(i), np.int64) if len(ring) else np.empty(0, np.int64)
             near = near_of[i] = near[self._alive[near]]
             # a side shared with a smaller id is that cell's to draw
-            sides = _ring_segments(ring)
+            sides = ring_segments(ring)
             across = self._across(i, sides, near)
             self._cells.set(i, sides[(across < 0) | (across > i)])
             # the Delaunay links to larger ids

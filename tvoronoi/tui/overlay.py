@@ -4,7 +4,8 @@ Fortune: the sweep line, the beach line's arcs, pending circle events,
 growing edges, the event just handled, the sites not reached yet; the cells
 behind the beach line (which are final) are filled. Incremental: the diagram
 of the sites inserted so far, the new site, its conflict region and the cells
-it took area from.
+it took area from, and the location walk that found it (the triangles
+visited, and the hull edge it ended beyond when the site lies outside).
 """
 
 from __future__ import annotations
@@ -14,8 +15,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
-from tvoronoi.trace import parabola_y
+from tvoronoi.trace import FortuneStep, IncrementalStep, parabola_y
 from tvoronoi.tui.colours import adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, clip_segments
 from tvoronoi.tui.raster import (
@@ -29,9 +31,11 @@ from tvoronoi.tui.raster import (
     SPARSE_SITES_PER_CHAR,
     SWEEP,
     TINTED,
+    WALK,
     Painter,
     Scene,
     View,
+    ViewLike,
     char_centres,
     per_char,
 )
@@ -51,7 +55,7 @@ def _empty_segments() -> np.ndarray:
     return np.empty((0, 4))
 
 
-def _far_below(view: View, cols: int, rows: int) -> float:
+def _far_below(view: ViewLike, cols: int, rows: int) -> float:
     """A height this many canvas heights below the bottom of the view."""
     _, y = view.to_world(0.0, (1.0 + FAR_VIEWS) * rows * DOT_ROWS, cols, rows)
     return float(y)
@@ -63,6 +67,21 @@ def _triangle_segments(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     a = points[triangles.ravel()]
     b = points[triangles[:, [1, 2, 0]].ravel()]
     return np.hstack([a, b]) if len(a) else _empty_segments()
+
+
+def walk_segments(points: np.ndarray, walk: np.ndarray) -> np.ndarray:
+    """The sides of the triangles a location walk visited (w, 3 point rows, -1 at infinity), each
+    once: the finite triangles whole, of an infinite one its finite side (the hull edge)."""
+    walk = np.asarray(walk, np.int64).reshape(-1, 3)
+    if not len(walk):
+        return _empty_segments()
+    a, b = walk.ravel(), walk[:, [1, 2, 0]].ravel()
+    keep = (a >= 0) & (b >= 0)
+    a, b = a[keep], b[keep]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    _, first = np.unique(lo * len(points) + hi, return_index=True)
+    first = np.sort(first)
+    return np.hstack([points[a[first]], points[b[first]]])
 
 
 def _inside_triangles(xs: np.ndarray, ys: np.ndarray, corners: np.ndarray) -> np.ndarray:
@@ -78,7 +97,7 @@ def _inside_triangles(xs: np.ndarray, ys: np.ndarray, corners: np.ndarray) -> np
     return inside
 
 
-def circle_segments(circles: np.ndarray, scale: float, window=None) -> np.ndarray:
+def circle_segments(circles: npt.ArrayLike, scale: float, window=None) -> np.ndarray:
     """Outlines of circles (m, 3: cx, cy, r) as polygon sides (k, 4), fine enough for dots of ``scale``.
 
     With a ``window`` (x0, y0, x1, y1), the world box the canvas shows, only what lies in it is
@@ -132,9 +151,9 @@ def _arcs_in_window(circle: np.ndarray, scale: float, window) -> np.ndarray:
         if abs(y - cy) <= r:
             a = math.asin(min(max((y - cy) / r, -1.0), 1.0))
             cuts += [a % (2 * math.pi), (math.pi - a) % (2 * math.pi)]
-    cuts = np.unique(cuts)
+    angles = np.unique(cuts)
     parts = []
-    for t0, t1 in zip(cuts[:-1], cuts[1:]):
+    for t0, t1 in zip(angles[:-1], angles[1:]):
         mid = (t0 + t1) / 2
         mx, my = cx + r * math.cos(mid), cy + r * math.sin(mid)
         if not (x0 <= mx <= x1 and y0 <= my <= y1) or t1 <= t0:
@@ -166,7 +185,7 @@ def beach_heights(step, points: np.ndarray, xs: np.ndarray) -> np.ndarray:
 class FortuneOverlay:
     """What a Fortune step draws over the cells finished so far."""
 
-    step: object
+    step: FortuneStep
     points: np.ndarray
     future: np.ndarray      # (k, 2) sites beyond the sweep line
     bbox: tuple             # the diagram's box: edges are cut to it, as in the finished diagram
@@ -187,6 +206,7 @@ class FortuneOverlay:
             x1, _ = view.to_world(cols * DOT_COLS + 1.0, 0.0, cols, rows)
             paint.segments(SWEEP, [[float(x0), step.sweep_y, float(x1), step.sweep_y]])
         if step.kind == "circle":
+            assert step.vertex is not None, "a circle event creates a vertex"
             vx, vy = step.vertex
             # the circle that just emptied, and its centre: the new vertex
             paint.segments(EVENT, circle_segments([[vx, vy, step.sweep_y - vy]], view.scale, paint.world),
@@ -195,7 +215,7 @@ class FortuneOverlay:
         elif step.kind in ("site", "repeat"):
             paint.points(EVENT, [step.position], block=True)
 
-    def beach_segments(self, view: View, cols: int, rows: int) -> np.ndarray:
+    def beach_segments(self, view: ViewLike, cols: int, rows: int) -> np.ndarray:
         """The beach line as short segments: sampled at every dot column and at every breakpoint."""
         step = self.step
         beach = np.asarray(step.beach, np.int64)
@@ -243,18 +263,20 @@ class FortuneOverlay:
 class IncrementalOverlay:
     """What an insertion step draws over the diagram of the sites inserted so far."""
 
-    step: object
+    step: IncrementalStep
     points: np.ndarray
     future: np.ndarray          # (k, 2) sites not inserted yet
     conflict: np.ndarray        # (c, 3, 2) corners of the destroyed triangles
     new_edges: np.ndarray       # (e, 4) Delaunay edges of the new triangles
     stolen_rows: np.ndarray     # rows of scene.sites whose cells lost area
     bbox: tuple
+    walk: np.ndarray = dataclasses.field(default_factory=_empty_segments)  # (w, 4) sides visited
 
     def draw(self, paint: Painter) -> None:
         sparse = per_char(len(self.points), self, paint.view) < SPARSE_SITES_PER_CHAR
         paint.points(FUTURE, self.future, block=sparse)
         paint.segments(GROWING, self.new_edges, dash=DASH)
+        paint.segments(WALK, self.walk)
         corners = self.conflict
         if len(corners):
             sides = np.concatenate([np.hstack([corners[:, k], corners[:, (k + 1) % 3]]) for k in range(3)])
@@ -354,6 +376,7 @@ def incremental_picture(step, points: np.ndarray, colours: np.ndarray) -> tuple[
         new_edges=_triangle_segments(points, new_tri),
         stolen_rows=np.flatnonzero(np.isin(rows, step.stolen_from)),
         bbox=full.bbox,
+        walk=walk_segments(points, step.walk),
     )
     return scene, overlay
 

@@ -74,7 +74,7 @@ HELP = {
 # The actions that only make sense during playback, and those that wait until it ends
 # (which also leaves room in the footer for the playback keys).
 PLAYBACK_ACTIONS = {"play_pause", "step", "step_to", "jump", "speed", "toggle_follow"}
-PAUSED_ACTIONS = {"generate", "open", "save"}
+PAUSED_ACTIONS = {"generate", "open", "save", "export"}
 
 
 class Player:

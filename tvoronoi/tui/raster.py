@@ -8,8 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 from rich.segment import Segment
 from rich.style import Style
 from scipy.spatial import cKDTree
@@ -22,9 +24,9 @@ from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, braille_text, pack_braille, po
 # GROWING, CONFLICT, CIRCLE, BEACH, SWEEP and EVENT belong to algorithm playback,
 # CURSOR to editing: the lowest, so that a site or edge under the keyboard cursor
 # keeps its colour (the cursor's characters are lit up by their fill instead).
-(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, CONFLICT, CIRCLE, BEACH, SWEEP,
- VERTEX, SITE, EVENT) = range(13)
-N_MARKS = 13
+(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, WALK, CONFLICT, CIRCLE, BEACH, SWEEP,
+ VERTEX, SITE, EVENT) = range(14)
+N_MARKS = 14
 # Fills: -1 none, 0 .. N_FILLS - 1 the cell colours, TINTED + c the tinted
 # colour c, CONFLICT_FILL the inside of a conflict region, HIGHLIGHTED + c the
 # colour c under the keyboard cursor.
@@ -146,8 +148,57 @@ class Window:
                                   self.cols, self.rows)
 
 
+# What the rasterizer draws through: a whole canvas's view, or a part of it.
+ViewLike = View | Window
+
+
 # ---------------------------------------------------------------------------
 # the drawable form of a diagram
+
+def ring_next(offsets: np.ndarray, size: int) -> np.ndarray:
+    """Rings stored one after the other (ring i: entries ``offsets[i]:offsets[i + 1]`` of an array
+    of ``size``): for each entry, the index of the next entry round its ring, so that the sides of
+    every ring run from entry k to entry ``ring_next(...)[k]``. The one routine that turns rings
+    into sides, for the scene, the live scene and the export."""
+    offsets = np.asarray(offsets, np.int64)
+    nxt = np.arange(1, size + 1)
+    full = np.diff(offsets) > 0
+    nxt[offsets[1:][full] - 1] = offsets[:-1][full]
+    return nxt
+
+
+def ring_segments(points: np.ndarray) -> np.ndarray:
+    """The sides of one ring of points (k, 2) as (k, 4) segments, the last back to the first."""
+    points = np.asarray(points, np.float64).reshape(-1, 2)
+    if len(points) < 2:
+        return np.empty((0, 4))
+    return np.hstack([points, points[ring_next(np.array([0, len(points)]), len(points))]])
+
+
+def _cell_sides(a: np.ndarray, b: np.ndarray, points: np.ndarray, bbox) -> tuple[np.ndarray, np.ndarray]:
+    """The sides a -> b of every cell ring (indices of ``points``), each once.
+
+    Neighbouring cells share point indices and go round counter-clockwise, so a side between two
+    cells comes twice, once each way: the one from the smaller index is kept, and a side along the
+    box (one cell only) always. Should the rings not pair up so (every side inside the box twice),
+    the sides are made unique by sorting instead.
+    """
+    a = np.asarray(a, np.int64)
+    b = np.asarray(b, np.int64)
+    if not a.size:
+        return a, b
+    xmin, ymin, xmax, ymax = bbox
+    # per point, a bit for each side of the box it lies on; a side is along the box if its ends share one
+    sides = ((points[:, 0] == xmin).astype(np.uint8) | ((points[:, 0] == xmax).astype(np.uint8) << 1)
+             | ((points[:, 1] == ymin).astype(np.uint8) << 2) | ((points[:, 1] == ymax).astype(np.uint8) << 3))
+    on_box = (sides[a] & sides[b]) != 0
+    inner = ~on_box & (a != b)
+    first = inner & (a < b)
+    if 2 * int(first.sum()) == int(inner.sum()):
+        keep = first | (on_box & (a != b))
+        return a[keep], b[keep]
+    return _unique_pairs(a, b, len(points))
+
 
 def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Undirected pairs (a, b), each once, self pairs dropped."""
@@ -158,6 +209,42 @@ def _unique_pairs(a: np.ndarray, b: np.ndarray, n: int) -> tuple[np.ndarray, np.
     if key.size:
         key = key[np.r_[True, key[1:] != key[:-1]]]
     return key // max(n, 1), key % max(n, 1)
+
+
+class Drawable(Protocol):
+    """What the canvas draws and picks in: a ``Scene`` (a whole diagram, or some of its sites
+    during playback) or a ``LiveScene`` (a diagram edited in place).
+
+    ``version`` grows with every change made in place; ``changes_since(version)`` says which
+    sites and what world box changed since then (None: it cannot say, draw everything again),
+    and ``update_owner`` finds the owners of the characters those changes touched.
+    """
+
+    @property
+    def sites(self) -> np.ndarray: ...
+    @property
+    def edges(self) -> np.ndarray: ...
+    @property
+    def delaunay(self) -> np.ndarray: ...
+    @property
+    def vertices(self) -> np.ndarray: ...
+    @property
+    def colours(self) -> np.ndarray: ...
+    @property
+    def bbox(self) -> tuple: ...
+    @property
+    def n_sites(self) -> int: ...
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def version(self) -> int: ...
+
+    def nearest(self, points: np.ndarray) -> np.ndarray: ...
+    def site_ids(self) -> np.ndarray | None: ...
+    def site_near(self, x: float, y: float, radius: float) -> int | None: ...
+    def drawn(self) -> np.ndarray: ...
+    def changes_since(self, version: int) -> tuple[np.ndarray, tuple | None] | None: ...
+    def update_owner(self, old: np.ndarray, ids: np.ndarray, view, cols: int, rows: int) -> np.ndarray: ...
 
 
 @dataclass(eq=False)
@@ -191,6 +278,23 @@ class Scene:
         return len(self.sites)
 
     @property
+    def version(self) -> int:
+        """A scene is never changed in place."""
+        return 0
+
+    def drawn(self) -> np.ndarray:
+        """Rows of ``sites`` that own a cell: all of them."""
+        return np.arange(len(self.sites))
+
+    def changes_since(self, version: int) -> None:
+        """Never changed in place: nothing to tell."""
+        return None
+
+    def update_owner(self, old: np.ndarray, ids: np.ndarray, view, cols: int, rows: int) -> np.ndarray:
+        """Never changed in place: the owners stay."""
+        return old
+
+    @property
     def n_vertices(self) -> int:
         return len(self.vertices)
 
@@ -221,13 +325,9 @@ class Scene:
         # every clipped cell ring, point to next point (wrapping round)
         offsets = np.asarray(diagram.cell_offsets, np.int64)
         ring = np.asarray(diagram.cell_vertices, np.int64)
-        nxt = np.arange(1, ring.size + 1)
-        sizes = np.diff(offsets)
-        full = sizes > 0
-        nxt[offsets[1:][full] - 1] = offsets[:-1][full]
+        nxt = ring_next(offsets, ring.size)
         points = np.asarray(diagram.cell_points, np.float64)
-        # neighbouring cells share point indices: keep each edge once
-        a, b = _unique_pairs(ring, ring[nxt] if ring.size else ring, len(points))
+        a, b = _cell_sides(ring, ring[nxt] if ring.size else ring, points, diagram.bbox)
         edges = np.hstack([points[a], points[b]]) if a.size else np.empty((0, 4))
 
         tri = np.asarray(diagram.delaunay_triangles(), np.int64).reshape(-1, 3)
@@ -282,7 +382,7 @@ class Frame:
     owner: np.ndarray
 
 
-def char_centres(view: View, cols: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
+def char_centres(view: ViewLike, cols: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
     """World x of each character column's centre (cols,) and y of each row's centre (rows,)."""
     u = (np.arange(cols) + 0.5) * DOT_COLS
     v = (np.arange(rows) + 0.5) * DOT_ROWS
@@ -291,7 +391,7 @@ def char_centres(view: View, cols: int, rows: int) -> tuple[np.ndarray, np.ndarr
     return xs, ys
 
 
-def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
+def cell_owner(scene: Drawable, view: ViewLike, cols: int, rows: int) -> np.ndarray:
     """The row of ``scene.sites`` whose cell holds each character's centre (-1 outside the box).
 
     The nearest site of the centre owns it: that is the Voronoi cell itself,
@@ -312,7 +412,7 @@ def cell_owner(scene: Scene, view: View, cols: int, rows: int) -> np.ndarray:
     return owner
 
 
-def fill_of(scene: Scene, owner: np.ndarray) -> np.ndarray:
+def fill_of(scene: Drawable, owner: np.ndarray) -> np.ndarray:
     """The palette index of each owner (-1 stays -1)."""
     fill = np.full(owner.shape, -1, np.int16)
     inside = owner >= 0
@@ -327,8 +427,9 @@ class Painter:
     layer with a dot in it.
     """
 
-    def __init__(self, view: View, cols: int, rows: int) -> None:
+    def __init__(self, view: ViewLike, cols: int, rows: int, cache: "LayerCache | None" = None) -> None:
         self.view, self.cols, self.rows = view, cols, rows
+        self.cache = cache
         self.shape = (rows * DOT_ROWS, cols * DOT_COLS)
         self.codes = np.zeros((rows, cols), np.uint8)
         self.mark = np.zeros((rows, cols), np.uint8)
@@ -353,35 +454,54 @@ class Painter:
     def new_dots(self) -> np.ndarray:
         return np.zeros(self.shape, bool)
 
-    def lay(self, layer: int, dots: np.ndarray) -> None:
-        """Merge a layer's dots into the frame."""
+    def lay(self, layer: int, dots: np.ndarray) -> np.ndarray:
+        """Merge a layer's dots into the frame; returns their bit patterns per character."""
         packed = pack_braille(dots)
+        self.lay_packed(layer, packed)
+        return packed
+
+    def lay_packed(self, layer: int, packed: np.ndarray) -> None:
+        """Merge a layer's bit patterns (rows, cols) into the frame."""
         self.codes |= packed
         np.maximum(self.mark, np.where(packed != 0, np.uint8(layer), np.uint8(0)), out=self.mark)
+
+    def from_cache(self, layer: int, key) -> bool:
+        """Lay a layer drawn before for this key (see ``LayerCache``); False if there is none."""
+        packed = None if self.cache is None or key is None else self.cache.get(key, self)
+        if packed is None:
+            return False
+        self.lay_packed(layer, packed)
+        return True
+
+    def _keep(self, key, packed: np.ndarray) -> None:
+        if self.cache is not None and key is not None:
+            self.cache.put(key, self, packed)
 
     def to_dots(self, xs, ys):
         return self.view.to_dots(xs, ys, self.cols, self.rows)
 
-    def segments(self, layer: int, seg: np.ndarray, *, dash: int = 0) -> None:
-        """World segments (k, 4) as x0, y0, x1, y1."""
+    def segments(self, layer: int, seg: npt.ArrayLike, *, dash: int = 0, key=None) -> None:
+        """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache."""
+        if self.from_cache(layer, key):
+            return
         seg = self._visible_segments(np.asarray(seg, np.float64).reshape(-1, 4))
-        if not len(seg):
-            return
         dots = self.new_dots()
-        u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
-        u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
-        segment_dots(dots, u0, v0, u1, v1, dash=dash)
-        self.lay(layer, dots)
+        if len(seg):
+            u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
+            u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
+            segment_dots(dots, u0, v0, u1, v1, dash=dash)
+        self._keep(key, self.lay(layer, dots))
 
-    def points(self, layer: int, xy: np.ndarray, *, block: bool = False) -> None:
-        """World points (k, 2)."""
-        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
-        if not len(xy):
+    def points(self, layer: int, xy: npt.ArrayLike, *, block: bool = False, key=None) -> None:
+        """World points (k, 2); ``key`` names them for the layer cache."""
+        if self.from_cache(layer, key):
             return
+        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
         dots = self.new_dots()
-        u, v = self.to_dots(xy[:, 0], xy[:, 1])
-        point_dots(dots, u, v, block=block)
-        self.lay(layer, dots)
+        if len(xy):
+            u, v = self.to_dots(xy[:, 0], xy[:, 1])
+            point_dots(dots, u, v, block=block)
+        self._keep(key, self.lay(layer, dots))
 
     def cross(self, layer: int, x: float, y: float) -> np.ndarray:
         """A small cross centred on the world point (x, y); the (rows, cols) mask of its characters."""
@@ -394,9 +514,43 @@ class Painter:
         return pack_braille(dots) != 0
 
 
+class LayerCache:
+    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last frames, as bit
+    patterns per character, so that a frame that differs only in another layer (Delaunay shown or
+    hidden, vertices, an overlay) does not draw them again.
+
+    An entry holds its scene (so its id cannot be reused while the entry lives) and is found only
+    for the same scene, version, view and size; ``rasterize`` keeps the entries the last frame used.
+    """
+
+    def __init__(self) -> None:
+        self._entries: dict = {}
+        self._used: dict = {}
+
+    def _full_key(self, key, paint: "Painter"):
+        scene, rest = key
+        return (id(scene), scene.version, paint.view, paint.cols, paint.rows, rest)
+
+    def get(self, key, paint: "Painter") -> np.ndarray | None:
+        full = self._full_key(key, paint)
+        entry = self._entries.get(full)
+        if entry is None or entry[0] is not key[0]:
+            return None
+        self._used[full] = entry
+        return entry[1]
+
+    def put(self, key, paint: "Painter", packed: np.ndarray) -> None:
+        full = self._full_key(key, paint)
+        self._entries[full] = self._used[full] = (key[0], packed)
+
+    def frame_done(self) -> None:
+        """Keep what this frame used (the previous frames' other entries go)."""
+        self._entries, self._used = self._used, {}
+
+
 def rasterize(
-    scene: Scene,
-    view: View,
+    scene: Drawable,
+    view: ViewLike,
     cols: int,
     rows: int,
     *,
@@ -406,6 +560,7 @@ def rasterize(
     cursor: tuple[float, float] | None = None,
     owner: np.ndarray | None = None,
     site_blocks: bool = False,
+    layers: LayerCache | None = None,
 ) -> Frame:
     """Draw a scene into a frame of ``cols x rows`` characters.
 
@@ -414,17 +569,20 @@ def rasterize(
     ``cursor`` is a world point marked with a cross; ``owner`` is the
     ``cell_owner`` of this scene and view when the caller already has it;
     ``site_blocks`` draws every site as a block of dots (else only where
-    sites are sparse), for a picture without fills.
+    sites are sparse), for a picture without fills. ``layers``, if given, keeps the diagram's
+    layers of this frame and gives back those of the last one that are the same.
     """
-    paint = Painter(view, cols, rows)
+    paint = Painter(view, cols, rows, layers)
     if delaunay and len(scene.delaunay):
-        paint.segments(DELAUNAY, scene.delaunay)
-    paint.segments(EDGE, scene.edges)
+        paint.segments(DELAUNAY, scene.delaunay, key=(scene, "delaunay"))
+    paint.segments(EDGE, scene.edges, key=(scene, "edges"))
     if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
-        paint.points(VERTEX, scene.vertices)
+        paint.points(VERTEX, scene.vertices, key=(scene, "vertices"))
     if scene.n_sites:
         sparse = site_blocks or per_char(scene.n_sites, scene, view) < SPARSE_SITES_PER_CHAR
-        paint.points(SITE, scene.sites, block=sparse)
+        paint.points(SITE, scene.sites, block=sparse, key=(scene, ("sites", sparse)))
+    if layers is not None:
+        layers.frame_done()
     if overlay is not None:
         overlay.draw(paint)
     under_cursor = None if cursor is None else paint.cross(CURSOR, *cursor)
@@ -455,7 +613,7 @@ def redraw_part(frame: Frame, scene, view: View, cols: int, rows: int, span, *, 
         whole[r0:r1, c0:c1] = piece
 
 
-def per_char(count: int, scene, view: View) -> float:
+def per_char(count: int, scene, view: ViewLike) -> float:
     """About how many of ``count`` marks spread over the box share one character."""
     xmin, ymin, xmax, ymax = scene.bbox
     char_w, char_h = view.scale * DOT_COLS, view.scale * DOT_ROWS
@@ -475,6 +633,7 @@ def style_table(palette: Palette) -> tuple[Style, ...]:
         DELAUNAY: (palette.delaunay, False),
         EDGE: (palette.edge, True),
         GROWING: (palette.growing, True),
+        WALK: (palette.walk, True),
         CONFLICT: (palette.conflict, True),
         CIRCLE: (palette.circle, False),
         BEACH: (palette.beach, True),

@@ -2,8 +2,9 @@
 
 Fortune: the next events of the queue (site or circle, and where), the beach
 line's arcs in order (a window about the current arc when it is long), and the
-vertices and edges so far. Incremental: the site inserted, its cavity and the
-cells that lost area to it.
+vertices and edges so far. Incremental: the site inserted, the location walk
+that found it (the triangles visited), its cavity and the cells that lost area
+to it.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ NEXT_EVENTS = 4
 ARCS_EACH_SIDE = 2
 # Cells that lost area listed by id.
 LOSERS_LISTED = 8
+# Triangles of the location walk listed: the first ones and the last (where it ended).
+WALK_LISTED = 4
 
 
 def _count(n: int, noun: str) -> str:
@@ -113,6 +116,7 @@ def incremental_state(step) -> Text:
         return text
     text.append(f"Site {step.site} inserted", style="bold")
     text.append(f"\n  {step.index} of {step.n_steps}")
+    _walk_lines(text, step)
     text.append("\nCavity", style="bold")
     n_conflict = len(step.conflict)
     text.append(f"\n  {_count(n_conflict, 'triangle')} in conflict")
@@ -128,3 +132,28 @@ def incremental_state(step) -> Text:
     text.append(f"\n  {_count(len(step.inserted), 'site')}")
     text.append(f"\n  {d.n_vertices} vertices")
     return text
+
+
+def _triangle(tri) -> str:
+    return " ".join("∞" if v < 0 else str(int(v)) for v in tri)
+
+
+def _walk_lines(text: Text, step) -> None:
+    """The location walk: how many triangles it visited, the first few and the one it ended in."""
+    walk = np.asarray(step.walk, np.int64).reshape(-1, 3)
+    if not len(walk):
+        text.append("\nLocation: the first triangle", style="bold")
+        return
+    text.append(f"\nLocation walk: {_count(len(walk), 'triangle')}", style="bold")
+    shown = list(range(min(len(walk), WALK_LISTED)))
+    if len(walk) > WALK_LISTED:
+        shown[-1] = len(walk) - 1
+    for n, i in enumerate(shown):
+        if n and i != shown[n - 1] + 1:
+            text.append(f"\n  … {i - shown[n - 1] - 1} more", style="dim")
+        last = i == len(walk) - 1
+        text.append(f"\n{'▶ ' if last else '  '}{_triangle(walk[i])}", style="bold" if last else "")
+    if (walk[-1] < 0).any():
+        text.append("\n  beyond the hull: outside", style="dim")
+    else:
+        text.append("\n  holds the site", style="dim")
