@@ -506,13 +506,38 @@ def test_hard_families_finish(kind, tmp_path):
 # ---------------------------------------------------------------------------------------------------------
 # the stages of the event order are all exercised, and trouble is an error, not a crash
 
+def two_circles_with_one_top():
+    """The integer points of two circles whose tops are at one height but whose radii differ (5 about
+    (0, 0), 10 about (40, -5)), the top points left out: equal tops that no shift along x relates."""
+    pts = []
+    for (cx, cy), r in (((0, 0), 5), ((40, -5), 10)):
+        pts += [(cx + x, cy + y) for x in range(-r, r + 1) for y in range(-r, r + 1)
+                if x * x + y * y == r * r and (x, y) != (0, r)]
+    return np.array(pts, float)
+
+
 def test_every_stage_of_the_event_order_runs():
-    """An exact lattice has exactly equal tops (integers decide), sites within 1e-16 of two lines have
-    near ties that the rises settle; both sweeps stay exact."""
-    _, _, out, _ = check_sweep(lattice(8, "square", 0.0, 0.0, SEED))
+    """Equal tops of circles of different sizes: exact integers decide; sites within 1e-16 of two lines
+    have near ties that the rises settle; every sweep stays exact."""
+    _, _, out, _ = check_sweep(two_circles_with_one_top(), against_all=True)
     assert out["exact_tests"][1] > 0
     _, _, out, _ = check_sweep(parallel_lines(300, 1.0, 1e-16, SEED))
     assert out["near_ties"][0] > 0
+
+
+@pytest.mark.parametrize("kind", ["square", "triangular"])
+@pytest.mark.parametrize("scale", [1.0, 0.125, 3.0])
+def test_lattice_rows_are_settled_without_the_integer_fallback(kind, scale):
+    """A lattice row parallel to the sweep line puts many events at one exact height (congruent circles side
+    by side, several triples of one cocircular square); an exact shift along x proves those ties
+    (a 1000 x 1000 grid took 54 s when each went to the integer fallback, 5 s now). The sweep stays exact."""
+    pts = lattice(12, kind, 0.0, 0.0, SEED)
+    if kind == "triangular":
+        pts = np.round(pts * 8) / 8            # rows at exact heights, coordinates exact in binary
+    pts = pts * scale + 1000.0                 # exact: a power of two or a small integer, and an offset
+    _, _, out, _ = check_sweep(pts)
+    assert out["near_ties"][0] > 0
+    assert out["exact_tests"][1] == 0
 
 
 def test_an_inconsistent_sweep_is_a_tvoronoi_error(monkeypatch):

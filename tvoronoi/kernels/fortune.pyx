@@ -19,7 +19,7 @@ from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.circle_events cimport (
     circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_order, fine_site,
 )
-from tvoronoi.kernels.event_order_exact cimport tvb_site_first, tvb_top_order
+from tvoronoi.kernels.event_order_exact cimport same_top_by_shift, tvb_site_first, tvb_top_order
 from tvoronoi.kernels.sweep_state cimport (
     Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
     OK, BROKEN, NO_MEMORY, NO_REPAIR,
@@ -119,6 +119,8 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
             return c
     event_sites(s, i, ti)
     event_sites(s, j, tj)
+    if same_top_by_shift(ti, tj):
+        return 0            # degenerate case: one circle, or congruent circles side by side (a lattice)
     s.n_exact_circle += 1
     c = tvb_top_order(ti, tj)
     if c == 2:
