@@ -325,6 +325,40 @@ def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(mon
     assert drawn == [1, 1, 0, 1, 1, 1]
 
 
+def test_the_layer_cache_keeps_recent_views_and_lets_other_scenes_go(monkeypatch):
+    """Coming back to a view of the last few frames (fit after a zoom, Delaunay shown again)
+    draws nothing again and gives the same frame as a fresh drawing; an older view, or a view of
+    a scene replaced since, is drawn again."""
+    from tvoronoi.tui import raster
+    from tvoronoi.tui.raster import LAYER_FRAMES_KEPT, LayerCache
+
+    scene = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=6)))
+    other = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=7)))
+    fit = View.fit(scene.bbox, 60, 24)
+    calls = []
+    real = raster.segment_dots
+    monkeypatch.setattr(raster, "segment_dots", lambda *a, **k: (calls.append(len(a[1])), real(*a, **k)))
+    cache = LayerCache()
+
+    def drawn(sc, view, tri=False) -> int:
+        calls.clear()
+        cached = rasterize(sc, view, 60, 24, delaunay=tri, layers=cache)
+        count = len(calls)
+        fresh = rasterize(sc, view, 60, 24, delaunay=tri)
+        assert np.array_equal(cached.codes, fresh.codes) and np.array_equal(cached.mark, fresh.mark)
+        return count
+
+    assert drawn(scene, fit, True) == 2            # edges and Delaunay edges
+    assert drawn(scene, fit.zoomed(2)) == 1         # a new view: its edges
+    assert drawn(scene, fit) == 0                   # fit again: kept
+    assert drawn(scene, fit.zoomed(2), True) == 1   # the Delaunay edges of that view are new
+    for k in range(LAYER_FRAMES_KEPT):
+        drawn(scene, fit.panned(k + 1, 0))
+    assert drawn(scene, fit) == 1                   # too many frames ago: drawn again
+    drawn(other, fit)
+    assert drawn(scene, fit) == 1                   # the other scene's frame let this one go
+
+
 def test_the_layer_cache_follows_a_live_scene_edited_in_place():
     from tvoronoi.tui.building import build
     from tvoronoi.tui.editing import make_live

@@ -41,6 +41,8 @@ SPARSE_SITES_PER_CHAR = 0.05
 # Vertex marks are drawn only below this many vertices per character: denser, they
 # would recolour most edge characters and hide the edges they mark.
 VERTEX_MARKS_PER_CHAR = 0.12
+# The layer cache keeps the layers of this many recent frames.
+LAYER_FRAMES_KEPT = 4
 # Fitting the box leaves this fraction of the canvas free around it.
 FIT_MARGIN = 0.04
 
@@ -515,17 +517,20 @@ class Painter:
 
 
 class LayerCache:
-    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last frames, as bit
+    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last few frames, as bit
     patterns per character, so that a frame that differs only in another layer (Delaunay shown or
-    hidden, vertices, an overlay) does not draw them again.
+    hidden, vertices, an overlay), or that comes back to a recent view (fit after a zoom), does not
+    draw them again.
 
     An entry holds its scene (so its id cannot be reused while the entry lives) and is found only
-    for the same scene, version, view and size; ``rasterize`` keeps the entries the last frame used.
+    for the same scene, version, view and size. ``rasterize`` calls ``frame_done`` after each
+    frame: the entries of the last ``frames`` frames are kept, those of other scenes dropped.
     """
 
-    def __init__(self) -> None:
-        self._entries: dict = {}
+    def __init__(self, frames: int = LAYER_FRAMES_KEPT) -> None:
+        self.frames = frames
         self._used: dict = {}
+        self._history: list[dict] = []  # the entries of the frames before, oldest first
 
     def _full_key(self, key, paint: "Painter"):
         scene, rest = key
@@ -533,19 +538,26 @@ class LayerCache:
 
     def get(self, key, paint: "Painter") -> np.ndarray | None:
         full = self._full_key(key, paint)
-        entry = self._entries.get(full)
+        entry = self._used.get(full)
+        for older in reversed(self._history):
+            if entry is not None:
+                break
+            entry = older.get(full)
         if entry is None or entry[0] is not key[0]:
             return None
         self._used[full] = entry
         return entry[1]
 
     def put(self, key, paint: "Painter", packed: np.ndarray) -> None:
-        full = self._full_key(key, paint)
-        self._entries[full] = self._used[full] = (key[0], packed)
+        self._used[self._full_key(key, paint)] = (key[0], packed)
 
     def frame_done(self) -> None:
-        """Keep what this frame used (the previous frames' other entries go)."""
-        self._entries, self._used = self._used, {}
+        """Keep what this frame used with the last frames' entries; a scene this frame did not
+        draw is let go."""
+        scenes = {id(entry[0]) for entry in self._used.values()}
+        kept = [{k: e for k, e in frame.items() if id(e[0]) in scenes} for frame in self._history]
+        self._history = [frame for frame in kept + [self._used] if frame][-self.frames:]
+        self._used = {}
 
 
 def rasterize(
