@@ -268,7 +268,8 @@ class DiagramCanvas(Widget, can_focus=True):
             width, height = self._canvas_size()
             fitted = View.fit(self.scene.bbox, width, height).scale
             scale = min(max(view.scale, fitted / MAX_ZOOM_IN), fitted * MAX_ZOOM_OUT)
-            view = View(view.cx, view.cy, scale)
+            if scale != view.scale:
+                view = View(view.cx, view.cy, scale)
         self.fitted = False
         self.view = view
         self.post_message(self.ViewChanged(view))
@@ -276,11 +277,13 @@ class DiagramCanvas(Widget, can_focus=True):
     # -- actions -------------------------------------------------------------
 
     def action_pan(self, right: int, down: int) -> None:
-        """Pan by a tenth of the canvas (right, down are -1, 0 or 1)."""
+        """Pan by about a tenth of the canvas (right, down are -1, 0 or 1), in whole characters,
+        so that the layers drawn before are moved rather than drawn again."""
         self._keep_fitted()
         width, height = self._canvas_size()
         step = PAN_STEP * min(width * DOT_COLS, height * DOT_ROWS)
-        self._set_view(self.view.panned(right * step, down * step))
+        step_cols, step_rows = max(round(step / DOT_COLS), 1), max(round(step / DOT_ROWS), 1)
+        self._set_view(self.view.panned(right * step_cols * DOT_COLS, down * step_rows * DOT_ROWS))
 
     def action_zoom(self, direction: int) -> None:
         """Zoom in (1) or out (-1) about the centre."""
