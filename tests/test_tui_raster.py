@@ -464,3 +464,19 @@ def test_scene_edges_are_each_cell_side_once(name):
     got = [tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in edges]
     assert len(got) == len(set(got)) == len(expected)
     assert set(got) == expected
+
+
+def test_the_scene_finds_its_delaunay_edges_when_first_shown():
+    """A scene from a diagram finds its Delaunay edges only when asked, and they are scipy's
+    Delaunay edges, each once."""
+    from scipy.spatial import Delaunay
+
+    points = generate("uniform", 700, seed=9)
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    assert scene.delaunay_edges is None and scene.triangles is not None
+    edges = scene.delaunay
+    assert scene.delaunay is edges and scene.triangles is None
+    tri = Delaunay(points).simplices
+    expected = {frozenset(map(tuple, points[[a, b]].tolist())) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    got = [frozenset(map(tuple, (e[:2].tolist(), e[2:].tolist()))) for e in edges]
+    assert len(got) == len(set(got)) and set(got) == expected

@@ -302,8 +302,9 @@ class Scene:
     sites : (n, 2) float64
     edges : (e, 4) float64
         Clipped Voronoi edges (the box outline included) as x0, y0, x1, y1, each once.
-    delaunay : (t, 4) float64
-        Delaunay edges, each once.
+    delaunay_edges : (t, 4) float64, or None
+        Delaunay edges, each once; None to find them from ``triangles`` when first
+        shown (``delaunay``), which a large diagram's start need not wait for.
     vertices : (m, 2) float64
         Voronoi vertices inside the box.
     colours : (n,) int8
@@ -313,11 +314,22 @@ class Scene:
 
     sites: np.ndarray
     edges: np.ndarray
-    delaunay: np.ndarray
+    delaunay_edges: np.ndarray | None
     vertices: np.ndarray
     colours: np.ndarray
     bbox: tuple
+    triangles: np.ndarray | None = field(default=None, repr=False)
     _tree: cKDTree | None = field(default=None, repr=False)
+
+    @property
+    def delaunay(self) -> np.ndarray:
+        """The Delaunay edges (t, 4), each once, found from the triangles on first use."""
+        if self.delaunay_edges is None:
+            tri = np.empty((0, 3), np.int64) if self.triangles is None else self.triangles
+            a, b = _unique_pairs(tri.ravel(), tri[:, [1, 2, 0]].ravel(), len(self.sites))
+            self.delaunay_edges = np.hstack([self.sites[a], self.sites[b]]) if a.size else np.empty((0, 4))
+            self.triangles = None
+        return self.delaunay_edges
 
     @property
     def n_sites(self) -> int:
@@ -377,10 +389,6 @@ class Scene:
         edges = np.hstack([points[a], points[b]]) if a.size else np.empty((0, 4))
 
         tri = np.asarray(diagram.delaunay_triangles(), np.int64).reshape(-1, 3)
-        ta = tri.ravel()
-        tb = tri[:, [1, 2, 0]].ravel()
-        a, b = _unique_pairs(ta, tb, len(sites))
-        delaunay = np.hstack([sites[a], sites[b]]) if a.size else np.empty((0, 4))
 
         xmin, ymin, xmax, ymax = diagram.bbox
         vertices = np.asarray(diagram.vertices, np.float64).reshape(-1, 2)
@@ -391,10 +399,11 @@ class Scene:
         return cls(
             sites=sites,
             edges=edges,
-            delaunay=delaunay,
+            delaunay_edges=None,
             vertices=vertices[inside],
             colours=cell_colours(diagram) if colours is None else np.asarray(colours, np.int8),
             bbox=tuple(float(c) for c in diagram.bbox),
+            triangles=tri,
         )
 
     @property
