@@ -149,6 +149,7 @@ class DiagramCanvas(Widget, can_focus=True):
         self._base_key: tuple | None = None
         self._frame_version = 0
         self._frame_cursor: tuple[float, float] | None = None
+        self._owner_key: tuple | None = None
         self._press: tuple[int, int] | None = None
         self._drag_from: tuple[int, int] | None = None
         self._grabbed: int | None = None
@@ -390,14 +391,21 @@ class DiagramCanvas(Widget, can_focus=True):
             self._frame = None
             self._lines = [[] for _ in range(size.height)]
         elif base != self._base_key or not self._redraw_changes(scene, size, palette):
+            # the cells under the characters stay while the scene, its version, the view and size do
+            # (the scene itself is held, so that another scene cannot take its id)
+            same = (self._owner_key is not None and self._owner_key[0] is scene
+                    and self._owner_key[1:] == (version, self.view, size))
+            owner = self._frame.owner if self._frame is not None and same else None
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
                 overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled, layers=self._layers,
+                owner=owner,
             )
             self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
         self._frame_version, self._frame_cursor = version, self.cursor
+        self._owner_key = None if scene is None else (scene, version, self.view, size)
         return self._lines
 
     def palette(self) -> Palette:
