@@ -754,3 +754,30 @@ async def test_choosing_the_option_already_chosen_also_hands_the_keys_back():
         await pilot.press("enter", "escape")
         await pilot.pause()
         assert engine.has_focus
+
+
+@pilot_test
+async def test_toggling_a_layer_keeps_the_cells_under_the_characters(monkeypatch):
+    """Showing the Delaunay edges or moving the view by whole characters gives the frame a fresh
+    drawing gives; only a change of view finds the cells under the characters again."""
+    from tvoronoi.tui import raster
+
+    calls = []
+    real = raster.cell_owner
+    monkeypatch.setattr(raster, "cell_owner", lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    app = make_app()
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        canvas = app.canvas
+        for key, finds in (("d", False), ("right", True), ("d", False), ("down", True), ("plus", True)):
+            calls.clear()
+            await pilot.press(key)
+            await pilot.pause()
+            frame = canvas._frame
+            assert bool(calls) == finds, key
+            width, height = canvas.content_size.width, canvas.content_size.height
+            fresh = raster.rasterize(canvas.scene, canvas.view, width, height, delaunay=canvas.show_delaunay,
+                                     vertices=canvas.show_vertices, site_blocks=not canvas.palette().filled)
+            for a, b in ((frame.codes, fresh.codes), (frame.mark, fresh.mark), (frame.fill, fresh.fill),
+                         (frame.owner, fresh.owner)):
+                assert np.array_equal(a, b), key

@@ -415,6 +415,30 @@ def test_neighbours_keep_their_colours(live_case):
     assert no_colour_clash(live)
 
 
+def test_nearest_after_edits_measures_a_few_points_without_the_tree(live_case):
+    """After an edit, a few points (the inspector's) are matched to their nearest live cell owner
+    without rebuilding the k-d tree; the answers are those of a fresh tree and of brute force."""
+    from scipy.spatial import cKDTree
+
+    _, live = live_case
+    rng = np.random.default_rng(11)
+    for k in range(6):
+        live.insert(*(0.05 + 0.9 * rng.random(2)))
+        if k % 2:
+            live.remove(int(rng.choice(np.flatnonzero(live._alive))))
+        points = rng.random((5, 2))
+        got = live.nearest(points)
+        assert live._tree is None
+        ids = live.drawn()
+        _, k_tree = cKDTree(live.sites[ids]).query(points)
+        assert np.array_equal(got, ids[k_tree])
+        d2 = ((live.sites[ids][None, :, :] - points[:, None, :]) ** 2).sum(axis=2)
+        assert np.array_equal(got, ids[np.argmin(d2, axis=1)])
+    many = rng.random((50, 2))
+    assert np.array_equal(live.nearest(many)[:5], live.nearest(many[:5]))
+    assert live._tree is not None
+
+
 def test_edits_far_from_the_view_redraw_nothing(live_case):
     _, live = live_case
     view = View(0.1, 0.1, 0.0005)  # zoomed in near a corner

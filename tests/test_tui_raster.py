@@ -9,7 +9,7 @@ import tvoronoi
 from conftest import DATASETS
 from tvoronoi.generators import generate
 from tvoronoi.tui.colours import DARK, LIGHT, cell_adjacency, cell_colours, colour_graph
-from tvoronoi.tui.dots import BRAILLE_BLANK, braille_text, pack_braille, point_dots, segment_dots
+from tvoronoi.tui.dots import BRAILLE_BLANK, DOT_COLS, DOT_ROWS, braille_text, pack_braille, point_dots, segment_dots
 from tvoronoi.tui.raster import EDGE, SITE, Scene, View, frame_lines, rasterize
 
 
@@ -325,6 +325,97 @@ def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(mon
     assert drawn == [1, 1, 0, 1, 1, 1]
 
 
+def test_the_layer_cache_keeps_recent_views_and_lets_other_scenes_go(monkeypatch):
+    """Coming back to a view of the last few frames (fit after a zoom, Delaunay shown again)
+    draws nothing again and gives the same frame as a fresh drawing; an older view, or a view of
+    a scene replaced since, is drawn again."""
+    from tvoronoi.tui import raster
+    from tvoronoi.tui.raster import LAYER_FRAMES_KEPT, LayerCache
+
+    scene = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=6)))
+    other = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=7)))
+    fit = View.fit(scene.bbox, 60, 24)
+    calls = []
+    real = raster.segment_dots
+    monkeypatch.setattr(raster, "segment_dots", lambda *a, **k: (calls.append(len(a[1])), real(*a, **k)))
+    cache = LayerCache()
+
+    def drawn(sc, view, tri=False) -> int:
+        calls.clear()
+        cached = rasterize(sc, view, 60, 24, delaunay=tri, layers=cache)
+        count = len(calls)
+        fresh = rasterize(sc, view, 60, 24, delaunay=tri)
+        assert np.array_equal(cached.codes, fresh.codes) and np.array_equal(cached.mark, fresh.mark)
+        return count
+
+    assert drawn(scene, fit, True) == 2            # edges and Delaunay edges
+    assert drawn(scene, fit.zoomed(2)) == 1         # a new view: its edges
+    assert drawn(scene, fit) == 0                   # fit again: kept
+    assert drawn(scene, fit.zoomed(2), True) == 1   # the Delaunay edges of that view are new
+    for k in range(LAYER_FRAMES_KEPT):
+        drawn(scene, fit.zoomed(3 + k))
+    assert drawn(scene, fit) == 1                   # too many frames ago: drawn again
+    drawn(other, fit)
+    assert drawn(scene, fit) == 1                   # the other scene's frame let this one go
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(-9, 30), st.integers(-9, 30), st.sampled_from([0, 2]))
+def test_a_window_of_the_dot_plane_gets_the_dots_of_the_whole(seed, ou, ov, dash):
+    """Segments drawn into a window of the dot plane (any origin, segments crossing its sides)
+    set exactly the dots a larger window sets there, and those of the segment-by-segment
+    reference: no sample depends on where the window cuts a segment."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-20.0, 60.0, (200, 2))
+    q = p + rng.normal(0.0, rng.choice([0.5, 4.0, 40.0]), (200, 2))
+    half = rng.random(200) < 0.3  # ends on dot borders and centres too
+    p[half], q[half] = np.round(p[half] * 2) / 2, np.round(q[half] * 2) / 2
+    whole = np.zeros((48, 40), bool)  # the plane's dots (0, 0) .. (40, 48)
+    segment_dots(whole, p[:, 0], p[:, 1], q[:, 0], q[:, 1], dash=dash)
+    if not dash:
+        assert (whole == reference_dots(whole.shape, *p.T, *q.T)).all()
+    part = np.zeros((12, 16), bool)
+    segment_dots(part, p[:, 0], p[:, 1], q[:, 0], q[:, 1], dash=dash, origin=(ou, ov))
+    rows, cols = np.mgrid[ov:ov + 12, ou:ou + 16]
+    on_whole = (rows >= 0) & (rows < 48) & (cols >= 0) & (cols < 40)
+    assert (part[on_whole] == whole[rows[on_whole], cols[on_whole]]).all()
+
+
+@pytest.mark.parametrize("zoom", [1.0, 3.0, 40.0])
+def test_a_panned_layer_shifted_from_the_cache_equals_a_fresh_drawing(monkeypatch, zoom):
+    """Panning by whole characters moves the cached layers and draws only the characters they
+    lack: every frame equals one drawn afresh, dot for dot, in every direction and by more than
+    the canvas; only the strips are drawn (few sites and edges), and a pan by part of a
+    character draws the whole layer."""
+    from tvoronoi.tui import raster
+    from tvoronoi.tui.raster import LayerCache
+
+    diagram = tvoronoi.voronoi(generate("uniform", 3000, seed=8))
+    scene = Scene.from_diagram(diagram)
+    cols, rows = 48, 20
+    view = View.fit(diagram.bbox, cols, rows).zoomed(zoom)
+    sizes = []
+    real = raster.segment_dots
+    monkeypatch.setattr(raster, "segment_dots", lambda *a, **k: (sizes.append(a[0].size), real(*a, **k)))
+    cache = LayerCache()
+    rasterize(scene, view, cols, rows, delaunay=True, layers=cache)
+    sizes.clear()
+    rasterize(scene, view.panned(1, 0), cols, rows, delaunay=True, layers=cache)
+    assert sizes == [cols * rows * DOT_COLS * DOT_ROWS] * 2
+    for dx, dy in [(1, 0), (0, 1), (-3, 2), (5, -4), (-1, -1), (cols + 2, 0), (0, -rows - 1), (7, 3)]:
+        view = view.panned(dx * DOT_COLS, dy * DOT_ROWS)
+        sizes.clear()
+        cached = rasterize(scene, view, cols, rows, delaunay=True, layers=cache)
+        drawn = sum(sizes)
+        fresh = rasterize(scene, view, cols, rows, delaunay=True)
+        for a, b in ((cached.codes, fresh.codes), (cached.mark, fresh.mark), (cached.fill, fresh.fill)):
+            assert np.array_equal(a, b)
+        if abs(dx) < cols and abs(dy) < rows:
+            # the dots drawn: those of the strips the pan uncovered, for the two layers
+            strips = (abs(dx) * rows + abs(dy) * cols) * DOT_COLS * DOT_ROWS
+            assert drawn <= 2 * strips
+
+
 def test_the_layer_cache_follows_a_live_scene_edited_in_place():
     from tvoronoi.tui.building import build
     from tvoronoi.tui.editing import make_live
@@ -373,3 +464,19 @@ def test_scene_edges_are_each_cell_side_once(name):
     got = [tuple(sorted(map(tuple, s.reshape(2, 2).tolist()))) for s in edges]
     assert len(got) == len(set(got)) == len(expected)
     assert set(got) == expected
+
+
+def test_the_scene_finds_its_delaunay_edges_when_first_shown():
+    """A scene from a diagram finds its Delaunay edges only when asked, and they are scipy's
+    Delaunay edges, each once."""
+    from scipy.spatial import Delaunay
+
+    points = generate("uniform", 700, seed=9)
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    assert scene.delaunay_edges is None and scene.triangles is not None
+    edges = scene.delaunay
+    assert scene.delaunay is edges and scene.triangles is None
+    tri = Delaunay(points).simplices
+    expected = {frozenset(map(tuple, points[[a, b]].tolist())) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    got = [frozenset(map(tuple, (e[:2].tolist(), e[2:].tolist()))) for e in edges]
+    assert len(got) == len(set(got)) and set(got) == expected

@@ -149,6 +149,7 @@ class DiagramCanvas(Widget, can_focus=True):
         self._base_key: tuple | None = None
         self._frame_version = 0
         self._frame_cursor: tuple[float, float] | None = None
+        self._owner_key: tuple | None = None
         self._press: tuple[int, int] | None = None
         self._drag_from: tuple[int, int] | None = None
         self._grabbed: int | None = None
@@ -268,7 +269,8 @@ class DiagramCanvas(Widget, can_focus=True):
             width, height = self._canvas_size()
             fitted = View.fit(self.scene.bbox, width, height).scale
             scale = min(max(view.scale, fitted / MAX_ZOOM_IN), fitted * MAX_ZOOM_OUT)
-            view = View(view.cx, view.cy, scale)
+            if scale != view.scale:
+                view = View(view.cx, view.cy, scale)
         self.fitted = False
         self.view = view
         self.post_message(self.ViewChanged(view))
@@ -276,11 +278,13 @@ class DiagramCanvas(Widget, can_focus=True):
     # -- actions -------------------------------------------------------------
 
     def action_pan(self, right: int, down: int) -> None:
-        """Pan by a tenth of the canvas (right, down are -1, 0 or 1)."""
+        """Pan by about a tenth of the canvas (right, down are -1, 0 or 1), in whole characters,
+        so that the layers drawn before are moved rather than drawn again."""
         self._keep_fitted()
         width, height = self._canvas_size()
         step = PAN_STEP * min(width * DOT_COLS, height * DOT_ROWS)
-        self._set_view(self.view.panned(right * step, down * step))
+        step_cols, step_rows = max(round(step / DOT_COLS), 1), max(round(step / DOT_ROWS), 1)
+        self._set_view(self.view.panned(right * step_cols * DOT_COLS, down * step_rows * DOT_ROWS))
 
     def action_zoom(self, direction: int) -> None:
         """Zoom in (1) or out (-1) about the centre."""
@@ -387,14 +391,21 @@ class DiagramCanvas(Widget, can_focus=True):
             self._frame = None
             self._lines = [[] for _ in range(size.height)]
         elif base != self._base_key or not self._redraw_changes(scene, size, palette):
+            # the cells under the characters stay while the scene, its version, the view and size do
+            # (the scene itself is held, so that another scene cannot take its id)
+            same = (self._owner_key is not None and self._owner_key[0] is scene
+                    and self._owner_key[1:] == (version, self.view, size))
+            owner = self._frame.owner if self._frame is not None and same else None
             self._frame = rasterize(
                 scene, self.view, size.width, size.height,
                 delaunay=self.show_delaunay, vertices=self.show_vertices,
                 overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled, layers=self._layers,
+                owner=owner,
             )
             self._lines = frame_lines(self._frame, palette)
         self._frame_key, self._base_key = key, base
         self._frame_version, self._frame_cursor = version, self.cursor
+        self._owner_key = None if scene is None else (scene, version, self.view, size)
         return self._lines
 
     def palette(self) -> Palette:

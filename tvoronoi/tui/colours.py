@@ -187,12 +187,12 @@ def cell_adjacency(diagram) -> tuple[np.ndarray, np.ndarray]:
     keep = (twins >= 0) & (faces >= 0)
     a = faces[keep]
     b = faces[twins[keep]]
-    keep = (b >= 0) & (a != b)
+    # each edge comes twice, a half-edge and its twin, once each way: the one from the lower
+    # face is kept (so half as much to sort), and the sort drops any pair that still repeats
+    keep = (b >= 0) & (a < b)
     a, b = a[keep], b[keep]
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
     n = max(int(diagram.n_sites), 1)
-    # each edge comes twice (a half-edge and its twin): sort and keep one of each
-    key = np.sort(lo * n + hi)
+    key = np.sort(a * n + b)
     key = key[np.r_[True, key[1:] != key[:-1]]] if key.size else key
     return key // n, key % n
 

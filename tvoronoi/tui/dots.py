@@ -17,107 +17,92 @@ DOT_BITS = np.array([[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]], np
 SPACE = 0x20
 
 
-def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0) -> None:
+def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tuple[int, int] = (0, 0)) -> None:
     """Set the dots along many segments at once.
 
-    Each segment is clipped to the dot array, then sampled once per dot
-    along its longer axis (a vectorised DDA), so consecutive samples touch
-    and a line has no gaps.
+    Each segment is sampled once per dot along its longer axis (a vectorised
+    DDA), so consecutive samples touch and a line has no gaps. The samples
+    depend on the segment only, never on the array: the array is a window on
+    an unbounded plane of dots, from dot ``origin`` on, and it gets exactly
+    the dots of that plane inside it. So two windows that overlap agree dot
+    for dot where they overlap (a layer drawn before can be shifted and only
+    the strip it lacks drawn).
 
     Parameters
     ----------
     dots : (H, W) bool, changed in place
     u0, v0, u1, v1 : (k,) float
-        Segment ends in continuous dot coordinates; they may lie outside.
-        Segments with a NaN end are skipped.
+        Segment ends in continuous dot coordinates of the plane; they may lie
+        outside the window. Segments with a NaN end are skipped.
     dash : int
-        If > 0, draw dashes: ``dash`` dots on, ``dash`` dots off.
+        If > 0, draw dashes: ``dash`` dots on, ``dash`` dots off (counted on the plane).
+    origin : (int, int)
+        The plane's dot (column, row) at the window's top left.
     """
     height, width = dots.shape
+    ou, ov = (int(o) for o in origin)
     u0, v0, u1, v1 = (np.asarray(c, np.float64).ravel() for c in (u0, v0, u1, v1))
     if u0.size == 0 or width == 0 or height == 0:
         return
-    # drop the segments wholly beyond one side
+    # drop the segments wholly beyond one side (and those with a NaN end)
     lo_u, hi_u = np.minimum(u0, u1), np.maximum(u0, u1)
     lo_v, hi_v = np.minimum(v0, v1), np.maximum(v0, v1)
-    near = (hi_u >= 0) & (lo_u < width) & (hi_v >= 0) & (lo_v < height)
+    near = (hi_u >= ou) & (lo_u < ou + width) & (hi_v >= ov) & (lo_v < ov + height)
     if not near.all():
         u0, v0, u1, v1 = u0[near], v0[near], u1[near], v1[near]
-        lo_u, hi_u, lo_v, hi_v = lo_u[near], hi_u[near], lo_v[near], hi_v[near]
-    # clip the segments that cross a side; an end the clip moves is not the segment's own
-    crossing = (lo_u < 0) | (hi_u >= width) | (lo_v < 0) | (hi_v >= height)
-    own0 = np.ones(u0.shape, bool)
-    own1 = np.ones(u0.shape, bool)
-    if crossing.any():
-        # clip copies: the caller's arrays stay as they were
-        u0, v0, u1, v1 = u0.copy(), v0.copy(), u1.copy(), v1.copy()
-        keep = np.ones(u0.shape, bool)
-        keep[crossing], t0, t1, u0[crossing], v0[crossing], u1[crossing], v1[crossing] = _clip(
-            u0[crossing], v0[crossing], u1[crossing], v1[crossing], width, height
-        )
-        own0[crossing], own1[crossing] = t0 == 0, t1 == 1
-        u0, v0, u1, v1, own0, own1 = u0[keep], v0[keep], u1[keep], v1[keep], own0[keep], own1[keep]
-    # one sample per dot along the longer axis, at the dot's centre line: the samples
-    # depend on the line only, not on where it was cut, so a part of the canvas drawn
-    # on its own gets the same dots as the whole
     steep = np.abs(v1 - v0) > np.abs(u1 - u0)
+    # the ends are always drawn (those beyond the window are dropped there)
+    cols, rows = [u0, u1], [v0, v1]
     if dash <= 0:
-        # a segment of its own ends within one dot along its longer axis has one sample, in the
-        # dot of an end (the same column or row, a height between the ends'): its ends, drawn
-        # below, are all its dots. Most edges of a zoomed-out view are such.
-        short = own0 & own1 & np.where(steep, np.floor(v0) == np.floor(v1), np.floor(u0) == np.floor(u1))
+        # a segment whose ends lie within one dot along its longer axis has one sample, in the
+        # dot of an end (the same column or row, a height between the ends'): its ends are all
+        # its dots. Most edges of a zoomed-out view are such.
+        short = np.where(steep, np.floor(v0) == np.floor(v1), np.floor(u0) == np.floor(u1))
         if short.any():
-            cols_e = np.concatenate([u0[short], u1[short]])
-            rows_e = np.concatenate([v0[short], v1[short]])
             long = ~short
-            u0, v0, u1, v1, own0, own1, steep = (u0[long], v0[long], u1[long], v1[long], own0[long],
-                                                 own1[long], steep[long])
-            _set_dots(dots, cols_e, rows_e)
+            u0, v0, u1, v1, steep = u0[long], v0[long], u1[long], v1[long], steep[long]
+    else:
+        cols, rows = [], []
     flat = ~steep
-    cols_f, rows_f = _centre_samples(u0[flat], u1[flat], v0[flat], v1[flat], own0[flat], own1[flat], dash)
-    rows_s, cols_s = _centre_samples(v0[steep], v1[steep], u0[steep], u1[steep], own0[steep], own1[steep], dash)
-    cols, rows = [cols_f, cols_s], [rows_f, rows_s]
-    if dash <= 0:
-        # the segment's own ends are always drawn
-        cols += [u0[own0], u1[own1]]
-        rows += [v0[own0], v1[own1]]
-    _set_dots(dots, np.concatenate(cols), np.concatenate(rows))
+    cols_f, rows_f = _centre_samples(u0[flat], u1[flat], v0[flat], v1[flat], ou, ou + width, dash)
+    rows_s, cols_s = _centre_samples(v0[steep], v1[steep], u0[steep], u1[steep], ov, ov + height, dash)
+    _set_dots(dots, np.concatenate(cols + [cols_f, cols_s]), np.concatenate(rows + [rows_f, rows_s]), (ou, ov))
 
 
-def _set_dots(dots: np.ndarray, cols: np.ndarray, rows: np.ndarray) -> None:
-    """Set the dots holding points (cols, rows) in continuous dot coordinates; points beyond the
-    canvas (rounding, a cut end between two dot centres) belong to no dot here."""
+def _set_dots(dots: np.ndarray, cols: np.ndarray, rows: np.ndarray, origin: tuple[int, int] = (0, 0)) -> None:
+    """Set the dots holding points (cols, rows) in continuous dot coordinates of the plane whose dot
+    ``origin`` is the window's top left; points beyond the window belong to no dot here."""
     height, width = dots.shape
-    inside = (cols >= 0) & (cols < width) & (rows >= 0) & (rows < height)
+    ou, ov = origin
+    col = np.floor(cols)
+    row = np.floor(rows)
+    inside = (col >= ou) & (col < ou + width) & (row >= ov) & (row < ov + height)  # False for NaN
     if not inside.all():
-        cols, rows = cols[inside], rows[inside]
-    dots.ravel()[rows.astype(np.int64) * width + cols.astype(np.int64)] = True
+        col, row = col[inside], row[inside]
+    dots.ravel()[(row.astype(np.int64) - ov) * width + (col.astype(np.int64) - ou)] = True
 
 
-def _centre_samples(a0, a1, b0, b1, own0, own1, dash: int):
-    """Points along segments at every dot centre line of their major axis ``a`` (as floats).
+def _centre_samples(a0, a1, b0, b1, lo: int, hi: int, dash: int):
+    """Points along segments at every dot centre line of their major axis ``a`` (as floats) from
+    dot ``lo`` up to (not including) dot ``hi`` of that axis, the window's.
 
-    A centre beyond the segment's own end is pulled back onto it; beyond an
-    end the clip made, it lies off the canvas and the caller drops it.
+    A centre beyond the segment's end is pulled back onto it. Each sample is
+    computed from the segment's own ends, so it is the same whatever the window.
     """
     flip = a1 < a0
     a0, a1 = np.where(flip, a1, a0), np.where(flip, a0, a1)
     b0, b1 = np.where(flip, b1, b0), np.where(flip, b0, b1)
-    own_lo, own_hi = np.where(flip, own1, own0), np.where(flip, own0, own1)
-    k0 = np.floor(a0)
-    counts = (np.floor(a1) - k0).astype(np.int64) + 1
+    k0 = np.maximum(np.floor(a0), lo)
+    k1 = np.minimum(np.floor(a1), hi - 1)
+    counts = np.maximum(k1 - k0 + 1, 0).astype(np.int64)
     first = np.cumsum(counts) - counts
     owner = np.repeat(np.arange(counts.size), counts)
     a = np.arange(owner.size, dtype=np.float64) + np.repeat(k0 + 0.5 - first, counts)
-    # the first and last sample of each segment, where its own end is nearer than the centre
-    last = first + counts - 1
-    if counts.size:
-        a[first] = np.where(own_lo, np.maximum(a[first], a0), a[first])
-        a[last] = np.where(own_hi, np.minimum(a[last], a1), a[last])
+    a = np.minimum(np.maximum(a, a0[owner]), a1[owner])
     span = a1 - a0
     with np.errstate(divide="ignore", invalid="ignore"):
         slope = np.where(span > 0, (b1 - b0) / span, 0.0)
-    b = b0[owner] + (a - a0[owner]) * slope[owner]
+        b = b0[owner] + (a - a0[owner]) * slope[owner]
     if dash > 0:
         on = (np.floor(a).astype(np.int64) // dash) % 2 == 0
         a, b = a[on], b[on]
@@ -158,18 +143,20 @@ def clip_segments(seg: np.ndarray, bbox) -> np.ndarray:
     return out[keep & np.isfinite(out).all(axis=1)]
 
 
-def point_dots(dots: np.ndarray, u, v, *, block: bool = False) -> None:
-    """Set the dot under each point that falls on the array.
+def point_dots(dots: np.ndarray, u, v, *, block: bool = False, origin: tuple[int, int] = (0, 0)) -> None:
+    """Set the dot under each point that falls on the array, a window from dot ``origin`` on (see
+    ``segment_dots``; a whole number of characters, so that blocks stay inside their character).
 
     With ``block``, set the 2 x 2 dots around it inside its own character,
     so that a lone site reads as a spot.
     """
     height, width = dots.shape
-    u = np.asarray(u, np.float64).ravel()
-    v = np.asarray(v, np.float64).ravel()
-    inside = (u >= 0) & (u < width) & (v >= 0) & (v < height)  # False for NaN too
-    col = u[inside].astype(np.int64)
-    row = v[inside].astype(np.int64)
+    ou, ov = (int(o) for o in origin)
+    u = np.floor(np.asarray(u, np.float64).ravel())
+    v = np.floor(np.asarray(v, np.float64).ravel())
+    inside = (u >= ou) & (u < ou + width) & (v >= ov) & (v < ov + height)  # False for NaN too
+    col = u[inside].astype(np.int64) - ou
+    row = v[inside].astype(np.int64) - ov
     dots[row, col] = True
     if block:
         # the other column of the character, and the neighbouring row inside it

@@ -22,6 +22,8 @@ ON_BOX = 1e-9
 # Changes the log keeps for the canvas to catch up with; a canvas further
 # behind finds every owner again.
 LOG_LENGTH = 64
+# Up to this many points, nearest() measures every site rather than rebuild an outdated k-d tree.
+FEW_POINTS = 8
 
 
 class SegmentPool:
@@ -214,8 +216,18 @@ class LiveScene:
         return self._drawn
 
     def nearest(self, points: np.ndarray) -> np.ndarray:
-        """The id of the cell owner nearest each point (k, 2)."""
+        """The id of the cell owner nearest each point (k, 2).
+
+        A few points (the inspector's one) are measured against every site
+        while the k-d tree is out of date, rather than rebuilding it after
+        every edit; a whole frame's characters build it again.
+        """
         ids = self.drawn()
+        points = np.asarray(points, np.float64).reshape(-1, 2)
+        if self._tree is None and len(points) <= FEW_POINTS and len(ids):
+            sites = self._sites[ids]
+            d2 = [((sites - p) ** 2).sum(axis=1) for p in points]
+            return ids[np.array([int(np.argmin(d)) for d in d2], np.int64)]
         if self._tree is None:
             self._tree = cKDTree(self._sites[ids] if len(ids) else np.zeros((0, 2)))
         _, k = self._tree.query(points)

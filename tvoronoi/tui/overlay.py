@@ -329,7 +329,7 @@ def fortune_picture(step, points: np.ndarray, colours: np.ndarray, bbox) -> tupl
     scene = _SubScene(
         sites=points[rows],
         edges=np.concatenate([outline, finished]),
-        delaunay=_empty_segments(),
+        delaunay_edges=_empty_segments(),
         vertices=vertices[inside],
         colours=np.asarray(colours)[rows],
         bbox=tuple(float(c) for c in bbox),
@@ -358,7 +358,7 @@ def incremental_picture(step, points: np.ndarray, colours: np.ndarray) -> tuple[
     scene = _SubScene(
         sites=points[rows],
         edges=full.edges,
-        delaunay=full.delaunay,
+        delaunay_edges=full.delaunay,
         vertices=full.vertices,
         colours=mine[rows],
         bbox=full.bbox,

@@ -41,6 +41,8 @@ SPARSE_SITES_PER_CHAR = 0.05
 # Vertex marks are drawn only below this many vertices per character: denser, they
 # would recolour most edge characters and hide the edges they mark.
 VERTEX_MARKS_PER_CHAR = 0.12
+# The layer cache keeps the layers of this many recent frames.
+LAYER_FRAMES_KEPT = 4
 # Fitting the box leaves this fraction of the canvas free around it.
 FIT_MARGIN = 0.04
 
@@ -51,22 +53,54 @@ class View:
 
     Dots are about square on a terminal whose characters are twice as high
     as wide, so one scale serves both axes. World y grows upwards.
+
+    The centre is kept as an anchor (``ax``, ``ay``) and a whole number of
+    characters (``dc`` right, ``dr`` down) the view was panned by since: the
+    dots of all views with the same anchor and scale lie on one plane, and a
+    panned view's dots are those of the view before, moved by whole
+    characters, exactly (see ``dots.segment_dots``), so a layer drawn before
+    is shifted rather than drawn again.
     """
 
-    cx: float = 0.5
-    cy: float = 0.5
+    ax: float = 0.5
+    ay: float = 0.5
     scale: float = 0.01
+    dc: int = 0
+    dr: int = 0
+
+    @property
+    def cx(self) -> float:
+        """World x of the centre."""
+        return self.ax + self.dc * DOT_COLS * self.scale if self.dc else self.ax
+
+    @property
+    def cy(self) -> float:
+        """World y of the centre."""
+        return self.ay - self.dr * DOT_ROWS * self.scale if self.dr else self.ay
+
+    @property
+    def origin(self) -> tuple[int, int]:
+        """The plane's dot at the canvas's top left (see ``plane_dots``)."""
+        return self.dc * DOT_COLS, self.dr * DOT_ROWS
+
+    def plane_dots(self, xs, ys, cols: int, rows: int):
+        """World coordinates to continuous dot coordinates of the anchor's plane: those of the
+        canvas plus ``origin``."""
+        u = (np.asarray(xs) - self.ax) / self.scale + cols * DOT_COLS / 2
+        v = rows * DOT_ROWS / 2 - (np.asarray(ys) - self.ay) / self.scale
+        return u, v
 
     def to_dots(self, xs, ys, cols: int, rows: int):
         """World coordinates to continuous dot coordinates (u right, v down)."""
-        u = (np.asarray(xs) - self.cx) / self.scale + cols * DOT_COLS / 2
-        v = rows * DOT_ROWS / 2 - (np.asarray(ys) - self.cy) / self.scale
-        return u, v
+        u, v = self.plane_dots(xs, ys, cols, rows)
+        ou, ov = self.origin
+        return (u - ou, v - ov) if ou or ov else (u, v)
 
     def to_world(self, u, v, cols: int, rows: int):
         """Continuous dot coordinates to world coordinates."""
-        xs = self.cx + (np.asarray(u) - cols * DOT_COLS / 2) * self.scale
-        ys = self.cy - (np.asarray(v) - rows * DOT_ROWS / 2) * self.scale
+        ou, ov = self.origin
+        xs = self.ax + (np.asarray(u) + ou - cols * DOT_COLS / 2) * self.scale
+        ys = self.ay - (np.asarray(v) + ov - rows * DOT_ROWS / 2) * self.scale
         return xs, ys
 
     def char_to_world(self, col: float, row: float, cols: int, rows: int) -> tuple[float, float]:
@@ -75,17 +109,22 @@ class View:
         return float(x), float(y)
 
     def panned(self, dx_dots: float, dy_dots: float) -> "View":
-        """The view moved by a number of dots (right, down on screen)."""
+        """The view moved by a number of dots (right, down on screen); by whole characters, it
+        keeps its anchor."""
+        if dx_dots % DOT_COLS == 0 and dy_dots % DOT_ROWS == 0:
+            return View(self.ax, self.ay, self.scale,
+                        self.dc + int(dx_dots) // DOT_COLS, self.dr + int(dy_dots) // DOT_ROWS)
         return View(self.cx + dx_dots * self.scale, self.cy - dy_dots * self.scale, self.scale)
 
     def zoomed(self, factor: float, about: tuple[float, float] | None = None) -> "View":
         """The view magnified by ``factor``, keeping the world point ``about`` where it is."""
         scale = self.scale / factor
+        cx, cy = self.cx, self.cy
         if about is None:
-            return View(self.cx, self.cy, scale)
+            return View(cx, cy, scale)
         ax, ay = about
         keep = 1.0 - 1.0 / factor
-        return View(self.cx + (ax - self.cx) * keep, self.cy + (ay - self.cy) * keep, scale)
+        return View(cx + (ax - cx) * keep, cy + (ay - cy) * keep, scale)
 
     def window(self, c0: int, r0: int, cols: int, rows: int) -> "Window":
         """The part of a ``cols x rows`` canvas from character (c0, r0) on, as a view of its own."""
@@ -123,10 +162,9 @@ class View:
 class Window:
     """The part of a canvas of ``cols x rows`` characters from character (c0, r0) on, used as a view.
 
-    Points go through the whole canvas's dots, then move by whole dots,
-    which is exact: a point lands on the same dot whether the part or the
-    whole canvas is drawn (sites put at character centres lie exactly on
-    dot corners, where any rounding would matter).
+    The rasterizer draws the part as a window on the whole view's plane of
+    dots (``origin``), which is exact: a mark lands on the same dots whether
+    the part or the whole canvas is drawn.
     """
 
     view: View
@@ -138,6 +176,14 @@ class Window:
     @property
     def scale(self) -> float:
         return self.view.scale
+
+    @property
+    def origin(self) -> tuple[int, int]:
+        ou, ov = self.view.origin
+        return ou + self.c0 * DOT_COLS, ov + self.r0 * DOT_ROWS
+
+    def plane_dots(self, xs, ys, cols: int, rows: int):
+        return self.view.plane_dots(xs, ys, self.cols, self.rows)
 
     def to_dots(self, xs, ys, cols: int, rows: int):
         u, v = self.view.to_dots(xs, ys, self.cols, self.rows)
@@ -256,8 +302,9 @@ class Scene:
     sites : (n, 2) float64
     edges : (e, 4) float64
         Clipped Voronoi edges (the box outline included) as x0, y0, x1, y1, each once.
-    delaunay : (t, 4) float64
-        Delaunay edges, each once.
+    delaunay_edges : (t, 4) float64, or None
+        Delaunay edges, each once; None to find them from ``triangles`` when first
+        shown (``delaunay``), which a large diagram's start need not wait for.
     vertices : (m, 2) float64
         Voronoi vertices inside the box.
     colours : (n,) int8
@@ -267,11 +314,22 @@ class Scene:
 
     sites: np.ndarray
     edges: np.ndarray
-    delaunay: np.ndarray
+    delaunay_edges: np.ndarray | None
     vertices: np.ndarray
     colours: np.ndarray
     bbox: tuple
+    triangles: np.ndarray | None = field(default=None, repr=False)
     _tree: cKDTree | None = field(default=None, repr=False)
+
+    @property
+    def delaunay(self) -> np.ndarray:
+        """The Delaunay edges (t, 4), each once, found from the triangles on first use."""
+        if self.delaunay_edges is None:
+            tri = np.empty((0, 3), np.int64) if self.triangles is None else self.triangles
+            a, b = _unique_pairs(tri.ravel(), tri[:, [1, 2, 0]].ravel(), len(self.sites))
+            self.delaunay_edges = np.hstack([self.sites[a], self.sites[b]]) if a.size else np.empty((0, 4))
+            self.triangles = None
+        return self.delaunay_edges
 
     @property
     def n_sites(self) -> int:
@@ -331,10 +389,6 @@ class Scene:
         edges = np.hstack([points[a], points[b]]) if a.size else np.empty((0, 4))
 
         tri = np.asarray(diagram.delaunay_triangles(), np.int64).reshape(-1, 3)
-        ta = tri.ravel()
-        tb = tri[:, [1, 2, 0]].ravel()
-        a, b = _unique_pairs(ta, tb, len(sites))
-        delaunay = np.hstack([sites[a], sites[b]]) if a.size else np.empty((0, 4))
 
         xmin, ymin, xmax, ymax = diagram.bbox
         vertices = np.asarray(diagram.vertices, np.float64).reshape(-1, 2)
@@ -345,10 +399,11 @@ class Scene:
         return cls(
             sites=sites,
             edges=edges,
-            delaunay=delaunay,
+            delaunay_edges=None,
             vertices=vertices[inside],
             colours=cell_colours(diagram) if colours is None else np.asarray(colours, np.int8),
             bbox=tuple(float(c) for c in diagram.bbox),
+            triangles=tri,
         )
 
     @property
@@ -433,23 +488,16 @@ class Painter:
         self.shape = (rows * DOT_ROWS, cols * DOT_COLS)
         self.codes = np.zeros((rows, cols), np.uint8)
         self.mark = np.zeros((rows, cols), np.uint8)
-        # the world box the canvas shows, a dot wider each way: marks beyond it are dropped
-        # before any work (NaN coordinates fail these tests too)
-        (x0, x1), (y1, y0) = view.to_world(np.array([-1.0, cols * DOT_COLS + 1.0]),
-                                           np.array([-1.0, rows * DOT_ROWS + 1.0]), cols, rows)
-        self.world = (float(x0), float(y0), float(x1), float(y1))
+        self.world = self.world_of((0, 0, cols, rows))
 
-    def _visible_segments(self, seg: np.ndarray) -> np.ndarray:
-        x0, y0, x1, y1 = self.world
-        sx0, sy0, sx1, sy1 = seg.T
-        keep = ((np.maximum(sx0, sx1) >= x0) & (np.minimum(sx0, sx1) <= x1)
-                & (np.maximum(sy0, sy1) >= y0) & (np.minimum(sy0, sy1) <= y1))
-        return seg if keep.all() else seg[keep]
-
-    def _visible_points(self, xy: np.ndarray) -> np.ndarray:
-        x0, y0, x1, y1 = self.world
-        keep = (xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)
-        return xy if keep.all() else xy[keep]
+    def world_of(self, span) -> tuple[float, float, float, float]:
+        """The world box (x0, y0, x1, y1) of the characters span = (c0, r0, c1, r1), a dot wider
+        each way: marks beyond it are dropped before any work (NaN coordinates fail its tests too)."""
+        c0, r0, c1, r1 = span
+        (x0, x1), (y1, y0) = self.view.to_world(np.array([c0 * DOT_COLS - 1.0, c1 * DOT_COLS + 1.0]),
+                                                np.array([r0 * DOT_ROWS - 1.0, r1 * DOT_ROWS + 1.0]),
+                                                self.cols, self.rows)
+        return float(x0), float(y0), float(x1), float(y1)
 
     def new_dots(self) -> np.ndarray:
         return np.zeros(self.shape, bool)
@@ -465,43 +513,67 @@ class Painter:
         self.codes |= packed
         np.maximum(self.mark, np.where(packed != 0, np.uint8(layer), np.uint8(0)), out=self.mark)
 
-    def from_cache(self, layer: int, key) -> bool:
-        """Lay a layer drawn before for this key (see ``LayerCache``); False if there is none."""
-        packed = None if self.cache is None or key is None else self.cache.get(key, self)
-        if packed is None:
-            return False
-        self.lay_packed(layer, packed)
-        return True
-
-    def _keep(self, key, packed: np.ndarray) -> None:
-        if self.cache is not None and key is not None:
-            self.cache.put(key, self, packed)
-
     def to_dots(self, xs, ys):
-        return self.view.to_dots(xs, ys, self.cols, self.rows)
+        """World coordinates to continuous dot coordinates of the view's plane (see ``View``):
+        the canvas's top left is the plane's dot ``self.origin``."""
+        return self.view.plane_dots(xs, ys, self.cols, self.rows)
+
+    @property
+    def origin(self) -> tuple[int, int]:
+        return self.view.origin
+
+    def _layer(self, layer: int, key, draw) -> None:
+        """Lay a layer: from the cache if drawn before for this view, else shifted from a view
+        panned from this one with only the strips it lacks drawn, else drawn whole.
+        ``draw(dots, origin, world)`` sets the layer's dots in a window of the plane from dot
+        ``origin`` on, given the world box (x0, y0, x1, y1) that window shows."""
+        cache = self.cache if key is not None else None
+        packed = None if cache is None else cache.get(key, self)
+        if packed is None:
+            shifted = None if cache is None else cache.shifted(key, self)
+            if shifted is None:
+                packed = self.draw_part(draw, (0, 0, self.cols, self.rows))
+            else:
+                packed, missing = shifted
+                for c0, r0, c1, r1 in missing:
+                    packed[r0:r1, c0:c1] = self.draw_part(draw, (c0, r0, c1, r1))
+            if cache is not None:
+                cache.put(key, self, packed)
+        self.lay_packed(layer, packed)
+
+    def draw_part(self, draw, span) -> np.ndarray:
+        """The bit patterns (r1 - r0, c1 - c0) of the characters span = (c0, r0, c1, r1) of a layer."""
+        c0, r0, c1, r1 = span
+        ou, ov = self.origin
+        dots = np.zeros(((r1 - r0) * DOT_ROWS, (c1 - c0) * DOT_COLS), bool)
+        world = self.world if span == (0, 0, self.cols, self.rows) else self.world_of(span)
+        draw(dots, (ou + c0 * DOT_COLS, ov + r0 * DOT_ROWS), world)
+        return pack_braille(dots)
 
     def segments(self, layer: int, seg: npt.ArrayLike, *, dash: int = 0, key=None) -> None:
         """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache."""
-        if self.from_cache(layer, key):
-            return
-        seg = self._visible_segments(np.asarray(seg, np.float64).reshape(-1, 4))
-        dots = self.new_dots()
-        if len(seg):
-            u0, v0 = self.to_dots(seg[:, 0], seg[:, 1])
-            u1, v1 = self.to_dots(seg[:, 2], seg[:, 3])
-            segment_dots(dots, u0, v0, u1, v1, dash=dash)
-        self._keep(key, self.lay(layer, dots))
+        seg = np.asarray(seg, np.float64).reshape(-1, 4)
+
+        def draw(dots, origin, world) -> None:
+            part = _visible_segments(seg, world)
+            if len(part):
+                u0, v0 = self.to_dots(part[:, 0], part[:, 1])
+                u1, v1 = self.to_dots(part[:, 2], part[:, 3])
+                segment_dots(dots, u0, v0, u1, v1, dash=dash, origin=origin)
+
+        self._layer(layer, key, draw)
 
     def points(self, layer: int, xy: npt.ArrayLike, *, block: bool = False, key=None) -> None:
         """World points (k, 2); ``key`` names them for the layer cache."""
-        if self.from_cache(layer, key):
-            return
-        xy = self._visible_points(np.asarray(xy, np.float64).reshape(-1, 2))
-        dots = self.new_dots()
-        if len(xy):
-            u, v = self.to_dots(xy[:, 0], xy[:, 1])
-            point_dots(dots, u, v, block=block)
-        self._keep(key, self.lay(layer, dots))
+        xy = np.asarray(xy, np.float64).reshape(-1, 2)
+
+        def draw(dots, origin, world) -> None:
+            part = _visible_points(xy, world)
+            if len(part):
+                u, v = self.to_dots(part[:, 0], part[:, 1])
+                point_dots(dots, u, v, block=block, origin=origin)
+
+        self._layer(layer, key, draw)
 
     def cross(self, layer: int, x: float, y: float) -> np.ndarray:
         """A small cross centred on the world point (x, y); the (rows, cols) mask of its characters."""
@@ -509,23 +581,41 @@ class Painter:
         u, v = self.to_dots(x, y)
         u, v = float(u), float(v)
         segment_dots(dots, [u - CURSOR_ARM, u], [v, v - CURSOR_ARM - 1], [u + CURSOR_ARM, u],
-                     [v, v + CURSOR_ARM + 1])
+                     [v, v + CURSOR_ARM + 1], origin=self.origin)
         self.lay(layer, dots)
         return pack_braille(dots) != 0
 
 
+def _visible_segments(seg: np.ndarray, world) -> np.ndarray:
+    """The segments (k, 4) that meet the world box (x0, y0, x1, y1)."""
+    x0, y0, x1, y1 = world
+    sx0, sy0, sx1, sy1 = seg.T
+    keep = ((np.maximum(sx0, sx1) >= x0) & (np.minimum(sx0, sx1) <= x1)
+            & (np.maximum(sy0, sy1) >= y0) & (np.minimum(sy0, sy1) <= y1))
+    return seg if keep.all() else seg[keep]
+
+
+def _visible_points(xy: np.ndarray, world) -> np.ndarray:
+    x0, y0, x1, y1 = world
+    keep = (xy[:, 0] >= x0) & (xy[:, 0] <= x1) & (xy[:, 1] >= y0) & (xy[:, 1] <= y1)
+    return xy if keep.all() else xy[keep]
+
+
 class LayerCache:
-    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last frames, as bit
+    """The diagram's layers (edges, Delaunay edges, vertices, sites) of the last few frames, as bit
     patterns per character, so that a frame that differs only in another layer (Delaunay shown or
-    hidden, vertices, an overlay) does not draw them again.
+    hidden, vertices, an overlay), or that comes back to a recent view (fit after a zoom), does not
+    draw them again.
 
     An entry holds its scene (so its id cannot be reused while the entry lives) and is found only
-    for the same scene, version, view and size; ``rasterize`` keeps the entries the last frame used.
+    for the same scene, version, view and size. ``rasterize`` calls ``frame_done`` after each
+    frame: the entries of the last ``frames`` frames are kept, those of other scenes dropped.
     """
 
-    def __init__(self) -> None:
-        self._entries: dict = {}
+    def __init__(self, frames: int = LAYER_FRAMES_KEPT) -> None:
+        self.frames = frames
         self._used: dict = {}
+        self._history: list[dict] = []  # the entries of the frames before, oldest first
 
     def _full_key(self, key, paint: "Painter"):
         scene, rest = key
@@ -533,19 +623,61 @@ class LayerCache:
 
     def get(self, key, paint: "Painter") -> np.ndarray | None:
         full = self._full_key(key, paint)
-        entry = self._entries.get(full)
+        entry = self._used.get(full)
+        for older in reversed(self._history):
+            if entry is not None:
+                break
+            entry = older.get(full)
         if entry is None or entry[0] is not key[0]:
             return None
         self._used[full] = entry
         return entry[1]
 
+    def shifted(self, key, paint: "Painter") -> tuple[np.ndarray, list] | None:
+        """The layer of a kept view that this one was panned from (same anchor, scale and size, see
+        ``View``), moved by the characters panned, and the spans (c0, r0, c1, r1) of characters
+        it lacks; None if there is none. When several are kept, the one lacking fewest."""
+        view = paint.view
+        if not isinstance(view, View):
+            return None
+        scene, rest = key
+        best = None
+        for frame in [self._used] + self._history[::-1]:
+            for full, entry in frame.items():
+                old = full[2]
+                if (entry[0] is not scene or full[1] != scene.version or full[3:] != (paint.cols, paint.rows, rest)
+                        or not isinstance(old, View) or (old.ax, old.ay, old.scale) != (view.ax, view.ay, view.scale)):
+                    continue
+                dc, dr = view.dc - old.dc, view.dr - old.dr
+                kept = max(paint.cols - abs(dc), 0) * max(paint.rows - abs(dr), 0)
+                if kept and (best is None or kept > best[0]):
+                    best = (kept, dc, dr, entry[1])
+        if best is None:
+            return None
+        _, dc, dr, old_packed = best
+        cols, rows = paint.cols, paint.rows
+        packed = np.zeros_like(old_packed)
+        # the character (c, r) of the new view is (c + dc, r + dr) of the old one
+        packed[max(-dr, 0):rows - max(dr, 0), max(-dc, 0):cols - max(dc, 0)] = \
+            old_packed[max(dr, 0):rows - max(-dr, 0), max(dc, 0):cols - max(-dc, 0)]
+        missing = []
+        if dr:  # whole rows
+            missing.append((0, rows - dr, cols, rows) if dr > 0 else (0, 0, cols, -dr))
+        if dc:  # the columns, beside those rows
+            r0, r1 = (0, rows - dr) if dr > 0 else (-dr, rows)
+            missing.append((cols - dc, r0, cols, r1) if dc > 0 else (0, r0, -dc, r1))
+        return packed, missing
+
     def put(self, key, paint: "Painter", packed: np.ndarray) -> None:
-        full = self._full_key(key, paint)
-        self._entries[full] = self._used[full] = (key[0], packed)
+        self._used[self._full_key(key, paint)] = (key[0], packed)
 
     def frame_done(self) -> None:
-        """Keep what this frame used (the previous frames' other entries go)."""
-        self._entries, self._used = self._used, {}
+        """Keep what this frame used with the last frames' entries; a scene this frame did not
+        draw is let go."""
+        scenes = {id(entry[0]) for entry in self._used.values()}
+        kept = [{k: e for k, e in frame.items() if id(e[0]) in scenes} for frame in self._history]
+        self._history = [frame for frame in kept + [self._used] if frame][-self.frames:]
+        self._used = {}
 
 
 def rasterize(
