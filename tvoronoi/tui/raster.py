@@ -734,8 +734,9 @@ def redraw_part(frame: Frame, scene, view: View, cols: int, rows: int, span, *, 
     """Draw again, in place, the characters ``span`` = (c0, r0, c1, r1) of a frame of this scene and view.
 
     ``owner`` gives the owners of those characters if the caller has them;
-    ``options`` are those of ``rasterize``. Segments are clipped at the
-    part's border, so a line crossing it may shift by a dot there.
+    ``options`` are those of ``rasterize``. A segment's dots come from its own
+    ends whatever window draws them, so the part matches a whole drawing dot
+    for dot, lines crossing its border included.
     """
     c0, r0, c1, r1 = span
     part_view = view.window(c0, r0, cols, rows)
