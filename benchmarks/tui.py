@@ -137,12 +137,16 @@ def main() -> None:
     parser.add_argument("--size", default="120x40", help="terminal size, COLSxROWS")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--start", default="", help="also time this many sites shown from start (e.g. 1M)")
+    parser.add_argument("--start-only", action="store_true", help="time only the start (--start), no keys")
     parser.add_argument("--out", type=Path, default=RESULTS / "tui.json")
     args = parser.parse_args()
+    if args.start_only and not args.start:
+        parser.error("--start-only needs --start")
     cols, rows = (int(v) for v in args.size.lower().split("x"))
     (n,) = parse_sizes(args.sites)
     report = {"sites": n, "terminal": f"{cols}x{rows}", "repeats": args.repeats,
-              "load_average": os.getloadavg()[0], "keys_ms": asyncio.run(keys(n, cols, rows, args.repeats))}
+              "load_average": os.getloadavg()[0],
+              "keys_ms": {} if args.start_only else asyncio.run(keys(n, cols, rows, args.repeats))}
     if args.start:
         (big,) = parse_sizes(args.start)
         report["start_ms"] = {str(big): asyncio.run(start(big, cols, rows))}

@@ -17,7 +17,8 @@ DOT_BITS = np.array([[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]], np
 SPACE = 0x20
 
 
-def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tuple[int, int] = (0, 0)) -> None:
+def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tuple[int, int] = (0, 0),
+                 ends: bool = True) -> None:
     """Set the dots along many segments at once.
 
     Each segment is sampled once per dot along its longer axis (a vectorised
@@ -38,6 +39,9 @@ def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tup
         If > 0, draw dashes: ``dash`` dots on, ``dash`` dots off (counted on the plane).
     origin : (int, int)
         The plane's dot (column, row) at the window's top left.
+    ends : bool
+        False: leave out the dots of the segments' ends (solid lines only), for a caller that
+        sets them itself (``point_dots`` on each end once, where many segments share ends).
     """
     height, width = dots.shape
     ou, ov = (int(o) for o in origin)
@@ -52,7 +56,7 @@ def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tup
         u0, v0, u1, v1 = u0[near], v0[near], u1[near], v1[near]
     steep = np.abs(v1 - v0) > np.abs(u1 - u0)
     # the ends are always drawn (those beyond the window are dropped there)
-    cols, rows = [u0, u1], [v0, v1]
+    cols, rows = ([u0, u1], [v0, v1]) if ends else ([], [])
     if dash <= 0:
         # a segment whose ends lie within one dot along its longer axis has one sample, in the
         # dot of an end (the same column or row, a height between the ends'): its ends are all

@@ -6,6 +6,7 @@ bit patterns are OR-ed per character, so no dot is lost where lines meet.
 
 from __future__ import annotations
 
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Protocol
@@ -36,6 +37,10 @@ CONFLICT_FILL = 2 * N_FILLS
 HIGHLIGHTED = 2 * N_FILLS + 1
 # The keyboard cursor's cross reaches this many dots each way (about a character).
 CURSOR_ARM = 2
+# From this many sites on, a scene's cell colours and k-d tree are made in two threads while
+# its segments are collected (numpy and the k-d tree let go of the GIL), so that a large
+# diagram's first frame waits for neither.
+PARALLEL_SCENE_SITES = 50_000
 # Below this many sites per character a site is drawn as a 2 x 2 block of dots.
 SPARSE_SITES_PER_CHAR = 0.05
 # Vertex marks are drawn only below this many vertices per character: denser, they
@@ -320,6 +325,8 @@ class Scene:
     bbox: tuple
     triangles: np.ndarray | None = field(default=None, repr=False)
     _tree: cKDTree | None = field(default=None, repr=False)
+    # the ends of ``edges``, each point once (None: draw the ends of every edge)
+    edge_ends: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def delaunay(self) -> np.ndarray:
@@ -377,9 +384,25 @@ class Scene:
 
     @classmethod
     def from_diagram(cls, diagram, colours: np.ndarray | None = None) -> "Scene":
-        """Collect the segments, marks and cell colours of a diagram (``colours``: given, not computed)."""
-        sites = np.asarray(diagram.sites, np.float64)
+        """Collect the segments, marks and cell colours of a diagram (``colours``: given, not computed).
 
+        A large diagram's colours and k-d tree are made in other threads meanwhile.
+        """
+        sites = np.asarray(diagram.sites, np.float64)
+        if len(sites) < PARALLEL_SCENE_SITES:
+            return cls._collect(diagram, sites, cell_colours(diagram) if colours is None else colours)
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            tree = pool.submit(cKDTree, sites)
+            made: Future | None = None if colours is not None else pool.submit(cell_colours, diagram)
+            scene = cls._collect(diagram, sites, colours if made is None else None)
+            if made is not None:
+                scene.colours = np.asarray(made.result(), np.int8)
+            scene._tree = tree.result()
+        return scene
+
+    @classmethod
+    def _collect(cls, diagram, sites: np.ndarray, colours) -> "Scene":
+        """The scene's segments and marks; ``colours`` None: set by the caller."""
         # every clipped cell ring, point to next point (wrapping round)
         offsets = np.asarray(diagram.cell_offsets, np.int64)
         ring = np.asarray(diagram.cell_vertices, np.int64)
@@ -387,6 +410,8 @@ class Scene:
         points = np.asarray(diagram.cell_points, np.float64)
         a, b = _cell_sides(ring, ring[nxt] if ring.size else ring, points, diagram.bbox)
         edges = np.hstack([points[a], points[b]]) if a.size else np.empty((0, 4))
+        used = np.zeros(len(points), bool)
+        used[a] = used[b] = True
 
         tri = np.asarray(diagram.delaunay_triangles(), np.int64).reshape(-1, 3)
 
@@ -401,9 +426,10 @@ class Scene:
             edges=edges,
             delaunay_edges=None,
             vertices=vertices[inside],
-            colours=cell_colours(diagram) if colours is None else np.asarray(colours, np.int8),
+            colours=np.empty(0, np.int8) if colours is None else np.asarray(colours, np.int8),
             bbox=tuple(float(c) for c in diagram.bbox),
             triangles=tri,
+            edge_ends=points[used],
         )
 
     @property
@@ -550,16 +576,24 @@ class Painter:
         draw(dots, (ou + c0 * DOT_COLS, ov + r0 * DOT_ROWS), world)
         return pack_braille(dots)
 
-    def segments(self, layer: int, seg: npt.ArrayLike, *, dash: int = 0, key=None) -> None:
-        """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache."""
+    def segments(self, layer: int, seg: npt.ArrayLike, *, dash: int = 0, key=None,
+                 ends: np.ndarray | None = None) -> None:
+        """World segments (k, 4) as x0, y0, x1, y1; ``key`` names them for the layer cache.
+
+        ``ends`` (m, 2), for solid segments: their ends, each point once (segments that meet
+        share ends, so there are fewer of these than of segment ends).
+        """
         seg = np.asarray(seg, np.float64).reshape(-1, 4)
+        own_ends = ends is None or dash > 0
 
         def draw(dots, origin, world) -> None:
             part = _visible_segments(seg, world)
             if len(part):
                 u0, v0 = self.to_dots(part[:, 0], part[:, 1])
                 u1, v1 = self.to_dots(part[:, 2], part[:, 3])
-                segment_dots(dots, u0, v0, u1, v1, dash=dash, origin=origin)
+                segment_dots(dots, u0, v0, u1, v1, dash=dash, origin=origin, ends=own_ends)
+            if not own_ends and ends is not None and len(ends):
+                point_dots(dots, *self.to_dots(ends[:, 0], ends[:, 1]), origin=origin)
 
         self._layer(layer, key, draw)
 
@@ -707,7 +741,7 @@ def rasterize(
     paint = Painter(view, cols, rows, layers)
     if delaunay and len(scene.delaunay):
         paint.segments(DELAUNAY, scene.delaunay, key=(scene, "delaunay"))
-    paint.segments(EDGE, scene.edges, key=(scene, "edges"))
+    paint.segments(EDGE, scene.edges, key=(scene, "edges"), ends=getattr(scene, "edge_ends", None))
     if vertices and scene.n_vertices and per_char(scene.n_vertices, scene, view) < VERTEX_MARKS_PER_CHAR:
         paint.points(VERTEX, scene.vertices, key=(scene, "vertices"))
     if scene.n_sites:
