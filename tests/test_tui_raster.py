@@ -190,6 +190,20 @@ def test_adjacency_comes_from_the_half_edges():
     assert sorted(zip(a.tolist(), b.tolist())) == [(0, 1), (0, 2), (1, 2)]
 
 
+@pytest.mark.parametrize("name", sorted(DATASETS))
+def test_adjacency_lists_each_pair_of_neighbours_once(name):
+    """Every (face, twin's face) pair of the half-edges, once each, against a set built in Python."""
+    diagram = tvoronoi.voronoi(DATASETS[name])
+    a, b = cell_adjacency(diagram)
+    faces, twins = diagram.he_face.tolist(), diagram.he_twin.tolist()
+    expected = {(min(f, faces[t]), max(f, faces[t])) for f, t in zip(faces, twins)
+                if t >= 0 and f >= 0 and faces[t] >= 0 and f != faces[t]}
+    pairs = list(zip(a.tolist(), b.tolist()))
+    assert (a < b).all()
+    assert len(pairs) == len(set(pairs))
+    assert set(pairs) == expected
+
+
 def test_colour_graph_on_a_wheel():
     """A hub with 12 spokes and a rim: the hub needs a colour none of the rim uses."""
     rim = np.arange(1, 13)
