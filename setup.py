@@ -9,6 +9,7 @@ build/checked``; ``tests/hunt_worker.py --kernels build/checked`` loads it.
 import os
 from pathlib import Path
 
+import numpy
 from Cython.Build import cythonize
 from setuptools import Extension, setup
 
@@ -41,6 +42,8 @@ extensions = [
     Extension(
         f"tvoronoi.kernels.{path.stem}",
         [str(path)],
+        include_dirs=[numpy.get_include()],             # pages.pyx: numpy's data memory handler
+        define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")],
         extra_compile_args=COMPILE_ARGS + OPENMP,
         extra_link_args=LINK_ARGS + OPENMP,
     )

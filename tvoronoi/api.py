@@ -226,22 +226,24 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
     >>> d.n_vertices, len(d.delaunay_triangles())
     (1, 2)
     """
-    pts = as_points(points)
-    check_engine(engine, insertion)
-    threads = as_threads(threads)
-    from tvoronoi.build import build_diagram
+    from tvoronoi.build import build_arrays, build_diagram
 
-    if clip is not None:
-        from tvoronoi.region import as_region, clip_to_region, region_box
+    with build_arrays():                             # its checks' temporaries too
+        pts = as_points(points)
+        check_engine(engine, insertion)
+        threads = as_threads(threads)
+        if clip is not None:
+            from tvoronoi.region import as_region, clip_to_region, region_box
 
-        region = as_region(clip)
-        box = region_box(region) if bbox is None else as_bbox(bbox)
-        return clip_to_region(
-            pts, region,
-            lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed, threads=threads),
-        )
-    box = default_bbox(pts) if bbox is None else as_bbox(bbox)
-    return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
+            region = as_region(clip)
+            box = region_box(region) if bbox is None else as_bbox(bbox)
+            return clip_to_region(
+                pts, region,
+                lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed,
+                                             threads=threads),
+            )
+        box = default_bbox(pts) if bbox is None else as_bbox(bbox)
+        return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
 
 
 def as_threads(threads) -> int:

@@ -7,17 +7,24 @@ import numpy as np
 from tvoronoi import engines
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError
-from tvoronoi.kernels import clip
+from tvoronoi.kernels import clip, pages
+
+
+def build_arrays():
+    """The context a build's arrays are made in: large ones in pages of their own, handed back to the
+    system when freed, not kept as holes in the heap (kernels/pages.pyx)."""
+    return pages.mapped()
 
 
 def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int, threads: int = 1) -> Diagram:
     """Build the Diagram of checked points (n, 2) in the checked box (threads: see api.voronoi)."""
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
-    t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
-    s, out = t.sites, t.voronoi(threads)
-    del t                                            # the triangulation is not needed to clip
-    return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+    with build_arrays():
+        t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
+        s, out = t.sites, t.voronoi(threads, clip_room=True)
+        del t                                        # the triangulation is not needed to clip
+        return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 
 
 def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True,
@@ -41,12 +48,6 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     n = len(pts)
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
-    points, offsets, ring, status = clip.clip_cells(
-        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"], out["face_edge"], first.astype(np.int8), box, e, threads,
-    )
-    if status != 0:
-        raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
-
     # the cell of a repeated point belongs to the first input row at that place
     root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
     owner = perm.astype(np.int32)                    # engine site -> input row owning its cell (a copy)
@@ -55,12 +56,20 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     site_of = np.empty(n, np.int32)
     site_of[perm] = owner[root]
 
-    # cells to input rows (CSR gather)
-    cell_of_row = np.full(n, -1, np.int64)           # engine site whose cell row r shows
+    points, offsets, ring, status = clip.clip_cells(
+        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"], out["face_edge"],
+        first.astype(np.int8), box, e, threads, room=out.pop("vertex_room", None),
+    )
+    if status != 0:
+        raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
+
+    # cells to input rows (CSR gather; the clipper works in engine order, where a cell's edges and
+    # vertices lie near its neighbours' in memory)
+    cell_of_row = np.full(n, -1, np.int32)           # engine site whose cell row r shows
     firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
     cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row)
-    del ring, offsets, cell_of_row                   # the clipper's buffer, before the relabelling below
+    del ring, offsets, cell_of_row
 
     face_edge = np.full(n, -1, np.int32)
     face_edge[owner[firsts]] = out["face_edge"][firsts]

@@ -164,13 +164,13 @@ class Triangulation:
         """True when the distinct sites are collinear: no triangle, parallel strips for cells."""
         return self.tv is None
 
-    def voronoi(self, threads: int = 1) -> dict:
+    def voronoi(self, threads: int = 1, clip_room: bool = False) -> dict:
         """The Voronoi DCEL (vertices in the user's unit, correctly rounded) with ``dup``, in engine order;
-        the same for any thread count."""
+        the same for any thread count (clip_room: see dual.voronoi_from_delaunay)."""
         s = self.sites
         if self.flat:
             return collinear_dcel(s.xs, s.ys)
-        out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads)
+        out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room)
         out["dup"] = self.dup
         return out
 

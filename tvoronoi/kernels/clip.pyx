@@ -3,7 +3,7 @@
 import numpy as np
 
 from libc.math cimport hypot
-from libc.stdlib cimport malloc, free
+from libc.stdlib cimport calloc, malloc, free
 from libc.string cimport memcpy, memmove
 from cython.parallel cimport prange
 from libc.stdint cimport int32_t, int64_t
@@ -26,7 +26,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                const int32_t[::1] he_origin, const int32_t[::1] he_twin,
                const int32_t[::1] he_face,
                const int32_t[::1] face_edge, const signed char[::1] active, box_tuple, int e, int threads=1,
-               int parallel_min=PARALLEL_MIN_CELLS):
+               int parallel_min=PARALLEL_MIN_CELLS, room=None):
     """Clip every cell to the box (xmin, ymin, xmax, ymax), exactly.
 
     Each edge is clipped once, so neighbouring cells share their points;
@@ -42,6 +42,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     box_tuple : the box, user unit; e : the scale exponent
     threads : cells are clipped on this many threads (the same result for any count), when there are
         at least parallel_min of them
+    room : optional (R, 2) float64 whose first m rows are ``vertices`` (dual's vertex_room): the new
+        points are written after them when they fit, instead of into a copy
 
     Returns
     -------
@@ -52,21 +54,25 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         closed, starting at its lowest point; empty when the cell misses the box.
     status : int, 0, or 1 if the edges of some cell did not chain (never on a valid DCEL).
 
-    points and ring are views of the kernel's buffers (ring's has room for every cell's worst case).
+    points is a view of room, or of a buffer with room for exactly the crossings counted.
     """
     xmin, ymin, xmax, ymax = [float(side) for side in box_tuple]
     cdef Box box = make_box(xmin, ymin, xmax, ymax, e)
     cdef int n = xs.shape[0], m = vertices.shape[0], n_he = he_origin.shape[0]
     cdef signed char[::1] vcx = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] vcy = np.empty(max(m, 1), np.int8)
-    cdef signed char[::1] tie = np.zeros(max(m, 1), np.int8)
-    cdef int32_t[::1] seg_start = np.empty(n_he, np.int32)    # written and read only for edges not WHOLE
-    cdef int32_t[::1] seg_end = np.empty(n_he, np.int32)
+    # arrays written at a few places only (Scratch): ties, the parts of edges not WHOLE
+    cdef Scratch scratch = Scratch()
+    cdef signed char* tie = <signed char*> scratch.take(max(m, 1), True)
+    cdef int32_t* seg_start = <int32_t*> scratch.take(max(n_he, 1) * sizeof(int32_t), False)
+    cdef int32_t* seg_end = <int32_t*> scratch.take(max(n_he, 1) * sizeof(int32_t), False)
     cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
-    cdef double[:, ::1] pts
-    cdef signed char[::1] pt_side
-    cdef int32_t[::1] pt_a, pt_b, pt_c                         # how a boundary point was made (Points)
+    cdef double[:, ::1] pts, room_pts
+    cdef signed char* pt_side                                   # read only at exits and entries
+    cdef int32_t* pt_a                                          # how a boundary point was made (Points)
+    cdef int32_t* pt_b
+    cdef int32_t* pt_c
     cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0, n_bent = 0
     cdef int n_cross = 0, lo, hi
     cdef int64_t n_ring = 0
@@ -113,14 +119,20 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                 flags[h] = HAS | WHOLE
             elif he_twin[h] > h:
                 n_cross += 1
-    pts = np.empty((m + 2 * n_cross + 4, 2), np.float64)
-    pt_side = np.empty(m + 2 * n_cross + 4, np.int8)            # read only at exits and entries
-    pt_a = np.empty(m + 2 * n_cross + 4, np.int32)
-    pt_b = np.empty(m + 2 * n_cross + 4, np.int32)
-    pt_c = np.empty(m + 2 * n_cross + 4, np.int32)
+    cdef bint in_room = False
+    if room is not None:
+        room_pts = room
+        in_room = (room_pts.shape[0] >= m + 2 * n_cross + 4
+                   and (m == 0 or &room_pts[0, 0] == &vertices[0, 0]))
+    pts_buf = room if in_room else np.empty((m + 2 * n_cross + 4, 2), np.float64)
+    pts = pts_buf
+    pt_side = <signed char*> scratch.take(m + 2 * n_cross + 4, False)
+    pt_a = <int32_t*> scratch.take((m + 2 * n_cross + 4) * sizeof(int32_t), False)
+    pt_b = <int32_t*> scratch.take((m + 2 * n_cross + 4) * sizeof(int32_t), False)
+    pt_c = <int32_t*> scratch.take((m + 2 * n_cross + 4) * sizeof(int32_t), False)
 
     with nogil:
-        if m > 0:
+        if m > 0 and not in_room:
             memcpy(&pts[0, 0], &vertices[0, 0], 2 * m * sizeof(double))
         for h in range(n_he if n_ties > 0 else 0):
             v = he_origin[h]
@@ -180,19 +192,20 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             pt_a[corner0 + k] = -1
         n_pts += 4
         P.xy = &pts[0, 0]
-        P.side = &pt_side[0]
-        P.da = &pt_a[0]
-        P.db = &pt_b[0]
-        P.dc = &pt_c[0]
+        P.side = pt_side
+        P.da = pt_a
+        P.db = pt_b
+        P.dc = pt_c
         P.sx = &xs[0] if n > 0 else NULL
         P.sy = &ys[0] if n > 0 else NULL
         P.corner0 = corner0
 
     # each cell: walk its edges counter-clockwise, and the box boundary between exits and entries; the
-    # cells are split into one run per thread, each writing its rings into its own part of the buffer
-    # (room for the worst case of every cell), the parts then moved together
+    # cells are split into one run per thread, each writing into its own part of the buffer (room for
+    # the worst case of every cell), the parts then moved together and the buffer cut to size in place
     cdef int64_t cap = 2 * n_he + 4 * n + 4
-    cdef int32_t[::1] ring = np.empty(T * cap, np.int32)
+    ring_buf = np.empty(T * cap, np.int32)
+    cdef int32_t[::1] ring = ring_buf
     cdef int64_t[::1] ends = np.zeros(T, np.int64)
     cdef int[::1] bent = np.zeros(T, np.intc)
     cdef int[::1] stat = np.zeros(T, np.intc)
@@ -205,8 +218,8 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     S.face_edge = &face_edge[0] if n > 0 else NULL
     S.active = &active[0] if n > 0 else NULL
     S.flags = &flags[0] if n_he > 0 else NULL
-    S.seg_start = &seg_start[0] if n_he > 0 else NULL
-    S.seg_end = &seg_end[0] if n_he > 0 else NULL
+    S.seg_start = seg_start
+    S.seg_end = seg_end
     S.box = &box
     S.P = &P
     with nogil:
@@ -234,10 +247,12 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     if status == 2:
         raise MemoryError("no memory for the edges of a cell")
 
-    # views, not copies: the caller gathers the rings into input order, and pts has room for exactly
-    # the crossings counted
-    points = np.asarray(pts)[:n_pts]
-    rings = np.asarray(ring)[:n_ring]
+    # no copies: the ring buffer is cut to its rings in place (no view of it is left), and points is a
+    # view of a buffer with room for at least the crossings counted
+    ring = None
+    ring_buf.resize(max(n_ring, 1), refcheck=False)
+    rings = ring_buf[:n_ring]
+    points = pts_buf[:n_pts]
     offs = np.asarray(offsets)
     if n_bent:
         kind = np.full(n_pts, 2, np.int8)               # an interior vertex
@@ -247,6 +262,28 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         kind[corner0:] = 0                               # a corner
         offs, rings = straighten(points, offs, rings, kind)
     return points, offs, rings, status
+
+
+cdef class Scratch:
+    """C buffers that a pass writes at a few places only, freed with this object. Not numpy's: numpy asks
+    the kernel for 2 MiB pages on large arrays, and a few scattered writes would then make all of them
+    resident."""
+    cdef void* buf[8]
+    cdef int count
+
+    cdef void* take(self, size_t nbytes, bint zeroed) except NULL:
+        assert self.count < 8, "Scratch holds at most 8 buffers"
+        p = calloc(nbytes, 1) if zeroed else malloc(nbytes)
+        if p == NULL:
+            raise MemoryError()
+        self.buf[self.count] = p
+        self.count += 1
+        return p
+
+    def __dealloc__(self):
+        cdef int k
+        for k in range(self.count):
+            free(self.buf[k])
 
 
 cdef inline int next_in_cell(int h, int n_he, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
@@ -402,7 +439,7 @@ cdef void release(CellEdges* C) noexcept nogil:
         free(C.start); free(C.end); free(C.entry); free(C.exit_); free(C.has); free(C.nbx); free(C.nby)
 
 
-def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int64_t[::1] cell_of_row):
+def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int32_t[::1] cell_of_row):
     """Rings gathered into input-row order: row r shows cell cell_of_row[r] (-1: no cell).
 
     Returns (cell_offsets (rows + 1,) int64, cell_vertices (K,) int32), the CSR of Diagram.
@@ -426,6 +463,7 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int6
             if c >= 0 and offsets[c + 1] > offsets[c]:
                 memcpy(&out[cell_offsets[r]], &ring[offsets[c]], (offsets[c + 1] - offsets[c]) * sizeof(int32_t))
     return cell_offsets_arr, vertices_arr
+
 
 
 def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):

@@ -44,7 +44,7 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
-                          int parallel_min=PARALLEL_MIN_SITES):
+                          int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -65,12 +65,16 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         returned in the user's unit, each coordinate correctly rounded.
     threads : int, threads for the circumcentres and the cocircular test (the result is the same
         for any count), when there are at least parallel_min sites.
+    clip_room : bool, leave room after the vertices for the points clip.clip_cells adds on the box
+        (at most two per edge, and four corners), so that it writes them there instead of copying the
+        vertices: address space only, as rows never written cost no memory.
 
     Returns
     -------
     dict of arrays: vertices (m, 2) float64; he_origin, he_twin, he_face (h,) int32;
     face_edge (n,) int32 (the first half-edge of each cell, -1 for a site without one); triangles
-    (k, 3) int32, the finite Delaunay triangles. The next half-edge of a cell is the following one
+    (k, 3) int32, the finite Delaunay triangles; with clip_room, vertex_room: the buffer whose first m
+    rows are the vertices. The next half-edge of a cell is the following one
     while the face stays the same, then the first again (next_in_cell).
     """
     cdef int n = xs.shape[0], inf = n
@@ -104,7 +108,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 for e in range(3 * t, 3 * t + 3):
                     if first_e[tv[e]] < 0:
                         first_e[tv[e]] = e
-    centre = np.empty((n_finite, 2), np.float64)
+    # (an edge is dual to a Delaunay edge between two sites, n_he_d bounds twice their number)
+    centre_buf = np.empty((n_finite + (n_he_d + 4 if clip_room else 0), 2), np.float64)
+    centre = centre_buf
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
     cdef int n_zero = 0, lo, hi
@@ -179,14 +185,17 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             m, h = drop_zero_edges(h, m, n, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
                                    &zero[0], &parent[0], &vid[0], &vor[0], &centre[0, 0])
 
-    return {
-        "vertices": np.asarray(centre)[:m],
+    out = {
+        "vertices": centre_buf[:m],
         "he_origin": np.asarray(he_origin)[:h],
         "he_twin": np.asarray(he_twin)[:h],
         "he_face": np.asarray(he_face)[:h],
         "face_edge": np.asarray(face_edge),
         "triangles": np.asarray(tri),
     }
+    if clip_room:
+        out["vertex_room"] = centre_buf
+    return out
 
 
 cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:

@@ -1,0 +1,105 @@
+"""The allocator a build's arrays come from (kernels/pages.pyx): large arrays in mappings of their own."""
+
+import os
+import sys
+import threading
+
+import numpy as np
+import pytest
+from numpy._core.multiarray import get_handler_name
+
+import tvoronoi
+from tvoronoi import engines
+from tvoronoi.api import default_bbox
+from tvoronoi.build import assemble, build_arrays
+from tvoronoi.generators import generate
+from tvoronoi.kernels import pages
+
+BIG = (1 << 20) // 8 + 1000          # doubles: just over the size that gets a mapping
+
+
+def test_arrays_made_inside_come_from_the_handler_and_the_old_one_returns():
+    before = get_handler_name(np.empty(3))
+    with build_arrays():
+        small, big = np.empty(10), np.empty(BIG)
+        assert get_handler_name(small) == get_handler_name(big) == "tvoronoi_pages"
+    assert get_handler_name(np.empty(BIG)) == before
+    big[:] = 1.5                     # still usable, and freed by its own handler after the block
+    assert big.sum() == 1.5 * BIG
+
+
+def test_the_handler_is_left_on_an_exception():
+    before = get_handler_name(np.empty(3))
+    with pytest.raises(RuntimeError):
+        with build_arrays():
+            raise RuntimeError("stop")
+    assert get_handler_name(np.empty(3)) == before
+
+
+def test_another_thread_keeps_its_own_allocator():
+    names = []
+    with build_arrays():
+        t = threading.Thread(target=lambda: names.append(get_handler_name(np.empty(BIG))))
+        t.start()
+        t.join()
+    assert names and names[0] != "tvoronoi_pages"
+
+
+@pytest.mark.parametrize("n", [5, BIG, 4 * BIG])
+def test_zeros_grow_and_shrink_keep_the_data(n):
+    with build_arrays():
+        z = np.zeros(n)
+        assert not z.any()
+        a = np.arange(n, dtype=np.float64)
+        a.resize(3 * n, refcheck=False)          # a mapping grows in place or moves, with its pages
+        assert np.array_equal(a[:n], np.arange(n)) and not a[n:].any()
+        a.resize(n // 2 + 1, refcheck=False)
+        assert np.array_equal(a, np.arange(n // 2 + 1))
+        b = np.arange(7, dtype=np.float64)
+        b.resize(n + 7, refcheck=False)          # from malloc to a mapping when it grows past 1 MiB
+        assert np.array_equal(b[:7], np.arange(7)) and not b[7:].any()
+
+
+def test_a_build_equals_one_made_with_the_default_allocator_and_no_room():
+    """The build's arrays under the handler, the crossings written into the dual's room: the same Diagram as
+    the arrays of numpy's own allocator and the crossings in a copy."""
+    pts = generate("clustered", 30_000, seed=4)
+    box = default_bbox(pts)
+    e = engines.scale_exponent(pts)
+    t = engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
+    out = t.voronoi(1)
+    assert "vertex_room" not in out
+    plain = assemble(pts, box, e, t.sites.perm, t.sites.xs, t.sites.ys, out, engine="incremental")
+    assert get_handler_name(owner(plain.cell_points)) != "tvoronoi_pages"
+    built = tvoronoi.voronoi(pts, threads=1)
+    assert get_handler_name(owner(built.cell_points)) == "tvoronoi_pages"
+    for name in ("vertices", "he_origin", "he_twin", "he_face", "face_edge", "triangles", "cell_points",
+                 "cell_offsets", "cell_vertices", "site_of"):
+        assert np.array_equal(getattr(plain, name), getattr(built, name)), name
+
+
+def owner(a: np.ndarray) -> np.ndarray:
+    while isinstance(a.base, np.ndarray):
+        a = a.base
+    return a
+
+
+def resident_mib() -> float:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+@pytest.mark.skipif(not pages.MAPS or not os.path.exists("/proc/self/statm"), reason="no mappings here")
+def test_a_freed_array_is_handed_back():
+    """Unlike the C heap's blocks below its threshold, a freed array leaves the resident set at once."""
+    with build_arrays():
+        scratch = np.empty(2 << 20)              # raise the heap's threshold as a build's temporaries do
+        del scratch
+        a = np.ones(2 << 20)                     # 16 MiB
+        held = resident_mib()
+        del a
+    assert held - resident_mib() > 14
+
+
+def test_it_maps_on_linux():
+    assert pages.MAPS == sys.platform.startswith("linux")
