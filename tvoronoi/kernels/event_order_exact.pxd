@@ -113,6 +113,31 @@ cdef extern from *:
 
 
 
+cdef inline bint translates(const double* t1, const double* t2) noexcept nogil:
+    """True when the sites of t2 are those of t1, in the same cyclic order, moved along x by one amount
+    that a double holds exactly: congruent circles side by side, so their tops are equal. Exact
+    comparisons only, no in-circle test: the common tie of a lattice's row parallel to the sweep line,
+    settled before any filter. Each list is counter-clockwise: ax, ay, bx, by, cx, cy."""
+    cdef int r, w, k
+    cdef double dx, tail, px
+    for r in range(3):
+        if t2[1] != t1[2 * r + 1]:
+            continue
+        dx, tail = two_diff(t2[0], t1[2 * r])
+        if tail != 0.0:
+            continue
+        for w in range(1, 3):
+            k = (w + r) % 3
+            if t2[2 * w + 1] != t1[2 * k + 1]:
+                break
+            px, tail = two_diff(t2[2 * w], dx)
+            if tail != 0.0 or px != t1[2 * k]:
+                break
+        else:
+            return True
+    return False
+
+
 cdef inline bint same_top_by_shift(const double* t1, const double* t2) noexcept nogil:
     """True when the circle of one event is the other's moved along x by an exact amount (zero
     included): each site of t2, moved back by it, is a site of t1 or lies on t1's circle (exact

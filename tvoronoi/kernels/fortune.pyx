@@ -19,7 +19,7 @@ from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.circle_events cimport (
     circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_order, fine_site,
 )
-from tvoronoi.kernels.event_order_exact cimport same_top_by_shift, tvb_site_first, tvb_top_order
+from tvoronoi.kernels.event_order_exact cimport same_top_by_shift, translates, tvb_site_first, tvb_top_order
 from tvoronoi.kernels.sweep_state cimport (
     Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
     OK, BROKEN, NO_MEMORY, NO_REPAIR,
@@ -107,6 +107,12 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     cdef double base_i, rise_i, err_i, base_j, rise_j, err_j
     # near tie: the rises above the sites, the double-double filter, then exact integers
     s.n_near += 1
+    if s.ev_y[i] == s.ev_y[j]:
+        # first the degenerate case of a lattice: congruent circles side by side (one rounded top)
+        event_sites(s, i, ti)
+        event_sites(s, j, tj)
+        if translates(ti, tj):
+            return 0
     event_rise(s, i, &base_i, &rise_i, &err_i)
     event_rise(s, j, &base_j, &rise_j, &err_j)
     c = relative_sign(base_i, rise_i, err_i, base_j, rise_j, err_j)
@@ -131,9 +137,18 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
 
 cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil:
     """ev_less when the two events' intervals overlap: the exact sign, then the centre's rounded x."""
-    cdef int c = top_order_exact(s, i, j)
-    if c != 0:
-        return c < 0
+    cdef int c = 0
+    if s.ev_class[i] != s.ev_class[j]:
+        c = top_order_exact(s, i, j)
+        if c != 0:
+            return c < 0
+        # equal tops: remembered, so that the next comparison of the two (a heap compares the events of
+        # a lattice's row with each other again and again) costs nothing. Equality is transitive: both
+        # take the older class, so a row's events gather into its first event's class
+        if s.ev_class[i] < s.ev_class[j]:
+            s.ev_class[j] = s.ev_class[i]
+        else:
+            s.ev_class[i] = s.ev_class[j]
     # equal tops: different centres share no arc (the events commute), one centre is a cocircular group
     return s.ev_x[i] < s.ev_x[j]
 
@@ -197,6 +212,8 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
                    &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &s.ev_x[ev], &s.ev_cy[ev])
         s.ev_fine_state[ev] = FINE_UNKNOWN | RISE_KNOWN
     s.ev_arc[ev] = arc
+    s.ev_class[ev] = s.n_classes
+    s.n_classes += 1
     s.arc_event[arc] = ev
     heap_push(s, ev)
 
@@ -476,6 +493,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
         "ev_fine_state": np.empty(cap_ev, np.int8),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
+        "ev_class": np.empty(cap_ev, np.int64),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
         "rec_a": np.empty(cap_rec, np.int32), "rec_b": np.empty(cap_rec, np.int32),
@@ -494,6 +512,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     cdef double[::1] ev_span = arrays["ev_span"], ev_rise = arrays["ev_rise"]
     cdef int8_t[::1] ev_fine_state = arrays["ev_fine_state"]
     cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
+    cdef int64_t[::1] ev_class = arrays["ev_class"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
     cdef double[::1] rec_x = arrays["rec_x"], rec_y = arrays["rec_y"]
@@ -507,6 +526,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
+    s.ev_class = &ev_class[0]; s.n_classes = 0
     s.ev_span = &ev_span[0]
     s.ev_rise = &ev_rise[0]
     s.ev_fine_state = &ev_fine_state[0]
@@ -644,12 +664,13 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
     cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
     cdef double* fine = <double*>malloc(3 * cap_ev * sizeof(double))
+    cdef int64_t* classes = <int64_t*>malloc(cap_ev * sizeof(int64_t))
     cdef int32_t* p = ib
     cdef double* q = fb
     cdef Sweep s
     cdef int next_site = 0, k, result = -1
-    if ib == NULL or fb == NULL or bb == NULL or fine == NULL:
-        free(ib); free(fb); free(bb); free(fine)
+    if ib == NULL or fb == NULL or bb == NULL or fine == NULL or classes == NULL:
+        free(ib); free(fb); free(bb); free(fine); free(classes)
         return -1
     s.x = x; s.y = y; s.n = n
     s.arc_site = p; p += cap_arcs
@@ -662,6 +683,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.arc_edge = p; p += cap_arcs
     s.free_arcs = p; p += 3 * cap_arcs
     s.ev_arc = p; p += cap_ev
+    s.ev_class = classes; s.n_classes = 0
     s.ev_pos = p; p += cap_ev
     s.heap = p; p += cap_ev
     s.free_events = p; p += cap_ev
@@ -709,6 +731,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     free(fb)
     free(bb)
     free(fine)
+    free(classes)
     return result
 
 

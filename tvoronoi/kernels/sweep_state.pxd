@@ -1,7 +1,7 @@
 # The state of Fortune's sweep (fortune.pyx): one struct of arrays, shared by the beach line, the event
 # queue and the events; the enums of event kinds, double-double filter states and status codes.
 
-from libc.stdint cimport int8_t, int32_t
+from libc.stdint cimport int8_t, int32_t, int64_t
 
 
 cdef enum:
@@ -53,6 +53,8 @@ cdef struct Sweep:
     int8_t* ev_fine_state   # FINE_UNKNOWN, FINE_OK, FINE_NONE, | RISE_KNOWN
     double* ev_rise         # base, rise, rise error (3 per event), where RISE_KNOWN
     int32_t* ev_arc
+    int64_t* ev_class       # events proven to have equal tops share a class (numbers never reused)
+    int64_t n_classes
     int32_t* heap
     int32_t* ev_pos        # where each pending event sits in the heap
     int n_heap
