@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol
+from typing import Callable, Protocol
 
 import numpy as np
 from textual.message import Message
-from textual.worker import Worker, get_current_worker
+from textual.worker import get_current_worker
 
 import tvoronoi
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.readers.pointset import PointSet
-from tvoronoi.tui.canvas import DiagramCanvas
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.raster import Scene
 
 # Work on this many sites or more runs in a worker thread; the status line and the panel's
@@ -66,13 +66,11 @@ class BuildFailed(Message):
         self.error = error
 
 
-class BuildingHost(Protocol):
+class BuildingHost(Host, Protocol):
     """What building uses of the App."""
 
     clock: Clock
 
-    @property
-    def canvas(self) -> DiagramCanvas: ...
     def selected_engine(self) -> str: ...
     def set_status(self, text: str) -> None: ...
     def update_status(self) -> None: ...
@@ -81,12 +79,6 @@ class BuildingHost(Protocol):
     def diagram_replaced(self) -> None: ...
     def diagram_shown(self) -> None: ...
     def action_generate(self) -> None: ...
-    def notify(self, message: str, *, title: str = ..., severity: Any = ..., timeout: float | None = ...,
-               markup: bool = ...) -> None: ...
-    def post_message(self, message: Message) -> bool: ...
-    def run_worker(self, work: Callable[[], None], name: str | None = ..., group: str = ...,
-                   description: str = ..., exit_on_error: bool = ..., start: bool = ..., exclusive: bool = ...,
-                   thread: bool = ...) -> Worker[None]: ...
 
 
 class Building:

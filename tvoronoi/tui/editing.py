@@ -13,12 +13,12 @@ from typing import Any, Callable, Protocol
 from textual.binding import Binding
 from textual.message import Message
 from textual.widget import Widget
-from textual.worker import Worker
 
 import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.building import Built, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.live import LiveScene
 from tvoronoi.tui.playback import Player
@@ -78,13 +78,11 @@ class EditorReady(Message):
         self.live = live
 
 
-class EditingHost(Protocol):
+class EditingHost(Host, Protocol):
     """What editing uses of the App."""
 
     clock: Clock
 
-    @property
-    def canvas(self) -> DiagramCanvas: ...
     @property
     def focused(self) -> Widget | None: ...
     @property
@@ -96,12 +94,6 @@ class EditingHost(Protocol):
     def set_status(self, text: str) -> None: ...
     def update_status(self) -> None: ...
     def refresh_bindings(self) -> None: ...
-    def notify(self, message: str, *, title: str = ..., severity: Any = ..., timeout: float | None = ...,
-               markup: bool = ...) -> None: ...
-    def post_message(self, message: Message) -> bool: ...
-    def run_worker(self, work: Callable[[], None], name: str | None = ..., group: str = ...,
-                   description: str = ..., exit_on_error: bool = ..., start: bool = ..., exclusive: bool = ...,
-                   thread: bool = ...) -> Worker[None]: ...
 
 
 class Editing:

@@ -9,14 +9,13 @@ from typing import Any, Callable, Protocol
 from textual.message import Message
 from textual.screen import Screen
 from textual.theme import Theme
-from textual.worker import Worker
 
 import tvoronoi
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.readers.pointset import PointSet
 from tvoronoi.tui.building import Built
-from tvoronoi.tui.canvas import DiagramCanvas
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.colours import palette_for
 from tvoronoi.tui.live import LiveScene
 from tvoronoi.tui.raster import Drawable, View
@@ -63,11 +62,9 @@ class SaveFinished(Message):
         self.error = error
 
 
-class FilesHost(Protocol):
+class FilesHost(Host, Protocol):
     """What opening, saving and exporting use of the App."""
 
-    @property
-    def canvas(self) -> DiagramCanvas: ...
     @property
     def built(self) -> Built | None: ...
     @property
@@ -81,13 +78,7 @@ class FilesHost(Protocol):
     def show_progress(self, done: int = 0, total: int | None = None) -> None: ...
     def progress_done(self) -> None: ...
     def push_screen(self, screen: Screen[Any], callback: Callable[[Any], None]) -> Any: ...
-    def notify(self, message: str, *, title: str = ..., severity: Any = ..., timeout: float | None = ...,
-               markup: bool = ...) -> None: ...
-    def post_message(self, message: Message) -> bool: ...
     def call_from_thread(self, callback: Callable[..., Any], *args: Any, **kwargs: Any) -> Any: ...
-    def run_worker(self, work: Callable[[], None], name: str | None = ..., group: str = ...,
-                   description: str = ..., exit_on_error: bool = ..., start: bool = ..., exclusive: bool = ...,
-                   thread: bool = ...) -> Worker[None]: ...
 
 
 class Files:

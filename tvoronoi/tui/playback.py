@@ -18,12 +18,11 @@ from textual.binding import Binding
 from textual.message import Message
 from textual.screen import Screen
 from textual.timer import Timer
-from textual.worker import Worker
 
 import tvoronoi
 from tvoronoi.trace import FortuneStep, FortuneTrace, IncrementalStep, IncrementalTrace
 from tvoronoi.tui.building import Built
-from tvoronoi.tui.canvas import DiagramCanvas
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.colours import cell_colours
 from tvoronoi.tui.follow import focus_box
 from tvoronoi.tui.live import LiveScene
@@ -145,11 +144,9 @@ class StepReady(Message):
 
 
 
-class PlaybackHost(Protocol):
+class PlaybackHost(Host, Protocol):
     """What playback uses of the App."""
 
-    @property
-    def canvas(self) -> DiagramCanvas: ...
     @property
     def timeline(self) -> Timeline: ...
     @property
@@ -162,14 +159,8 @@ class PlaybackHost(Protocol):
     def playback_ended(self) -> None: ...
     def set_engine_state(self, text: Text) -> None: ...
     def set_status(self, text: str) -> None: ...
-    def notify(self, message: str, *, title: str = ..., severity: Any = ..., timeout: float | None = ...,
-               markup: bool = ...) -> None: ...
     def push_screen(self, screen: Screen[Any], callback: Callable[[Any], None]) -> Any: ...
     def set_interval(self, interval: float, callback: Callable[[], None]) -> Timer: ...
-    def post_message(self, message: Message) -> bool: ...
-    def run_worker(self, work: Callable[[], None], name: str | None = ..., group: str = ...,
-                   description: str = ..., exit_on_error: bool = ..., start: bool = ..., exclusive: bool = ...,
-                   thread: bool = ...) -> Worker[None]: ...
 
 
 class Playback:
