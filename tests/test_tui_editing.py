@@ -241,7 +241,7 @@ async def test_escape_puts_a_moved_site_back():
         await pilot.press("m", "left", "up", "up", "escape")
         await pilot.pause()
         assert np.allclose(app.live.sites[i], (x0, y0))
-        assert app._moving is None
+        assert app.editing.moving is None
 
 
 @pilot_test

@@ -31,13 +31,13 @@ async def test_the_inspector_names_the_city_under_the_keyboard_cursor():
     app = make_app()
     async with app.run_test(size=SIZE) as pilot:
         await open_cities(app, pilot)
-        assert app.inspected is None
+        assert app.inspector.inspected is None
         await pilot.press("c")
         i = row_of(app, "Lisbon")
         x, y = app.built.diagram.sites[i]
         app.canvas.set_cursor((float(x), float(y)))
         await pilot.pause()
-        info = app.inspected
+        info = app.inspector.inspected
         assert info.site == i and info.row == i
         assert info.properties["name"] == "Lisbon"
         assert (info.x, info.y) == (x, y)
@@ -50,10 +50,10 @@ async def test_the_inspector_names_the_city_under_the_keyboard_cursor():
         # the cursor moves one character at a time: the inspector follows it
         await pilot.press("shift+right")
         await pilot.pause()
-        assert app.inspected.site == app.canvas.cell_at(*app.canvas.cursor)
+        assert app.inspector.inspected.site == app.canvas.cell_at(*app.canvas.cursor)
         await pilot.press("c")  # hidden: nothing under it any more
         await pilot.pause()
-        assert app.inspected is None
+        assert app.inspector.inspected is None
 
 
 @pilot_test
@@ -66,8 +66,8 @@ async def test_the_inspector_follows_the_mouse_pointer():
         await pilot.pause()
         x, y = canvas.world_at(20, 10)
         expected = int(np.argmin(((app.built.diagram.sites - (x, y)) ** 2).sum(axis=1)))
-        assert app.inspected.site == expected
-        assert app.inspected.properties == {}
+        assert app.inspector.inspected.site == expected
+        assert app.inspector.inspected.properties == {}
         assert "pointer" in text_of(app, "#inspector")
 
 
@@ -79,7 +79,7 @@ async def test_an_added_site_is_inspected_as_added():
         await app.workers.wait_for_complete()
         await pilot.press("c", "a")
         await pilot.pause()
-        info = app.inspected
+        info = app.inspector.inspected
         assert info.site == 300 and info.row is None
         ring = app.live.dynamic.diagram().cell_polygon(300)
         assert info.area == pytest.approx(ring_area(ring))

@@ -158,7 +158,7 @@ def test_snapshot_open_dialog_browsing_at_80x24(snap_compare):
     the x and y column fields and the hint, all within the terminal."""
 
     async def open_dialog(pilot):
-        pilot.app._last_folder = DATA
+        pilot.app.files.last_folder = DATA
         await pilot.press("o")
         tree = pilot.app.screen.query_one(DirectoryTree)
         for _ in range(50):

@@ -221,7 +221,7 @@ class FakeClock:
 async def test_playing_advances_with_the_clock():
     app = make_app()
     clock = FakeClock(100.0)
-    app.playback_clock = clock
+    app.playback.clock = clock
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot)
         await pilot.press("space")
@@ -242,7 +242,7 @@ async def test_playing_advances_with_the_clock():
 async def test_time_spent_paused_does_not_count():
     app = make_app()
     clock = FakeClock(100.0)
-    app.playback_clock = clock
+    app.playback.clock = clock
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot)
         await pilot.press("space")
@@ -558,7 +558,7 @@ async def test_follow_zooms_to_a_site_event_and_its_arcs():
     app = make_app()
     async with app.run_test(size=SIZE) as pilot:
         await start_playback(app, pilot, "fortune")
-        assert app.follow and app.timeline.following
+        assert app.playback.follow and app.timeline.following
         assert "f: follow" in app.timeline.render().plain
         await pilot.press(*["full_stop"] * 40)
         step = await step_until(app, pilot, "site")
@@ -620,7 +620,7 @@ async def test_f_stops_following_and_the_view_stays():
     async with app.run_test(size=SIZE) as pilot:
         player = await start_playback(app, pilot, "fortune")
         await pilot.press("f")
-        assert not app.follow and not app.timeline.following
+        assert not app.playback.follow and not app.timeline.following
         assert "f: fixed" in app.timeline.render().plain
         view = app.canvas.view
         await pilot.press(*["full_stop"] * 60)
@@ -628,7 +628,7 @@ async def test_f_stops_following_and_the_view_stays():
         step = await step_until(app, pilot, "site")
         assert app.canvas.view == view
         await pilot.press("f")  # on again: straight to the current event
-        assert app.follow and app.canvas.zoom() > 1.5 and shows(app, *step.position)
+        assert app.playback.follow and app.canvas.zoom() > 1.5 and shows(app, *step.position)
 
 
 @pilot_test
@@ -638,7 +638,7 @@ async def test_panning_during_follow_turns_it_off_and_the_view_stays():
         await start_playback(app, pilot, "fortune")
         await pilot.press(*["full_stop"] * 30)
         await pilot.press("minus")
-        assert not app.follow
+        assert not app.playback.follow
         view = app.canvas.view
         await pilot.press(*["full_stop"] * 30)
         assert app.canvas.view == view

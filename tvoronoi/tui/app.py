@@ -1,8 +1,12 @@
 """The tvoronoi terminal UI: a diagram canvas, a side panel of controls, a playback timeline and a status line.
 
-The App is put together from parts, each in its own module: building whole
-diagrams (``building``), opening and saving (``files``), algorithm playback
-(``playback``) and editing through dynamic updates (``editing``).
+The App composes the widgets and holds its controllers, plain objects each in
+its own module: building whole diagrams (``building``), opening, saving and
+exporting (``files``), algorithm playback (``playback``), editing through
+dynamic updates (``editing``) and the cell inspector (``inspector``). Each
+controller keeps its own state and reaches the App only through the small
+Protocol its module declares (``BuildingHost``, ``PlaybackHost``...); the App's
+actions, message handlers and ``check_action`` hand over to them by name.
 """
 
 from __future__ import annotations
@@ -10,29 +14,34 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
+from typing import Any, Callable, Iterable
 
 import numpy as np
 from rich.text import Text
 from textual import on
-from textual.app import App, ComposeResult
+from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
+from textual.screen import Screen
+from textual.widget import Widget
 from textual.widgets import Button, Footer, Input, Label, ProgressBar, Select, Static
 from textual.widgets._select import SelectOverlay
 
 from tvoronoi.api import ENGINES
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import DISTRIBUTIONS, generate
+from tvoronoi.readers.pointset import PointSet
 from tvoronoi.tui import editing, playback
-from tvoronoi.tui.building import BUILD_THREAD_MIN_SITES, Built, BuildingMixin, Clock
+from tvoronoi.tui.building import BUILD_THREAD_MIN_SITES, Box, BuildFailed, Building, Built, Clock, DiagramReady
 from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.commands import app_commands
-from tvoronoi.tui.editing import EditingMixin
-from tvoronoi.tui.files import FilesMixin
-from tvoronoi.tui.inspector import InspectorMixin
+from tvoronoi.tui.editing import Editing, EditorReady
+from tvoronoi.tui.files import Files, SaveFinished, SaveProgress
+from tvoronoi.tui.inspector import PANEL_MIN_HEIGHT, Inspector
 from tvoronoi.tui.legend import legend_text
-from tvoronoi.tui.playback import PlaybackMixin
+from tvoronoi.tui.live import LiveScene
+from tvoronoi.tui.playback import Playback, Player, StepReady
 from tvoronoi.tui.relaxing import relaxed_live, relaxed_points, relaxed_source
 from tvoronoi.tui.screens import HelpScreen, OpenRequest
 from tvoronoi.tui.timeline import Timeline
@@ -70,7 +79,7 @@ class PanelSelect(Select):
     class Chosen(Message):
         """The user chose an option in the list."""
 
-        def __init__(self, select: "PanelSelect") -> None:
+        def __init__(self, select: PanelSelect) -> None:
             super().__init__()
             self.select = select
 
@@ -84,12 +93,12 @@ class SidePanel(VerticalScroll, can_focus=False):
     """The controls beside the canvas; it scrolls when the terminal is short, but Tab skips it."""
 
 
-def _tip(widget, text: str):
+def _tip(widget: Widget, text: str) -> Widget:
     widget.tooltip = text
     return widget
 
 
-class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, InspectorMixin, App[int]):
+class VoronoiApp(App[int]):
     """Explore Voronoi diagrams in the terminal.
 
     Parameters
@@ -130,14 +139,19 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         *editing.BINDINGS,
     ]
 
-    def __init__(self, points=None, *, path=None, x: str | None = None, y: str | None = None,
-                 engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
+    def __init__(self, points: Any = None, *, path: str | Path | None = None, x: str | None = None,
+                 y: str | None = None, engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
         super().__init__()
         self.initial_points = None if points is None else np.asarray(points, np.float64)
         self.initial_file = None if path is None else OpenRequest(Path(path), x, y)
         self.initial_engine = engine if engine in ENGINES else ENGINES[0]
         self.clock = clock
-        self.built: Built | None = None
+        # the controllers: each keeps its own state and uses the App through its module's Protocol
+        self.building = Building(self)
+        self.files = Files(self)
+        self.playback = Playback(self)
+        self.editing = Editing(self)
+        self.inspector = Inspector(self)
         self._panel_wanted: bool | None = None  # None: decided by the width
         self._narrow: bool | None = None  # whether the panel was last laid out for a narrow terminal
         self._status_text = ""  # the left part of the status line
@@ -238,9 +252,10 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         self.canvas.focus()
         self.watch(self.canvas, "view", self._show_view, init=False)
         if self.initial_points is not None:
-            self._request_build(lambda: self.initial_points, source="points given", size=len(self.initial_points))
+            points = self.initial_points
+            self.request_build(lambda: points, source="points given", size=len(points))
         elif self.initial_file is not None:
-            self._open_path(self.initial_file)
+            self.files.open(self.initial_file)
         else:
             self.action_generate()
 
@@ -253,9 +268,6 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         """Say where the view is (its centre and zoom) at the right of the status line."""
         self._view_text = self.canvas.describe_view() if self.built is not None else ""
         self._render_status()
-
-    def on_diagram_canvas_target_changed(self) -> None:
-        self.inspect()
 
     def _layout_panel(self) -> None:
         """Show or hide the side panel: as the user chose with `p`, else by the terminal's width.
@@ -275,9 +287,152 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         if not wanted and panel.has_focus_within:
             self.canvas.focus()
 
+    # -- what the controllers share: the diagram shown and the widgets ---------
+
     @property
     def canvas(self) -> DiagramCanvas:
         return self.query_one("#canvas", DiagramCanvas)
+
+    @property
+    def timeline(self) -> Timeline:
+        return self.query_one("#timeline", Timeline)
+
+    @property
+    def built(self) -> Built | None:
+        """The whole diagram shown (or last shown, under playback or edits); kept by building."""
+        return self.building.built
+
+    @property
+    def live(self) -> LiveScene | None:
+        """The diagram as edited, once an edit was made; kept by editing."""
+        return self.editing.live
+
+    @property
+    def player(self) -> Player | None:
+        """The playback session, while one runs; kept by playback."""
+        return self.playback.player
+
+    def selected_engine(self) -> str:
+        """The engine chosen in the panel."""
+        return str(self.query_one("#engine", Select).value)
+
+    def request_build(self, make_points: Callable[[], Any], *, source: str, size: int | None,
+                      fit: bool = True, point_set: PointSet | None = None,
+                      read: Callable[[], PointSet] | None = None, bbox: Box | None = None) -> None:
+        """Build a whole diagram and show it (see ``Building.request``)."""
+        self.building.request(make_points, source=source, size=size, fit=fit, point_set=point_set, read=read,
+                              bbox=bbox)
+
+    def fail(self, error: str) -> None:
+        """Tell the user that nothing was built; the last good diagram stays."""
+        self.building.fail(error)
+
+    def finish_editing(self) -> None:
+        """Build the edited sites into a whole diagram again."""
+        self.editing.finish()
+
+    def show_progress(self, done: int = 0, total: int | None = None) -> None:
+        """Show the panel's progress bar (total None: no known end)."""
+        bar = self.query_one("#progress", ProgressBar)
+        bar.update(total=total, progress=done)
+        bar.display = True
+
+    def progress_done(self) -> None:
+        """A build or a save ended: the bar goes, unless the other still runs."""
+        if self.building.running is None and not self.files.saving:
+            self.query_one("#progress").display = False
+
+    def diagram_replaced(self) -> None:
+        """A new whole diagram is about to be shown: playback and edits of the old one end."""
+        self.playback.stop()
+        self.editing.drop()
+
+    def diagram_shown(self) -> None:
+        """A new whole diagram is on screen: make it ready for editing; a file's ambiguous columns
+        are asked about."""
+        self.editing.prepare()
+        self.files.offer_columns()
+
+    def playback_started(self) -> None:
+        """Playback began: the panel shows the engine's state, the keys are playback's."""
+        self.refresh_bindings()
+        self.inspect()  # hidden during playback
+        self._show_engine_state(True)
+        self.update_legend()
+
+    def playback_ended(self) -> None:
+        """Playback ended: the panel's controls and the diagram's status come back."""
+        self._show_engine_state(False)
+        self.refresh_bindings()
+        self.update_status()
+
+    def _show_engine_state(self, shown: bool) -> None:
+        """During playback the panel shows the engine's state where the point controls were
+        (new points wait until playback ends)."""
+        self.query_one("#points-section").display = not shown
+        for widget in self.query(".playstate"):
+            widget.display = shown
+
+    def set_engine_state(self, text: Text) -> None:
+        self.query_one("#playstate", Static).update(text)
+
+    def timeline_on_screen(self) -> bool:
+        """The timeline is on the screen shown (no dialog over it, the app not closing)."""
+        return bool(self.screen.query("#timeline"))
+
+    def inspect(self) -> None:
+        """Show the cell under the cursor or pointer now."""
+        self.inspector.inspect()
+
+    def inspector_in_panel(self) -> bool:
+        """Whether the side panel is shown and tall enough to hold the inspector."""
+        return bool(self.query_one("#panel").display) and self.size.height >= PANEL_MIN_HEIGHT
+
+    def show_inspector(self, text: Text, *, shown: bool, in_panel: bool) -> None:
+        """The inspector's text, in the panel or in the line above the status line."""
+        for widget in self.query(".inspector"):
+            widget.display = shown and in_panel
+        line = self.query_one("#inspect-line", Static)
+        line.display = shown and not in_panel
+        if in_panel:
+            self.query_one("#inspector", Static).update(text)
+        else:
+            line.update(text, layout=False)
+
+    # -- messages, handed to their controllers -----------------------------------
+
+    def on_diagram_ready(self, message: DiagramReady) -> None:
+        self.building.ready(message)
+
+    def on_build_failed(self, message: BuildFailed) -> None:
+        self.building.failed(message)
+
+    def on_save_progress(self, message: SaveProgress) -> None:
+        self.files.save_progress(message)
+
+    def on_save_finished(self, message: SaveFinished) -> None:
+        self.files.save_finished(message)
+
+    def on_step_ready(self, message: StepReady) -> None:
+        self.playback.step_ready(message)
+
+    def on_timeline_scrubbed(self, message: Timeline.Scrubbed) -> None:
+        self.playback.scrubbed(message.step)
+
+    def on_diagram_canvas_view_changed(self) -> None:
+        self.playback.view_changed()
+
+    def on_editor_ready(self, message: EditorReady) -> None:
+        self.editing.editor_ready(message)
+
+    def on_diagram_canvas_clicked(self, message: DiagramCanvas.Clicked) -> None:
+        self.editing.add_site_at(message.x, message.y)
+
+    def on_diagram_canvas_site_dragged(self, message: DiagramCanvas.SiteDragged) -> None:
+        self.editing.dragged(message)
+
+    def on_diagram_canvas_target_changed(self) -> None:
+        self.inspect()
 
     # -- the panel -----------------------------------------------------------
 
@@ -299,12 +454,12 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
             return
         # the same points again (as edited), with the other engine; the view stays
         if self.live is not None:
-            self.finish_editing()
+            self.editing.finish()
             return
         points, point_set = built.points, built.point_set
-        self._request_build(lambda: points, source=built.source, size=len(points), fit=False, point_set=point_set)
+        self.request_build(lambda: points, source=built.source, size=len(points), fit=False, point_set=point_set)
 
-    def _back_to_canvas(self, control) -> None:
+    def _back_to_canvas(self, control: Widget) -> None:
         """A control was used (a choice made, a field submitted): the keys go to the diagram again."""
         if control.has_focus:
             self.canvas.focus()
@@ -342,7 +497,7 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         except ValueError:
             raise TvoronoiError(f"{name} must be a number, got {text!r}") from None
 
-    def _panel_request(self) -> tuple[str, int, int, dict]:
+    def _panel_request(self) -> tuple[str, int, int, dict[str, float]]:
         """The distribution, count, seed and parameters set in the panel."""
         distribution = str(self.query_one("#distribution", Select).value)
         count = self._read_int("count", "count", 0)
@@ -351,32 +506,27 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                 f"count {count:,} is more than the UI takes ({GENERATE_MAX_SITES:,}); use the batch mode"
             )
         seed = self._read_int("seed", "seed", 0)
-        params = {}
+        params: dict[str, float] = {}
         for name, kind in PARAMETERS[distribution]:
             params[name] = self._read_int(name, name, 1) if kind is int else self._read_float(name, name)
         return distribution, count, seed, params
-
-    # -- building ------------------------------------------------------------
-
-    def action_generate(self) -> None:
-        """Make points from the panel's settings and build their diagram."""
-        self._generate()
 
     def _generate(self) -> bool:
         """Make points from the panel's settings and build their diagram; False if a setting is bad."""
         try:
             distribution, count, seed, params = self._panel_request()
         except TvoronoiError as exc:
-            self._fail(str(exc))
+            self.fail(str(exc))
             return False
         shown = ", ".join([f"seed {seed}", *(f"{k} {v:g}" for k, v in params.items())])
         source = f"{distribution} ({shown})"
-        self._request_build(lambda: generate(distribution, count, seed=seed, **params), source=source, size=count)
+        self.request_build(lambda: generate(distribution, count, seed=seed, **params), source=source, size=count)
         return True
 
     # -- status --------------------------------------------------------------
 
-    def _set_status(self, text: str) -> None:
+    def set_status(self, text: str) -> None:
+        """Say what is shown, at the left of the status line."""
         self._status_text = text
         self._render_status()
 
@@ -400,28 +550,31 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
             line.append(right, style="dim")
         status.update(line, layout=False)
 
-    def _update_status(self) -> None:
+    def update_status(self) -> None:
         """Say what is shown: in the status line, and the inspected cell (which may have changed)."""
         self.inspect()
         self.update_legend()
         self._show_view()
-        if self.building is not None:
-            self._set_status(self.building)  # the old diagram's status would hide the running build
+        if self.building.running is not None:
+            self.set_status(self.building.running)  # the old diagram's status would hide the running build
             return
         built = self.built
         if built is None:
-            self._set_status("no diagram")
+            self.set_status("no diagram")
             return
-        if self.player is not None:
-            if self.player.step is not None:
-                self._set_status(self.player.step.describe())
+        player = self.player
+        if player is not None:
+            if player.step is not None:
+                self.set_status(player.step.describe())
             return
         d = built.diagram
-        if self.live is not None:
+        live = self.live
+        if live is not None:
+            edits = self.editing
             parts = [
-                f"{self.live.n_sites:,} sites",
+                f"{live.n_sites:,} sites",
                 d.engine,
-                f"{self.n_edits:,} edits, last {self.last_edit_ms:.1f} ms",
+                f"{edits.n_edits:,} edits, last {edits.last_edit_ms:.1f} ms",
                 f"{built.source} (edited)",
             ]
         else:
@@ -434,14 +587,41 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
             ]
         if self.canvas.show_delaunay:
             parts.append("Delaunay shown")
-        self._set_status(" · ".join(parts))
+        self.set_status(" · ".join(parts))
 
     # -- actions -------------------------------------------------------------
 
-    def get_system_commands(self, screen):
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """Whether a key's action runs now: the legend's two bindings by playback, then what playback
+        and editing allow; every other action always."""
+        if action == "toggle_legend":
+            return (self.player is not None) == bool(parameters)
+        for controller in (self.playback, self.editing):
+            allowed = controller.allows(action)
+            if allowed is not None:
+                return allowed
+        return True
+
+    def get_system_commands(self, screen: Screen[Any]) -> Iterable[SystemCommand]:
         """The command palette: Textual's commands, then the app's own (tui/commands.py)."""
         yield from super().get_system_commands(screen)
         yield from app_commands(self)
+
+    def action_generate(self) -> None:
+        """Make points from the panel's settings and build their diagram."""
+        self._generate()
+
+    def action_open(self) -> None:
+        """Ask for a point file and show its diagram."""
+        self.files.ask_open()
+
+    def action_save(self) -> None:
+        """Ask for a path and write the cells there as GeoJSON."""
+        self.files.ask_save()
+
+    def action_export(self) -> None:
+        """Ask for a path and write the view there: .svg (vector) or .png."""
+        self.files.ask_export()
 
     def action_next_engine(self) -> None:
         """Switch to the other engine: the same points again, the view kept."""
@@ -459,21 +639,21 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
                         severity="warning", timeout=5)
             return
         source = relaxed_source(built.source)
-        if self.live is not None:
+        live = self.live
+        if live is not None:
             # edited sites: their whole diagram is built once to find the centroids
-            live = self.live
-            points = relaxed_live(live.points(), live.bbox, self._engine())
+            points = relaxed_live(live.points(), live.bbox, self.selected_engine())
             bbox = live.bbox
         else:
             points = relaxed_points(built.diagram, built.points)
             bbox = built.diagram.bbox
-        self._request_build(lambda: points, source=source, size=len(points), fit=False,
-                            point_set=built.point_set, bbox=bbox)
+        self.request_build(lambda: points, source=source, size=len(points), fit=False,
+                           point_set=built.point_set, bbox=bbox)
 
     def action_toggle_delaunay(self) -> None:
         """Show or hide the Delaunay triangulation over the cells."""
         self.canvas.show_delaunay = not self.canvas.show_delaunay
-        self._update_status()
+        self.update_status()
 
     def action_toggle_vertices(self) -> None:
         """Show or hide the Voronoi vertex marks."""
@@ -499,11 +679,6 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         if self.legend_shown:
             self.query_one("#legend").scroll_visible(animate=False)
 
-    def check_action(self, action: str, parameters: tuple) -> bool | None:
-        if action == "toggle_legend":
-            return (self.player is not None) == bool(parameters)
-        return super().check_action(action, parameters)
-
     def update_legend(self) -> None:
         """The legend of what is drawn now: the diagram, or the playback of its engine."""
         mode = "normal" if self.player is None else self.player.engine
@@ -520,26 +695,67 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
     def action_focus_canvas(self) -> None:
         self.canvas.focus()
 
-    def _diagram_replaced(self) -> None:
-        """A new whole diagram is about to be shown: playback and edits of the old one end."""
-        self.stop_playback()
-        self.drop_editing()
-
-    def _diagram_shown(self) -> None:
-        """A new whole diagram is on screen: make it ready for editing; a file's ambiguous columns
-        are asked about."""
-        self.prepare_editing()
-        self.offer_columns()
-
     def action_help(self) -> None:
         """List every key."""
         self.push_screen(HelpScreen(self.key_help()))
+
+    # playback (tui/playback.py)
+
+    def action_toggle_playback(self) -> None:
+        """Start playing the selected engine's steps, or stop and show the diagram again."""
+        self.playback.toggle()
+
+    def action_play_pause(self) -> None:
+        self.playback.play_pause()
+
+    def action_step(self, delta: int) -> None:
+        self.playback.step(delta)
+
+    def action_step_to(self, where: str) -> None:
+        self.playback.step_to(where)
+
+    def action_jump(self, direction: int) -> None:
+        self.playback.jump(direction)
+
+    def action_speed(self, direction: int) -> None:
+        self.playback.change_speed(direction)
+
+    def action_toggle_follow(self) -> None:
+        self.playback.toggle_follow()
+
+    # editing (tui/editing.py)
+
+    def action_toggle_cursor(self) -> None:
+        self.editing.toggle_cursor()
+
+    def action_cursor(self, dx: int, dy: int) -> None:
+        self.editing.move_cursor(dx, dy)
+
+    def action_add_site(self) -> None:
+        self.editing.add_site()
+
+    def action_remove_site(self) -> None:
+        self.editing.remove_site()
+
+    def action_move_site(self) -> None:
+        self.editing.pick_up()
+
+    def action_nudge(self, dx: int, dy: int) -> None:
+        self.editing.nudge(dx, dy)
+
+    def action_drop_site(self) -> None:
+        self.editing.drop_site()
+
+    def action_cancel_move(self) -> None:
+        self.editing.cancel_move()
 
     def key_help(self) -> list[tuple[str, str]]:
         """(keys, what they do) for every binding of the canvas and the app."""
         rows: list[tuple[str, str]] = []
         seen: dict[str, int] = {}
         for binding in (*DiagramCanvas.BINDINGS, *self.BINDINGS):
+            if not isinstance(binding, Binding):
+                continue
             if binding.action in editing.HELP_HIDDEN or binding.action in HELP_HIDDEN:
                 continue
             # each key by its own name (the footer shows only the first one's)
@@ -556,7 +772,6 @@ class VoronoiApp(BuildingMixin, FilesMixin, PlaybackMixin, EditingMixin, Inspect
         rows.append(("tab", "next control"))
         rows.append(("ctrl+p", "command palette (themes, screenshot, quit)"))
         return rows
-
 
 # Second bindings of a key, already in the help under the first.
 HELP_HIDDEN = {"toggle_legend('playback')"}

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Protocol
 
 import numpy as np
-from textual import work
 from textual.message import Message
 from textual.worker import get_current_worker
 
@@ -14,6 +13,7 @@ import tvoronoi
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.readers.pointset import PointSet
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.raster import Scene
 
 # Work on this many sites or more runs in a worker thread; the status line and the panel's
@@ -21,6 +21,8 @@ from tvoronoi.tui.raster import Scene
 BUILD_THREAD_MIN_SITES = 100_000
 
 Clock = Callable[[], float]
+# a box (xmin, ymin, xmax, ymax), as the API takes it
+Box = tuple[float, ...]
 
 
 @dataclass(frozen=True)
@@ -36,7 +38,7 @@ class Built:
 
 
 def build(points: np.ndarray, engine: str, source: str, clock: Clock, point_set: PointSet | None = None,
-          bbox=None) -> Built:
+          bbox: Box | None = None) -> Built:
     """Build the diagram of some points and prepare it for drawing (any thread)."""
     start = clock()
     diagram = tvoronoi.voronoi(points, engine=engine, bbox=bbox)
@@ -64,26 +66,39 @@ class BuildFailed(Message):
         self.error = error
 
 
-class BuildingMixin:
-    """The App's part that builds diagrams and hands them to the canvas.
+class BuildingHost(Host, Protocol):
+    """What building uses of the App."""
 
-    Every whole diagram reaches the canvas through ``_request_build`` and
-    ``DiagramReady``; point-by-point edits go through the editing part, and
-    algorithm steps through the playback part.
+    clock: Clock
+
+    def selected_engine(self) -> str: ...
+    def set_status(self, text: str) -> None: ...
+    def update_status(self) -> None: ...
+    def show_progress(self, done: int = 0, total: int | None = None) -> None: ...
+    def progress_done(self) -> None: ...
+    def diagram_replaced(self) -> None: ...
+    def diagram_shown(self) -> None: ...
+    def action_generate(self) -> None: ...
+
+
+class Building:
+    """Builds diagrams and hands them to the canvas; holds the diagram shown.
+
+    Every whole diagram reaches the canvas through ``request`` and
+    ``DiagramReady``; point-by-point edits go through the editing controller,
+    and algorithm steps through the playback controller.
     """
 
-    _request = 0
-    # what the status line says while a build runs in a worker (None: no build running)
-    building: str | None = None
+    def __init__(self, host: BuildingHost) -> None:
+        self.host = host
+        self.built: Built | None = None
+        # what the status line says while a build runs in a worker (None: no build running)
+        self.running: str | None = None
+        self._request = 0
 
-    def _engine(self) -> str:
-        from textual.widgets import Select
-
-        return str(self.query_one("#engine", Select).value)
-
-    def _request_build(self, make_points: Callable[[], np.ndarray], *, source: str, size: int | None,
-                       fit: bool = True, point_set=None, read: Callable[[], object] | None = None,
-                       bbox=None) -> None:
+    def request(self, make_points: Callable[[], np.ndarray], *, source: str, size: int | None,
+                fit: bool = True, point_set: PointSet | None = None,
+                read: Callable[[], PointSet] | None = None, bbox: Box | None = None) -> None:
         """Build a diagram now, or in a worker thread when it is large or its size unknown.
 
         ``make_points`` gives the sites; ``read``, if given, instead gives a
@@ -91,7 +106,8 @@ class BuildingMixin:
         """
         self._request += 1
         request = self._request
-        engine = self._engine()
+        engine = self.host.selected_engine()
+        clock = self.host.clock
 
         def job() -> Built:
             ps = point_set
@@ -100,73 +116,71 @@ class BuildingMixin:
                 pts = ps.xy
             else:
                 pts = make_points()
-            return build(pts, engine, source, self.clock, point_set=ps, bbox=bbox)
+            return build(pts, engine, source, clock, point_set=ps, bbox=bbox)
 
         if size is not None and size < BUILD_THREAD_MIN_SITES:
             try:
                 built = job()
             except TvoronoiError as exc:
-                self._fail(str(exc))
+                self.fail(str(exc))
                 return
             self._accept(request, built, fit)
         else:
             what = f"{size:,} sites" if size is not None else source
-            self._show_building(f"building {what} with {engine}…")
-            self._build_in_thread(request, job, fit)
+            self._show_running(f"building {what} with {engine}…")
+            self.host.run_worker(lambda: self._build_in_thread(request, job, fit), thread=True,
+                                 exclusive=True, group="build", exit_on_error=False)
 
-    def _show_building(self, text: str | None) -> None:
+    def _show_running(self, text: str | None) -> None:
         """Say that a build runs (text) or that none does (None).
 
         Not the canvas's loading indicator: a widget that is loading cannot
         hold the focus, which would pass to the panel and take the keys.
         """
-        from textual.widgets import ProgressBar
-
-        self.building = text
-        bar = self.query_one("#progress", ProgressBar)
+        self.running = text
         if text is not None:
-            bar.update(total=None, progress=0)
-            bar.display = True
-            self._set_status(text)
-        elif not self._saving:
-            bar.display = False
+            self.host.show_progress()
+            self.host.set_status(text)
+        else:
+            self.host.progress_done()
 
-    @work(thread=True, exclusive=True, group="build", exit_on_error=False)
     def _build_in_thread(self, request: int, job: Callable[[], Built], fit: bool) -> None:
         worker = get_current_worker()
         try:
             built = job()
         except TvoronoiError as exc:
-            self.post_message(BuildFailed(request, str(exc)))
+            self.host.post_message(BuildFailed(request, str(exc)))
             return
         except MemoryError:
-            self.post_message(BuildFailed(request, "not enough memory for that many points"))
+            self.host.post_message(BuildFailed(request, "not enough memory for that many points"))
             return
         if not worker.is_cancelled:
-            self.post_message(DiagramReady(request, built, fit))
+            self.host.post_message(DiagramReady(request, built, fit))
 
-    def on_diagram_ready(self, message: DiagramReady) -> None:
+    def ready(self, message: DiagramReady) -> None:
+        """A worker built a diagram: show it, unless a later request replaced it."""
         self._accept(message.request, message.built, message.fit)
 
-    def on_build_failed(self, message: BuildFailed) -> None:
+    def failed(self, message: BuildFailed) -> None:
+        """A worker could not build: say why; the last good diagram stays."""
         if message.request == self._request:
-            self._show_building(None)
-        self._fail(message.error)
-        self._update_status()
-        if self.built is None and self.building is None:
+            self._show_running(None)
+        self.fail(message.error)
+        self.host.update_status()
+        if self.built is None and self.running is None:
             # nothing to keep (a file given at start could not be read): show the panel's points
-            self.action_generate()
+            self.host.action_generate()
 
     def _accept(self, request: int, built: Built, fit: bool) -> None:
         if request != self._request:
             return  # a later request replaced this one
-        self._show_building(None)
-        self._diagram_replaced()
+        self._show_running(None)
+        self.host.diagram_replaced()
         self.built = built
-        self.canvas.show_scene(built.scene, fit=fit)
-        self._update_status()
-        self._diagram_shown()
+        self.host.canvas.show_scene(built.scene, fit=fit)
+        self.host.update_status()
+        self.host.diagram_shown()
 
-    def _fail(self, error: str) -> None:
+    def fail(self, error: str) -> None:
         """Tell the user; the last good diagram stays."""
-        self.notify(error, title="Not built", severity="error", timeout=8, markup=False)
+        self.host.notify(error, title="Not built", severity="error", timeout=8, markup=False)

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 from textual.app import SystemCommand
+
+if TYPE_CHECKING:
+    from tvoronoi.tui.app import VoronoiApp
 
 # (title, what it does, the action that runs it: "app.<name>" on the App, "canvas.<name>" on the canvas)
 COMMANDS = (
@@ -23,12 +27,12 @@ COMMANDS = (
 )
 
 
-def app_commands(app) -> Iterable[SystemCommand]:
+def app_commands(app: VoronoiApp) -> Iterable[SystemCommand]:
     """The palette's entries for what the app can do now (an action it would refuse is left out)."""
     for title, help_text, target in COMMANDS:
         where, action = target.split(".", 1)
         if where == "app":
-            parameters = ("playback",) if action == "toggle_legend" and app.player is not None else ()
+            parameters: tuple[str, ...] = ("playback",) if action == "toggle_legend" and app.player is not None else ()
             if app.check_action(action, parameters) is False:
                 continue
             yield SystemCommand(title, help_text, _runner(app, action, parameters))
@@ -36,6 +40,6 @@ def app_commands(app) -> Iterable[SystemCommand]:
             yield SystemCommand(title, help_text, getattr(app.canvas, f"action_{action}"))
 
 
-def _runner(app, action: str, parameters: tuple):
+def _runner(app: VoronoiApp, action: str, parameters: tuple[str, ...]) -> Callable[[], object]:
     method = getattr(app, f"action_{action}")
     return lambda: method(*parameters)

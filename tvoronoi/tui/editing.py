@@ -8,15 +8,20 @@ save start from the live sites.
 
 from __future__ import annotations
 
-from textual import work
+from typing import Any, Callable, Protocol
+
 from textual.binding import Binding
 from textual.message import Message
+from textual.widget import Widget
 
 import tvoronoi
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.tui.building import Built, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
-from tvoronoi.tui.live import LiveScene
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+from tvoronoi.tui.live import LiveScene
+from tvoronoi.tui.playback import Player
 
 # A dynamic diagram is made ahead, in a worker, for diagrams up to this many sites;
 # larger ones get theirs at the first edit.
@@ -57,7 +62,7 @@ EDITING_ACTIONS = {"add_site", "remove_site", "move_site", "toggle_cursor", "cur
 MOVING_ACTIONS = {"nudge", "drop_site", "cancel_move"}
 
 
-def make_live(built) -> LiveScene:
+def make_live(built: Built) -> LiveScene:
     """A LiveScene over a new DynamicVoronoi of a built diagram's points (any thread)."""
     diagram = built.diagram
     dynamic = tvoronoi.DynamicVoronoi(built.points, engine=diagram.engine, bbox=diagram.bbox)
@@ -67,210 +72,241 @@ def make_live(built) -> LiveScene:
 class EditorReady(Message):
     """A LiveScene for a built diagram was made ahead of the first edit."""
 
-    def __init__(self, built, live: LiveScene) -> None:
+    def __init__(self, built: Built, live: LiveScene) -> None:
         super().__init__()
         self.built = built
         self.live = live
 
 
-class EditingMixin:
-    """The App's part that edits sites in place."""
+class EditingHost(Host, Protocol):
+    """What editing uses of the App."""
 
-    live: LiveScene | None = None
-    _prepared: tuple | None = None
-    # (site id, where it was) while a site is picked up with m
-    _moving: tuple[int, tuple[float, float]] | None = None
-    last_edit_ms = 0.0
-    n_edits = 0
+    clock: Clock
 
-    def check_action(self, action: str, parameters: tuple) -> bool | None:
+    @property
+    def focused(self) -> Widget | None: ...
+    @property
+    def built(self) -> Built | None: ...
+    @property
+    def player(self) -> Player | None: ...
+    def request_build(self, make_points: Callable[[], Any], *, source: str, size: int | None,
+                      fit: bool = ..., point_set: Any = ..., read: Any = ..., bbox: Any = ...) -> None: ...
+    def set_status(self, text: str) -> None: ...
+    def update_status(self) -> None: ...
+    def refresh_bindings(self) -> None: ...
+
+
+class Editing:
+    """Edits sites in place: the live scene, the site picked up, the count and time of the edits."""
+
+    def __init__(self, host: EditingHost) -> None:
+        self.host = host
+        self.live: LiveScene | None = None
+        self._prepared: tuple[Built, LiveScene] | None = None
+        # (site id, where it was) while a site is picked up with m
+        self.moving: tuple[int, tuple[float, float]] | None = None
+        self.last_edit_ms = 0.0
+        self.n_edits = 0
+
+    def allows(self, action: str) -> bool | None:
+        """Whether the app may run ``action`` now as far as editing goes; None: editing has no say."""
         if action in MOVING_ACTIONS:
-            return self._moving is not None and self.focused is self.canvas
+            return self.moving is not None and self.host.focused is self.host.canvas
         if action in EDITING_ACTIONS:
-            return self.player is None
-        return super().check_action(action, parameters)
+            return self.host.player is None
+        return None
 
     # -- the live scene ------------------------------------------------------
 
-    def prepare_editing(self) -> None:
+    def prepare(self) -> None:
         """Make the dynamic diagram of the shown points in a worker, ahead of the first edit."""
-        built = self.built
+        built = self.host.built
         if built is None or len(built.points) > PREPARE_MAX_SITES:
             return
-        self._prepare_in_thread(built)
+        self.host.run_worker(lambda: self._prepare_in_thread(built), thread=True, exclusive=True,
+                             group="prepare-editing", exit_on_error=False)
 
-    @work(thread=True, exclusive=True, group="prepare-editing", exit_on_error=False)
-    def _prepare_in_thread(self, built) -> None:
+    def _prepare_in_thread(self, built: Built) -> None:
         try:
             live = make_live(built)
         except (TvoronoiError, MemoryError):
             return  # the first edit tries again and says why
-        self.post_message(EditorReady(built, live))
+        self.host.post_message(EditorReady(built, live))
 
-    def on_editor_ready(self, message: EditorReady) -> None:
-        if message.built is self.built and self.live is None:
+    def editor_ready(self, message: EditorReady) -> None:
+        """A worker made the live scene ahead: keep it for the first edit, if still wanted."""
+        if message.built is self.host.built and self.live is None:
             self._prepared = (message.built, message.live)
 
-    def _editor(self) -> LiveScene | None:
+    def editor(self) -> LiveScene | None:
         """The live scene, made now if need be; None (after saying why) if editing is not possible."""
         if self.live is not None:
             return self.live
-        if self.built is None:
+        built = self.host.built
+        if built is None:
             return None
-        if self._prepared is not None and self._prepared[0] is self.built:
+        if self._prepared is not None and self._prepared[0] is built:
             live = self._prepared[1]
         else:
             try:
-                live = make_live(self.built)
+                live = make_live(built)
             except TvoronoiError as exc:
-                self.notify(str(exc), title="Not edited", severity="error", timeout=8, markup=False)
+                self.host.notify(str(exc), title="Not edited", severity="error", timeout=8, markup=False)
                 return None
         self._prepared = None
         self.live = live
-        if self.canvas.scene is self.built.scene and self.canvas.overlay is None:
-            self.canvas.adopt_scene(live)  # it draws just as the built scene
+        canvas = self.host.canvas
+        if canvas.scene is built.scene and canvas.overlay is None:
+            canvas.adopt_scene(live)  # it draws just as the built scene
         else:
-            self.canvas.show_scene(live, fit=False)
+            canvas.show_scene(live, fit=False)
         return live
 
-    def finish_editing(self) -> None:
+    def finish(self) -> None:
         """Build the live sites into a whole diagram again (for another engine, playback)."""
-        live = self.live
-        if live is None:
+        live, built = self.live, self.host.built
+        if live is None or built is None:
             return
         points = live.points()
-        source = self.built.source if self.built.source.endswith("(edited)") else f"{self.built.source} (edited)"
-        self._request_build(lambda: points, source=source, size=len(points), fit=False, bbox=live.bbox)
+        source = built.source if built.source.endswith("(edited)") else f"{built.source} (edited)"
+        self.host.request_build(lambda: points, source=source, size=len(points), fit=False, bbox=live.bbox)
 
-    def drop_editing(self) -> None:
+    def drop(self) -> None:
         """Forget the live scene (a new diagram replaced it)."""
         self.live = None
         self._prepared = None
-        self._moving = None
+        self.moving = None
         self.n_edits = 0
 
-    def _edit(self, what: str, change) -> bool:
+    def _edit(self, what: str, change: Callable[[LiveScene], object]) -> bool:
         """Run one edit on the live scene; tell the user if it was refused."""
-        live = self._editor()
+        live = self.editor()
         if live is None:
             return False
-        start = self.clock()
+        clock = self.host.clock
+        start = clock()
         try:
             change(live)
         except TvoronoiError as exc:
-            self.notify(str(exc), title=f"Not {what}", severity="error", timeout=8, markup=False)
+            self.host.notify(str(exc), title=f"Not {what}", severity="error", timeout=8, markup=False)
             return False
-        self.last_edit_ms = (self.clock() - start) * 1000
+        self.last_edit_ms = (clock() - start) * 1000
         self.n_edits += 1
-        self.canvas.refresh()
-        self._update_status()
+        self.host.canvas.refresh()
+        self.host.update_status()
         return True
 
     def _site_under_cursor(self) -> int | None:
         """The site under the keyboard cursor if it is shown, else under the mouse pointer; None
         (after saying how to put the cursor on one) when there is none."""
-        canvas = self.canvas
+        canvas = self.host.canvas
         where = canvas.cursor if canvas.cursor is not None else canvas.pointer
         site = None if where is None else canvas.site_at(*where)
         if site is None:
-            self.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
-                        severity="warning")
+            self.host.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
+                             severity="warning")
         return site
 
     def _one_char(self) -> tuple[float, float]:
-        scale = self.canvas.view.scale
+        scale = self.host.canvas.view.scale
         return DOT_COLS * scale, DOT_ROWS * scale
 
-    # -- actions -------------------------------------------------------------
+    def _cursor(self) -> tuple[float, float]:
+        """The keyboard cursor, shown first (at the centre of the view) if it was hidden."""
+        canvas = self.host.canvas
+        if canvas.cursor is None:
+            canvas.set_cursor((canvas.view.cx, canvas.view.cy))
+        assert canvas.cursor is not None, "set just above"
+        return canvas.cursor
 
-    def action_toggle_cursor(self) -> None:
+    # -- what the keys do ------------------------------------------------------
+
+    def toggle_cursor(self) -> None:
         """Show the keyboard cursor (at the centre of the view) or hide it."""
-        canvas = self.canvas
+        canvas = self.host.canvas
         canvas.set_cursor(None if canvas.cursor is not None else (canvas.view.cx, canvas.view.cy))
 
-    def action_cursor(self, dx: int, dy: int) -> None:
+    def move_cursor(self, dx: int, dy: int) -> None:
         """Move the keyboard cursor by one character (showing it first if hidden)."""
-        canvas = self.canvas
+        canvas = self.host.canvas
         if canvas.cursor is None:
             canvas.set_cursor((canvas.view.cx, canvas.view.cy))
             return
         w, h = self._one_char()
         canvas.set_cursor((canvas.cursor[0] + dx * w, canvas.cursor[1] - dy * h))
 
-    def action_add_site(self) -> None:
+    def add_site(self) -> None:
         """Add a site at the keyboard cursor."""
-        canvas = self.canvas
-        if canvas.cursor is None:
-            canvas.set_cursor((canvas.view.cx, canvas.view.cy))
-        x, y = canvas.cursor
+        x, y = self._cursor()
         self._edit("added", lambda live: live.insert(x, y))
 
-    def action_remove_site(self) -> None:
+    def add_site_at(self, x: float, y: float) -> None:
+        """A click on empty space adds a site there."""
+        if self.host.player is not None or self.moving is not None:
+            return
+        self._edit("added", lambda live: live.insert(x, y))
+
+    def remove_site(self) -> None:
         """Delete the site under the cursor or the mouse pointer."""
         site = self._site_under_cursor()
         if site is None:
             return
-        if self._moving is not None and self._moving[0] == site:
-            self._moving = None
+        if self.moving is not None and self.moving[0] == site:
+            self.moving = None
         self._edit("deleted", lambda live: live.remove(site))
 
-    def action_move_site(self) -> None:
+    def pick_up(self) -> None:
         """Pick up the site under the cursor (m again drops it)."""
-        if self._moving is not None:
-            self.action_drop_site()
+        if self.moving is not None:
+            self.drop_site()
             return
         site = self._site_under_cursor()
         if site is None:
             return
-        live = self._editor()
+        live = self.editor()
         if live is None:
             return
         x, y = (float(c) for c in live.sites[site])
-        self._moving = (site, (x, y))
-        self.canvas.set_cursor((x, y))
-        self.refresh_bindings()
-        self._set_status(f"moving site {site}: arrows move it · enter or m drops it · esc puts it back")
+        self.moving = (site, (x, y))
+        self.host.canvas.set_cursor((x, y))
+        self.host.refresh_bindings()
+        self.host.set_status(f"moving site {site}: arrows move it · enter or m drops it · esc puts it back")
 
-    def action_nudge(self, dx: int, dy: int) -> None:
+    def nudge(self, dx: int, dy: int) -> None:
         """Move the picked-up site by one character."""
-        site, _ = self._moving
+        if self.moving is None or self.live is None:
+            return
+        site, _ = self.moving
         w, h = self._one_char()
-        x, y = self.live.sites[site]
-        x, y = float(x + dx * w), float(y - dy * h)
+        sx, sy = self.live.sites[site]
+        x, y = float(sx + dx * w), float(sy - dy * h)
         if self._edit("moved", lambda live: live.move(site, x, y)):
-            self.canvas.set_cursor((x, y))
+            self.host.canvas.set_cursor((x, y))
 
-    def action_drop_site(self) -> None:
+    def drop_site(self) -> None:
         """Leave the picked-up site where it is."""
-        self._moving = None
-        self.refresh_bindings()
-        self._update_status()
+        self.moving = None
+        self.host.refresh_bindings()
+        self.host.update_status()
 
-    def action_cancel_move(self) -> None:
+    def cancel_move(self) -> None:
         """Put the picked-up site back where it was."""
-        site, (x, y) = self._moving
-        self._moving = None
-        self.refresh_bindings()
+        if self.moving is None:
+            return
+        site, (x, y) = self.moving
+        self.moving = None
+        self.host.refresh_bindings()
         if self._edit("moved", lambda live: live.move(site, x, y)):
-            self.canvas.set_cursor((x, y))
+            self.host.canvas.set_cursor((x, y))
 
-    # -- the mouse -----------------------------------------------------------
-
-    def on_diagram_canvas_clicked(self, message: DiagramCanvas.Clicked) -> None:
-        """A click on empty space adds a site there."""
-        if self.player is not None or self._moving is not None:
-            return
-        x, y = message.x, message.y
-        self._edit("added", lambda live: live.insert(x, y))
-
-    def on_diagram_canvas_site_dragged(self, message: DiagramCanvas.SiteDragged) -> None:
+    def dragged(self, message: DiagramCanvas.SiteDragged) -> None:
         """A dragged site follows the pointer; a drag message that a newer one follows is skipped."""
-        if self.player is not None:
+        if self.host.player is not None:
             return
-        if not message.done and message.serial != self.canvas.drag_serial:
+        if not message.done and message.serial != self.host.canvas.drag_serial:
             return
         site, x, y = message.site, message.x, message.y
-        live = self._editor()
+        live = self.editor()
         if live is None or not live.alive(site):
             return
         self._edit("moved", lambda live: live.move(site, x, y))

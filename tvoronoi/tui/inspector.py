@@ -9,10 +9,18 @@ line above the status line when the panel is hidden or too short to show it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from rich.text import Text
-from textual.widgets import Static
+
+if TYPE_CHECKING:
+    from tvoronoi.diagram import Diagram
+    from tvoronoi.readers.pointset import PointSet
+    from tvoronoi.tui.building import Built
+    from tvoronoi.tui.canvas import DiagramCanvas
+    from tvoronoi.tui.live import LiveScene
+    from tvoronoi.tui.playback import Player
 
 # At most this many of a site's properties are listed in the panel.
 MAX_PROPERTIES = 6
@@ -67,7 +75,7 @@ def ring_area(ring: np.ndarray) -> float:
     return float(abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2)
 
 
-def row_properties(point_set, row: int) -> dict:
+def row_properties(point_set: PointSet | None, row: int) -> dict[str, Any]:
     """The other columns (or GeoJSON properties) of an input row; empty without a point file."""
     if point_set is None:
         return {}
@@ -76,7 +84,7 @@ def row_properties(point_set, row: int) -> dict:
     return {name: values[row] for name, values in point_set.columns.items()}
 
 
-def diagram_neighbours(diagram, i: int) -> np.ndarray:
+def diagram_neighbours(diagram: Diagram, i: int) -> np.ndarray:
     """The sites whose cells share an edge with cell i of a whole diagram."""
     cycle = diagram.half_edge_cycle(i)
     if not len(cycle):
@@ -86,7 +94,7 @@ def diagram_neighbours(diagram, i: int) -> np.ndarray:
     return np.unique(faces[(faces >= 0) & (faces != i)])
 
 
-def cell_info(built, live, site: int) -> CellInfo:
+def cell_info(built: Built, live: LiveScene | None, site: int) -> CellInfo:
     """What the inspector says of site ``site`` of the diagram shown (``live`` if edited)."""
     n_input = len(built.points)
     if live is None:
@@ -108,7 +116,7 @@ def cell_info(built, live, site: int) -> CellInfo:
     return CellInfo(site, row, x, y, ring_area(ring), n_neighbours, properties, moved)
 
 
-def _value(value) -> str:
+def _value(value: object) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
     return "" if value is None else str(value)
@@ -167,42 +175,57 @@ def line_text(info: CellInfo, where: str) -> Text:
     return text
 
 
-class InspectorMixin:
-    """The App's part that shows the cell under the keyboard cursor, else under the mouse pointer."""
+class InspectorHost(Protocol):
+    """What the inspector uses of the App."""
 
-    inspected: CellInfo | None = None
-    _inspector_seen: tuple | None = None
+    @property
+    def canvas(self) -> DiagramCanvas: ...
+    @property
+    def built(self) -> Built | None: ...
+    @property
+    def live(self) -> LiveScene | None: ...
+    @property
+    def player(self) -> Player | None: ...
+    def inspector_in_panel(self) -> bool: ...
+    def show_inspector(self, text: Text, *, shown: bool, in_panel: bool) -> None: ...
+
+
+class Inspector:
+    """Shows the cell under the keyboard cursor, else under the mouse pointer."""
+
+    def __init__(self, host: InspectorHost) -> None:
+        self.host = host
+        self.inspected: CellInfo | None = None
+        self._seen: tuple | None = None
 
     def inspect(self) -> None:
         """Show the cell under the cursor or pointer now (after a move, an edit, a new diagram)."""
-        canvas = self.canvas
+        host = self.host
+        canvas, built = host.canvas, host.built
         info, where = None, ""
-        if self.player is None and self.built is not None:
+        point: tuple[float, float] | None
+        if host.player is None and built is not None:
             if canvas.cursor is not None:
                 point, where = canvas.cursor, "cursor"
             else:
                 point, where = canvas.pointer, "pointer"
             site = None if point is None else canvas.cell_at(*point)
             if site is not None:
-                info = cell_info(self.built, self.live, site)
+                info = cell_info(built, host.live, site)
         self.inspected = info
         # playback shows the engine's own state, not cells: no inspector then
-        shown = self.player is None
-        panel = self.query_one("#panel")
-        in_panel = bool(panel.display) and self.size.height >= PANEL_MIN_HEIGHT
-        source = self.built.source if self.built is not None else ""
+        shown = host.player is None
+        in_panel = host.inspector_in_panel()
+        source = built.source if built is not None else ""
         # the pointer moves a character at a time: most moves stay in the same cell
         seen = (info, where, shown, in_panel, source)
-        if seen == self._inspector_seen:
+        if seen == self._seen:
             return
-        self._inspector_seen = seen
-        for widget in self.query(".inspector"):
-            widget.display = shown and in_panel
-        line = self.query_one("#inspect-line", Static)
-        line.display = shown and not in_panel
+        self._seen = seen
         if in_panel:
-            self.query_one("#inspector", Static).update(panel_text(info, where, source))
+            text = panel_text(info, where, source)
         elif info is None:
-            line.update(Text("point at a cell or press c to inspect it", style="dim"), layout=False)
+            text = Text("point at a cell or press c to inspect it", style="dim")
         else:
-            line.update(line_text(info, where), layout=False)
+            text = line_text(info, where)
+        host.show_inspector(text, shown=shown, in_panel=in_panel)

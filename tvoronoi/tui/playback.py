@@ -10,17 +10,24 @@ playback ever waits on the engine.
 from __future__ import annotations
 
 import time
+from typing import Any, Callable, Protocol
 
 import numpy as np
-from textual import work
+from rich.text import Text
 from textual.binding import Binding
 from textual.message import Message
-from textual.widgets import Static
+from textual.screen import Screen
+from textual.timer import Timer
 
 import tvoronoi
+from tvoronoi.trace import FortuneStep, FortuneTrace, IncrementalStep, IncrementalTrace
+from tvoronoi.tui.building import Built
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.colours import cell_colours
 from tvoronoi.tui.follow import focus_box
-from tvoronoi.tui.overlay import fortune_picture, incremental_picture
+from tvoronoi.tui.live import LiveScene
+from tvoronoi.tui.overlay import FortuneOverlay, IncrementalOverlay, fortune_picture, incremental_picture
+from tvoronoi.tui.raster import Scene, View
 from tvoronoi.tui.screens import SampleDialog
 from tvoronoi.tui.state import fortune_state, incremental_state
 from tvoronoi.tui.timeline import Timeline
@@ -77,14 +84,20 @@ PLAYBACK_ACTIONS = {"play_pause", "step", "step_to", "jump", "speed", "toggle_fo
 PAUSED_ACTIONS = {"generate", "open", "save", "export"}
 
 
+Step = FortuneStep | IncrementalStep
+# a step, the scene of its sites and the overlay of the engine's state
+Picture = tuple[Step, Scene, FortuneOverlay | IncrementalOverlay]
+
+
 class Player:
     """One playback session: the trace, the step asked for, the step shown, and the pace."""
 
-    def __init__(self, points: np.ndarray, engine: str, colours: np.ndarray, bbox) -> None:
+    def __init__(self, points: np.ndarray, engine: str, colours: np.ndarray, bbox: tuple) -> None:
         self.points = np.asarray(points, np.float64)
         self.engine = engine
         self.colours = colours
         self.bbox = bbox
+        self.trace: FortuneTrace | IncrementalTrace
         if engine == "fortune":
             self.trace = tvoronoi.fortune_steps(self.points)
         else:
@@ -92,18 +105,20 @@ class Player:
         self.n_steps = len(self.trace)
         self.threaded = len(self.points) >= STEP_THREAD_MIN_SITES
         self.index = 0          # the step asked for
-        self.step = None        # the step on screen
+        self.step: Step | None = None  # the step on screen
         self.busy = False       # a worker is computing a step
         self.playing = False
         self.speed = DEFAULT_SPEED
         self.carry = 0.0        # steps due but not taken (a fraction)
         self.last_tick: float | None = None
         self.sample = False  # the points are a sample of the diagram's
-        self.view_before = None  # the canvas's view and whether it was fitted, before playback
+        # the canvas's view and whether it was fitted, before playback
+        self.view_before: tuple[View, bool] | None = None
 
-    def picture(self, k: int):
+    def picture(self, k: int) -> Picture:
         """The step k with its scene and overlay (any thread)."""
         step = self.trace.step(k)
+        overlay: FortuneOverlay | IncrementalOverlay
         if self.engine == "fortune":
             scene, overlay = fortune_picture(step, self.points, self.colours, self.bbox)
         else:
@@ -122,122 +137,149 @@ def sample_of(points: np.ndarray, size: int) -> np.ndarray:
 class StepReady(Message):
     """A worker computed a step and its picture."""
 
-    def __init__(self, player: Player, picture) -> None:
+    def __init__(self, player: Player, picture: Picture) -> None:
         super().__init__()
         self.player = player
         self.picture = picture
 
 
-class PlaybackMixin:
-    """The App's part that plays an engine step by step."""
 
-    player: Player | None = None
-    # the time source of playback (tests put a fake one here)
-    playback_clock = staticmethod(time.monotonic)
-    _play_timer = None
-    # whether the view follows the events (kept from one playback to the next)
-    follow = True
+class PlaybackHost(Host, Protocol):
+    """What playback uses of the App."""
 
     @property
-    def timeline(self) -> Timeline:
-        return self.query_one("#timeline", Timeline)
+    def timeline(self) -> Timeline: ...
+    @property
+    def built(self) -> Built | None: ...
+    @property
+    def live(self) -> LiveScene | None: ...
+    def finish_editing(self) -> None: ...
+    def timeline_on_screen(self) -> bool: ...
+    def playback_started(self) -> None: ...
+    def playback_ended(self) -> None: ...
+    def set_engine_state(self, text: Text) -> None: ...
+    def set_status(self, text: str) -> None: ...
+    def push_screen(self, screen: Screen[Any], callback: Callable[[Any], None]) -> Any: ...
+    def set_interval(self, interval: float, callback: Callable[[], None]) -> Timer: ...
 
-    def check_action(self, action: str, parameters: tuple) -> bool | None:
+
+class Playback:
+    """Plays an engine step by step: the player, its timer, the timeline and whether the view follows."""
+
+    def __init__(self, host: PlaybackHost) -> None:
+        self.host = host
+        self.player: Player | None = None
+        # the time source of playback (tests put a fake one here)
+        self.clock: Callable[[], float] = time.monotonic
+        self._timer: Timer | None = None
+        # whether the view follows the events (kept from one playback to the next)
+        self.follow = True
+
+    def allows(self, action: str) -> bool | None:
+        """Whether the app may run ``action`` now as far as playback goes; None: playback has no say."""
         if action in PLAYBACK_ACTIONS:
             return self.player is not None
         if action in PAUSED_ACTIONS and self.player is not None:
             return False
-        return super().check_action(action, parameters)
+        return None
 
     # -- starting and stopping -----------------------------------------------
 
-    def action_toggle_playback(self) -> None:
+    def toggle(self) -> None:
         """Start playing the selected engine's steps, or stop and show the diagram again."""
         if self.player is not None:
-            self.stop_playback()
+            self.stop()
             return
-        if self.built is None:
+        built, live = self.host.built, self.host.live
+        if built is None:
             return
-        n = self.live.n_sites if self.live is not None else len(self.built.points)
+        n = live.n_sites if live is not None else len(built.points)
         if n > TEACHING_MAX_SITES or n > PLAYBACK_MAX_SITES:
             allowed = n <= PLAYBACK_MAX_SITES
             why = "" if allowed else (f"Playback takes up to {PLAYBACK_MAX_SITES:,} sites: "
                                       "a sample, or generate fewer points · Esc to cancel")
-            self.push_screen(SampleDialog(n, SAMPLE_SITES, all_allowed=allowed, why=why), self._playback_chosen)
+            self.host.push_screen(SampleDialog(n, SAMPLE_SITES, all_allowed=allowed, why=why), self._chosen)
             return
-        self._start_playback()
+        self.start()
 
-    def _playback_chosen(self, choice: str | None) -> None:
-        self.canvas.focus()
+    def _chosen(self, choice: str | None) -> None:
+        self.host.canvas.focus()
         if choice is not None and self.player is None:
-            self._start_playback(sample=choice == "sample")
+            self.start(sample=choice == "sample")
 
-    def _start_playback(self, *, sample: bool = False) -> None:
+    def start(self, *, sample: bool = False) -> None:
         """Play the engine on the sites as they are now, or on a random sample of them."""
-        if self.live is not None:
-            self.finish_editing()  # playback replays the sites as they are now
-        built = self.built
+        if self.host.live is not None:
+            self.host.finish_editing()  # playback replays the sites as they are now
+        built = self.host.built
+        if built is None:
+            return
         engine, bbox = built.diagram.engine, built.diagram.bbox
         if sample:
             points = sample_of(built.points, SAMPLE_SITES)
             colours = cell_colours(tvoronoi.voronoi(points, engine=engine, bbox=bbox))
         else:
             points, colours = built.points, built.scene.colours
-        self.player = Player(points, engine, colours, bbox)
-        self.player.sample = sample
-        self.player.view_before = (self.canvas.view, self.canvas.fitted)
-        timeline = self.timeline
-        timeline.n_steps = self.player.n_steps
-        timeline.engine = f"{self.player.engine} sample" if sample else self.player.engine
-        timeline.speed = self.player.speed
+        canvas = self.host.canvas
+        player = self.player = Player(points, engine, colours, bbox)
+        player.sample = sample
+        player.view_before = (canvas.view, canvas.fitted)
+        timeline = self.host.timeline
+        timeline.n_steps = player.n_steps
+        timeline.engine = f"{player.engine} sample" if sample else player.engine
+        timeline.speed = player.speed
         timeline.playing = False
         timeline.following = self.follow
         timeline.display = True
-        self.canvas.editable = False
-        self._play_timer = self.set_interval(1 / TICK_HZ, self._playback_tick)
-        self.refresh_bindings()
-        self.inspect()  # hidden during playback
-        self._show_engine_state(True)
-        self.update_legend()
-        self._goto(0)
+        canvas.editable = False
+        self._timer = self.host.set_interval(1 / TICK_HZ, self.tick)
+        self.host.playback_started()
+        self.goto(0)
 
-    def stop_playback(self) -> None:
+    def stop(self) -> None:
         """Leave playback; the built diagram comes back with the view as it is."""
         if self.player is None:
             return
         player, self.player = self.player, None
-        if self.follow:
+        canvas = self.host.canvas
+        if self.follow and player.view_before is not None:
             # the view the user had, not the one that followed the last event
-            self.canvas.view, self.canvas.fitted = player.view_before
-        if self._play_timer is not None:
-            self._play_timer.stop()
-            self._play_timer = None
-        self.timeline.display = False
-        self._show_engine_state(False)
-        self.canvas.editable = True
-        if self.built is not None:
-            self.canvas.show_scene(self.built.scene, fit=False)
-        self.refresh_bindings()
-        self._update_status()
+            canvas.view, canvas.fitted = player.view_before
+        if self._timer is not None:
+            self._timer.stop()
+            self._timer = None
+        self.host.timeline.display = False
+        canvas.editable = True
+        built = self.host.built
+        if built is not None:
+            canvas.show_scene(built.scene, fit=False)
+        self.host.playback_ended()
 
     # -- moving along --------------------------------------------------------
 
-    def _goto(self, k: int) -> None:
+    def goto(self, k: int) -> None:
+        """Ask for step k (clamped to the trace): shown now, or once a worker has computed it."""
         player = self.player
+        if player is None:
+            return
         k = min(max(int(k), 0), player.n_steps)
         player.index = k
-        self.timeline.index = k
+        self.host.timeline.index = k
         if not player.threaded:
             self._show_picture(player.picture(k))
         elif not player.busy:
             player.busy = True
             self._compute_step(player, k)
 
-    @work(thread=True, group="playback", exit_on_error=False)
     def _compute_step(self, player: Player, k: int) -> None:
-        self.post_message(StepReady(player, player.picture(k)))
+        self.host.run_worker(lambda: self._step_in_thread(player, k), thread=True, group="playback",
+                             exit_on_error=False)
 
-    def on_step_ready(self, message: StepReady) -> None:
+    def _step_in_thread(self, player: Player, k: int) -> None:
+        self.host.post_message(StepReady(player, player.picture(k)))
+
+    def step_ready(self, message: StepReady) -> None:
+        """A worker computed a step: show it, and compute the latest step asked for meanwhile."""
         player = message.player
         if player is not self.player:
             return  # playback stopped meanwhile
@@ -248,40 +290,34 @@ class PlaybackMixin:
             player.busy = True
             self._compute_step(player, player.index)
 
-    def _show_picture(self, picture) -> None:
-        step, scene, overlay = picture
-        self.player.step = step
-        self.canvas.show_scene(scene, fit=False, overlay=overlay)
-        if self.follow:
-            self._follow_step(step)
-        state = self.query_one("#playstate", Static)
-        if self.player.engine == "fortune":
-            state.update(fortune_state(step, self.player.points))
-        else:
-            state.update(incremental_state(step))
-        self._set_status(step.describe())
-
-    def _show_engine_state(self, shown: bool) -> None:
-        """During playback the panel shows the engine's state where the point controls were
-        (new points wait until playback ends)."""
-        self.query_one("#points-section").display = not shown
-        for widget in self.query(".playstate"):
-            widget.display = shown
-
-    def _follow_step(self, step) -> None:
-        """Move the view to the region of the step's event, unless it shows it well already."""
+    def _show_picture(self, picture: Picture) -> None:
         player = self.player
+        assert player is not None, "a picture is shown during playback"
+        step, scene, overlay = picture
+        player.step = step
+        self.host.canvas.show_scene(scene, fit=False, overlay=overlay)
+        if self.follow:
+            self._follow_step(player, step)
+        if isinstance(step, FortuneStep):
+            self.host.set_engine_state(fortune_state(step, player.points))
+        else:
+            self.host.set_engine_state(incremental_state(step))
+        self.host.set_status(step.describe())
+
+    def _follow_step(self, player: Player, step: Step) -> None:
+        """Move the view to the region of the step's event, unless it shows it well already."""
         box = focus_box(step, player.points, player.bbox)
         if box is not None:
-            self.canvas.follow(box)
+            self.host.canvas.follow(box)
 
-    def _playback_tick(self) -> None:
+    def tick(self) -> None:
+        """The timer: move on by the steps due since the last tick at the speed chosen."""
         player = self.player
         if player is None or not player.playing:
             return
-        if not self.screen.query("#timeline"):
-            return              # the app is closing: its widgets are gone, and the timer with them next
-        now = self.playback_clock()
+        if not self.host.timeline_on_screen():
+            return  # a dialog is over the timeline, or the app is closing
+        now = self.clock()
         if player.last_tick is not None:
             player.carry += (now - player.last_tick) * player.speed
         player.last_tick = now
@@ -289,65 +325,78 @@ class PlaybackMixin:
         if due <= 0:
             return
         player.carry -= due
-        self._goto(player.index + due)
+        self.goto(player.index + due)
         if player.index >= player.n_steps:
-            self._set_playing(False)
+            self._set_playing(player, False)
 
-    def _set_playing(self, playing: bool) -> None:
-        player = self.player
+    def _set_playing(self, player: Player, playing: bool) -> None:
         player.playing = playing
-        player.last_tick = self.playback_clock() if playing else None
+        player.last_tick = self.clock() if playing else None
         player.carry = 0.0
-        self.timeline.playing = playing
+        self.host.timeline.playing = playing
 
-    # -- actions -------------------------------------------------------------
+    # -- what the keys do ------------------------------------------------------
 
-    def action_play_pause(self) -> None:
+    def play_pause(self) -> None:
         """Play or pause; playing from the last step starts again from the first."""
         player = self.player
+        if player is None:
+            return
         if not player.playing and player.index >= player.n_steps:
-            self._goto(0)
-        self._set_playing(not player.playing)
+            self.goto(0)
+        self._set_playing(player, not player.playing)
 
-    def action_step(self, delta: int) -> None:
+    def step(self, delta: int) -> None:
         """One step on or back (pauses)."""
-        self._set_playing(False)
-        self._goto(self.player.index + delta)
+        player = self.player
+        if player is None:
+            return
+        self._set_playing(player, False)
+        self.goto(player.index + delta)
 
-    def action_step_to(self, where: str) -> None:
+    def step_to(self, where: str) -> None:
         """The first or the last step."""
-        self._set_playing(False)
-        self._goto(0 if where == "start" else self.player.n_steps)
+        player = self.player
+        if player is None:
+            return
+        self._set_playing(player, False)
+        self.goto(0 if where == "start" else player.n_steps)
 
-    def action_jump(self, direction: int) -> None:
+    def jump(self, direction: int) -> None:
         """A tenth of the steps on or back."""
         player = self.player
-        self._goto(player.index + direction * max(1, round(JUMP * player.n_steps)))
+        if player is None:
+            return
+        self.goto(player.index + direction * max(1, round(JUMP * player.n_steps)))
 
-    def action_speed(self, direction: int) -> None:
+    def change_speed(self, direction: int) -> None:
         """The next speed up or down."""
         player = self.player
+        if player is None:
+            return
         at = min(range(len(SPEEDS)), key=lambda i: abs(SPEEDS[i] - player.speed))
         player.speed = SPEEDS[min(max(at + direction, 0), len(SPEEDS) - 1)]
-        self.timeline.speed = player.speed
+        self.host.timeline.speed = player.speed
 
-    def action_toggle_follow(self) -> None:
+    def toggle_follow(self) -> None:
         """Let the view follow the events, or stay where it is."""
         self._set_follow(not self.follow)
-        if self.follow and self.player.step is not None:
-            self._follow_step(self.player.step)
+        player = self.player
+        if self.follow and player is not None and player.step is not None:
+            self._follow_step(player, player.step)
 
     def _set_follow(self, follow: bool) -> None:
         self.follow = follow
-        self.timeline.following = follow
+        self.host.timeline.following = follow
 
-    def on_diagram_canvas_view_changed(self) -> None:
-        # the user moved the view: it stays where they put it
+    def view_changed(self) -> None:
+        """The user moved the view: it stays where they put it."""
         if self.player is not None and self.follow:
             self._set_follow(False)
-            self.notify("the view stays where you put it; f follows the events again",
-                        title="Follow off", timeout=4)
+            self.host.notify("the view stays where you put it; f follows the events again",
+                             title="Follow off", timeout=4)
 
-    def on_timeline_scrubbed(self, message: Timeline.Scrubbed) -> None:
+    def scrubbed(self, step: int) -> None:
+        """The timeline was clicked or dragged at ``step``."""
         if self.player is not None:
-            self._goto(message.step)
+            self.goto(step)

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from tvoronoi.diagram import Diagram
 from tvoronoi.relax import cell_centroids, lloyd
 
 
-def relaxed_points(diagram, points: np.ndarray) -> np.ndarray:
+def relaxed_points(diagram: Diagram, points: np.ndarray) -> np.ndarray:
     """The sites of ``diagram`` (rows of ``points``) moved to the centroids of their cells; a site
     without a cell (a repeated point, a cell that misses the box) stays where it is."""
     centroids, has_cell = cell_centroids(diagram)
@@ -16,7 +17,7 @@ def relaxed_points(diagram, points: np.ndarray) -> np.ndarray:
     return moved
 
 
-def relaxed_live(points: np.ndarray, bbox, engine: str) -> np.ndarray:
+def relaxed_live(points: np.ndarray, bbox: tuple[float, ...], engine: str) -> np.ndarray:
     """One Lloyd step on edited sites, whose whole diagram is not built yet."""
     return lloyd(points, 1, bbox=bbox, engine=engine)
 
