@@ -97,11 +97,7 @@ class Player:
         self.engine = engine
         self.colours = colours
         self.bbox = bbox
-        self.trace: FortuneTrace | IncrementalTrace
-        if engine == "fortune":
-            self.trace = tvoronoi.fortune_steps(self.points)
-        else:
-            self.trace = tvoronoi.incremental_steps(self.points, bbox=bbox)
+        self.trace: FortuneTrace | IncrementalTrace = tvoronoi.steps(self.points, engine=engine, bbox=bbox)
         self.n_steps = len(self.trace)
         self.threaded = len(self.points) >= STEP_THREAD_MIN_SITES
         self.index = 0          # the step asked for
