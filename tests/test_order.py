@@ -22,6 +22,23 @@ def test_same_seed_same_order(rng):
     assert np.array_equal(np.sort(brio_order(xs, ys, -1)), np.arange(5000))   # any int seeds
 
 
+@pytest.mark.parametrize("kind", ["uniform", "clustered", "rows"])
+def test_the_same_order_on_any_thread_count(rng, kind):
+    """The rounds are ordered at once on several threads, each with its own pivots: the order does not
+    depend on how many (40,000 sites: above the size that splits)."""
+    n = 40_000
+    if kind == "uniform":
+        xs, ys = rng.random(n), rng.random(n)
+    elif kind == "clustered":
+        xs, ys = rng.normal(0, 1e-6, n) + rng.integers(0, 3, n), rng.normal(0, 1e-6, n)
+    else:
+        xs, ys = np.floor(rng.random(n) * 50), np.floor(rng.random(n) * 4)
+    one = brio_order(xs, ys, 11, 1)
+    assert np.array_equal(np.sort(one), np.arange(n))
+    for threads in (2, 3, 8):
+        assert np.array_equal(brio_order(xs, ys, 11, threads), one), threads
+
+
 def test_repeats_and_ties(rng):
     """All sites at one place, and sites on a few rows and columns (ties on both axes)."""
     for xs, ys in [(np.full(1000, 0.25), np.full(1000, 0.25)),

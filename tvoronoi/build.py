@@ -21,7 +21,8 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     with build_arrays():
-        t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
+        t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads,
+                        exponent=e)
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t                                        # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)

@@ -107,16 +107,17 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
 
 
 def engine_order(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio",
-                 seed: int = 0) -> np.ndarray:
+                 seed: int = 0, threads: int = 1) -> np.ndarray:
     """The order in which an engine takes the sites: perm[k] is the k-th site (int32).
 
     Fortune's sweep takes them by y then x; the incremental engine in a biased randomized
-    insertion order along a space-filling curve ("brio"), or fully at random ("random").
+    insertion order along a space-filling curve ("brio", its rounds ordered on ``threads`` threads:
+    the same order for any count), or fully at random ("random").
     """
     if engine == "fortune":
         return sweep_order(xs, ys)
     if insertion == "brio":
-        return order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed)
+        return order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed, threads)
     return np.random.default_rng(seed).permutation(len(xs)).astype(np.int32)
 
 
@@ -133,14 +134,14 @@ class Sites:
         return len(self.perm)
 
 
-def prepare(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0,
+def prepare(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1,
             exponent: int | None = None) -> Sites:
     """Scale the sites (input order) by 2^-exponent (default: their own scale) and order them for an engine."""
     xs = np.asarray(xs, np.float64)
     ys = np.asarray(ys, np.float64)
     e = scale_exponent(xs, ys) if exponent is None else exponent
     sx, sy = np.ldexp(xs, -e), np.ldexp(ys, -e)
-    perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed)
+    perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed, threads=threads)
     return Sites(e, perm, np.ascontiguousarray(sx[perm]), np.ascontiguousarray(sy[perm]))
 
 
@@ -200,8 +201,8 @@ def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triang
     return Triangulation(engine, sites, tv, opp, dup)
 
 
-def run(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0,
+def run(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1,
         exponent: int | None = None) -> Triangulation:
     """prepare, then triangulate: the Delaunay triangulation of sites given in input order."""
-    sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, exponent=exponent)
+    sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=exponent)
     return triangulate(sites, engine=engine, insertion=insertion)

@@ -7,6 +7,7 @@ from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.interrupt cimport poll_signals
 from libc.string cimport memcpy
+from cython.parallel cimport prange
 
 cdef enum:
     # rounds stop halving below this expected size: the first sites form one round (CGAL's threshold in 2D)
@@ -21,6 +22,8 @@ cdef enum:
     EXACT_EXTENT = 32
     # sites sampled for the extents of a larger range
     EXTENT_SAMPLE = 16
+    # fewer sites are ordered on one thread
+    PARALLEL_MIN = 1 << 15
 
 # A range longer than this many times its width along the curve's axis is cut in two, not four.
 cdef double ELONGATED = 2.0
@@ -190,7 +193,7 @@ cdef void hilbert_sort(Item* src, Item* dst, Item* out, Py_ssize_t lo, Py_ssize_
     hilbert_sort(src, dst, out, m3, hi, y, -uy, -ux, state)
 
 
-def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
+def brio_order(const double[::1] xs, const double[::1] ys, seed=0, int threads=1):
     """A biased randomized insertion order (Amenta, Choi and Rote), as a permutation.
 
     Each site joins a random round: the last with probability 1/2, the one
@@ -207,6 +210,9 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
     seed : int
         Seed of the rounds and of the pivots (taken modulo 2**64); the same
         seed gives the same order.
+    threads : int
+        The rounds are ordered on this many threads (each with its own stream
+        of pivots): the same order for any count.
 
     Returns
     -------
@@ -241,7 +247,8 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
         raise MemoryError(f"no memory to order {n} sites")
     cdef uint64_t state = <uint64_t>(int(seed) & 0xFFFFFFFFFFFFFFFF), word
     cdef Py_ssize_t count[MAX_ROUNDS + 1]
-    cdef int r, last
+    cdef uint64_t round_state[MAX_ROUNDS + 1]
+    cdef int r, k_round, last, axis
     cdef double e[2]
     try:
         with nogil:
@@ -268,14 +275,22 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
                 a[count[r]].c[1] = ys[k]
                 a[count[r]].i = <int32_t>k
                 count[r] += 1
-            # each round along the curve, its first axis the longer side of the whole set
+            # each round along the curve, its first axis the longer side of the whole set; each round
+            # draws its pivots from a stream of its own (the first goes on with the main one), so that
+            # the rounds can be ordered at once, the largest first (round last holds half the sites)
             extents(a, 0, n, &state, e)
-            start = 0
-            for r in range(last + 1):
-                end = count[r]
+            axis = 0 if e[0] >= e[1] else 1
+            round_state[0] = state
+            for r in range(1, last + 1):
+                word = state ^ (<uint64_t>r * <uint64_t>0xD1B54A32D192ED03)
+                round_state[r] = next_random(&word)
+            poll_signals()
+            for k_round in prange(last + 1, num_threads=threads if n >= PARALLEL_MIN else 1,
+                                  schedule="dynamic", chunksize=1):
+                r = last - k_round
                 poll_signals()
-                hilbert_sort(a, b, a, start, end, 0 if e[0] >= e[1] else 1, 1.0, 1.0, &state)
-                start = end
+                hilbert_sort(a, b, a, count[r - 1] if r > 0 else 0, count[r], axis, 1.0, 1.0,
+                             &round_state[r])
             for k in range(n):
                 perm[k] = a[k].i
     finally:
