@@ -218,7 +218,8 @@ class TileCells:
 
 
 def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Region, box, *,
-               everything: bool = False, engine: str = "incremental", threads: int = 1) -> TileCells:
+               everything: bool = False, engine: str = "incremental", threads: int = 1,
+               diagram=None) -> TileCells:
     """Build the diagram of the sites a task saw and certify the cells it must emit.
 
     Parameters
@@ -235,6 +236,8 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     box : the whole diagram's box
     everything : bool
         ``pts`` holds every site of the input: every cell is final.
+    diagram : Diagram, optional
+        The diagram of ``pts`` in ``box``, when already built (for the tile's Delaunay triangles too).
     """
     from tvoronoi.api import voronoi
 
@@ -242,7 +245,7 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     if len(rows) == 0:
         empty = np.empty(0, np.int64)
         return TileCells(empty, np.zeros(1, np.int64), np.empty((0, 2)), empty)
-    d = voronoi(pts, bbox=box, engine=engine, threads=threads)
+    d = voronoi(pts, bbox=box, engine=engine, threads=threads) if diagram is None else diagram
     starts, ends = d.cell_offsets[rows], d.cell_offsets[rows + 1]
     lengths = ends - starts
     offsets = np.zeros(len(rows) + 1, np.int64)
