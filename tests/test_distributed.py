@@ -14,6 +14,7 @@ import tvoronoi
 from tvoronoi.distributed import local_client, voronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import generate
+from tvoronoi.tile_delaunay import canonical_triangles
 
 # The issue's proof runs 200,000 sites per distribution; the special cases (a 1e-9 cluster, a grid, a clip
 # region) run on fewer, enough for several tiles of thousands of sites each.
@@ -46,39 +47,86 @@ def assert_same_cells(cells: pd.DataFrame, geoms: np.ndarray) -> None:
     assert not bad, f"{len(bad)} cells differ, first at site {bad[:5]}"
 
 
+def assert_same_triangles(result, full) -> None:
+    """Every triangle once, from one task, equal as site triples to one process's canonical triangles;
+    each row's geometry the triangle of its three sites."""
+    frame = result.triangles.compute()
+    tri = frame[["a", "b", "c"]].to_numpy()
+    assert (tri[:, 0] < tri[:, 1]).all() and (tri[:, 0] < tri[:, 2]).all()      # lowest first
+    tri = tri[np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))]
+    want, _ = canonical_triangles(np.asarray(full.sites), full.triangles, len(full.vertices))
+    assert tri.shape == want.shape and np.array_equal(tri, want)
+    # counter-clockwise polygons of the sites' own coordinates
+    geoms = shapely.from_wkb(frame["geometry"].to_numpy(dtype=object))
+    rows = frame[["a", "b", "c"]].to_numpy()
+    ring = shapely.get_coordinates(geoms).reshape(-1, 4, 2)
+    assert np.array_equal(ring[:, :3], np.asarray(full.sites)[rows])
+    assert (shapely.is_ccw(shapely.get_exterior_ring(geoms))).all()
+    assert result.triangles_pending_after[-1] == 0
+
+
 @pytest.mark.parametrize("distribution", ["uniform", "gaussian", "clustered"])
 def test_distributions_equal_one_process(client, distribution):
     pts = generate(distribution, N, seed=12)
-    result = voronoi(frame_of(pts), client=client, tiles=8)
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=8, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
     assert result.rounds == len(result.pending_after) and result.pending_after[-1] == 0
     if distribution == "gaussian":
         # the sparse corners of a gaussian cloud need a second round
         assert result.rounds > 1 and result.pending_after[0] > 0
+    # no four sites cocircular: the canonical triangles are the engine's own
+    assert len(full.vertices) == len(full.triangles)
+    assert_same_triangles(result, full)
 
 
 def test_a_1e9_cluster_with_repeats_equals_one_process(client):
     rng = np.random.default_rng(3)
     cluster = 0.5 + 1e-9 * rng.random((N_SMALL, 2))
     pts = np.concatenate([cluster, cluster[rng.integers(0, N_SMALL, 2_000)], generate("uniform", 2_000, seed=3)])
-    result = voronoi(frame_of(pts), client=client, tiles=6)
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=6, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
+    assert_same_triangles(result, full)
 
 
 def test_a_grid_with_a_tight_halo_needs_a_second_round_and_equals_one_process(client):
     side = 200
     pts = np.stack(np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float)), -1).reshape(-1, 2)
-    result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1)
-    assert result.rounds > 1 and result.pending_after[0] > 0
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1, delaunay=True)
+    assert result.rounds > 1 and result.pending_after[0] > 0 and result.triangles_pending_after[0] > 0
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
+    # every square's four corners are cocircular: each square cut along the diagonal from its lowest corner
+    assert len(full.vertices) < len(full.triangles)
+    assert_same_triangles(result, full)
+    tri = result.triangles.compute()[["a", "b", "c"]].to_numpy()
+    assert {int(t[2] - t[0]) for t in tri} | {int(t[1] - t[0]) for t in tri} == {1, side, side + 1}
+
+
+def test_cocircular_sites_on_circles_across_tiles_equal_the_canonical_triangles(client):
+    # concentric rings of 24 sites (every ring's sites cocircular), on a grid of centres spanning the tiles,
+    # and regular polygons sharing the circle of their neighbours
+    angles = 2 * np.pi * np.arange(24) / 24
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])
+    centres = np.stack(np.meshgrid(np.arange(12.0) * 3, np.arange(12.0) * 3), -1).reshape(-1, 2)
+    pts = np.concatenate([c + ring for c in centres] + [centres])
+    pts = pts[np.random.default_rng(1).permutation(len(pts))]
+    result = voronoi(frame_of(pts), client=client, tiles=6, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert len(full.vertices) < len(full.triangles)
+    assert_same_triangles(result, full)
 
 
 def test_a_clip_region_equals_one_process(client):
     pts = generate("uniform", N_SMALL, seed=5, bounds=(0, 0, 10, 10))
     region = shapely.Polygon([(1, 1), (9, 2), (8, 9), (2, 7)], holes=[[(4, 4), (6, 4), (5, 6)]])
-    result = voronoi(frame_of(pts, id=np.arange(N_SMALL) * 3), client=client, tiles=6, clip=region)
+    result = voronoi(frame_of(pts, id=np.arange(N_SMALL) * 3), client=client, tiles=6, clip=region, delaunay=True)
     cells = cells_of(result)
-    assert_same_cells(cells, tvoronoi.voronoi(pts, clip=region, threads=1).to_shapely())
+    full = tvoronoi.voronoi(pts, clip=region, threads=1)
+    assert_same_cells(cells, full.to_shapely())
+    # the triangles of the sites inside the region, as one process gives them
+    assert_same_triangles(result, full)
     # properties travel with their sites
     assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
 
@@ -177,14 +225,22 @@ def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, 
 
     pts = generate("gaussian", 20_000, seed=4)
     write_csv_parts(tmp_path, pts, 3)
-    out = tmp_path / "cells.parquet"
+    out, triangles = tmp_path / "cells.parquet", tmp_path / "triangles"
     status = main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", client.scheduler.address,
-                   "--tiles", "5"])
-    assert status == 0, capsys.readouterr().err
-    assert "3 file(s)" in capsys.readouterr().err
+                   "--tiles", "5", "--delaunay", str(triangles)])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert "3 file(s)" in err and f"Delaunay triangles -> {triangles}" in err
     frame = geopandas.read_parquet(out).sort_values("site").reset_index(drop=True)
     assert frame["label"].tolist() == [f"r{i}" for i in range(len(pts))]
-    assert shapely.equals_exact(frame.geometry.to_numpy(), tvoronoi.voronoi(pts).to_shapely(), tolerance=0).all()
+    full = tvoronoi.voronoi(pts)
+    assert shapely.equals_exact(frame.geometry.to_numpy(), full.to_shapely(), tolerance=0).all()
+    # the triangles' parts read as one table: the same site triples as one process's --delaunay output
+    tri = geopandas.read_parquet(triangles)
+    sites = np.stack(tri["sites"].to_numpy())
+    assert {tuple(sorted(t)) for t in sites.tolist()} == {tuple(sorted(t)) for t in full.triangles.tolist()}
+    assert len(sites) == len(full.triangles)
+    assert np.array_equal(shapely.get_coordinates(tri.geometry.to_numpy()).reshape(-1, 4, 2)[:, :3], pts[sites])
 
 
 def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path):
@@ -218,6 +274,7 @@ def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path)
     (["--tiles", "3"], "--tiles goes with --dask"),
     (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
     (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
+    (["--dask", "local", "--delaunay", "-"], "--delaunay names a new directory of parts"),
 ])
 def test_cli_errors_are_named(tmp_path, capsys, argv, message):
     from tvoronoi.cli import main

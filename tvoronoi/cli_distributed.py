@@ -1,4 +1,5 @@
-"""`tvoronoi batch INPUT -o DIR --dask ...`: point files read in partitions, cells written as parts by the tasks."""
+"""`tvoronoi batch INPUT -o DIR --dask ... [--delaunay DIR]`: point files read in partitions, cells (and
+triangles) written as parts by the tasks."""
 
 from __future__ import annotations
 
@@ -142,20 +143,23 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
     parse_dask(args.dask)
     if args.tiles is not None and args.tiles < 1:
         raise TvoronoiError(f"--tiles {args.tiles}: give a positive number of tiles")
-    for flag, value in (("--lloyd", args.lloyd), ("--delaunay", args.delaunay), ("--precision", args.precision)):
+    for flag, value in (("--lloyd", args.lloyd), ("--precision", args.precision)):
         if value is not None:
             raise TvoronoiError(f"{flag} is not available with --dask yet; run without --dask for it")
     if output_format not in ("parquet", "geojsonseq"):
         raise TvoronoiError(
             "with --dask, OUTPUT is a directory of parts: --to parquet (GeoParquet, the default) or geojsonseq"
         )
+    if args.delaunay == "-":
+        raise TvoronoiError('with --dask, --delaunay names a new directory of parts, not "-"')
     files = input_files(args.input)
     frame = read_partitions(files, args.format, args.delimiter)
     x, y = _column(frame, args.x), _column(frame, args.y)
     client = client_for(args.dask)
     try:
         result = voronoi(frame, client=client, bbox=bbox, tiles=args.tiles, to=args.output, format=output_format,
-                         clip=region, engine=args.engine, x=x, y=y, crs=args.crs)
+                         clip=region, engine=args.engine, x=x, y=y, crs=args.crs,
+                         delaunay=False if args.delaunay is None else args.delaunay)
     except TvoronoiError as exc:
         if str(exc).startswith(("partition ", "the points cannot be read")):
             # partitions are numbered through the files in sorted order (a CSV file may hold several)
@@ -171,3 +175,7 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
         print(f"tvoronoi: {len(files)} file(s) -> {args.output}: {parts} parts from {result.n_tiles} tiles, "
               f"{result.rounds} round(s) (cells left after each: {', '.join(map(str, result.pending_after))})",
               file=sys.stderr)
+        if args.delaunay is not None:
+            parts = sum(1 for name in result.triangle_parts if name)
+            print(f"tvoronoi: Delaunay triangles -> {args.delaunay}: {parts} parts (sites with triangles left after "
+                  f"each round: {', '.join(map(str, result.triangles_pending_after))})", file=sys.stderr)
