@@ -291,5 +291,51 @@ def test_cli_names_a_value_that_is_not_a_number_and_writes_nothing(tmp_path, cap
     out = tmp_path / "cells"
     assert main(["batch", str(tmp_path / "bad.csv"), "-o", str(out), "--dask", "local:1"]) == 2
     err = capsys.readouterr().err
-    assert "bad.csv: partition 0, row 1 (index 1): y is 'abc', not a finite number" in err
+    assert "bad.csv, line 3: y is 'abc', not a finite number" in err
     assert "Traceback" not in err and not out.exists()
+
+
+def test_cli_names_the_file_and_line_of_a_bad_value_in_a_later_block(tmp_path, capsys, monkeypatch):
+    from tvoronoi import cli_distributed
+    from tvoronoi.cli import main
+
+    # small blocks: each file is read in several partitions, and the bad row lies in a later one
+    monkeypatch.setattr(cli_distributed, "CSV_BLOCKSIZE", 20_000)
+    write_csv_parts(tmp_path, generate("uniform", 6_000, seed=3), 3)
+    path = tmp_path / "points-1.csv"
+    lines = path.read_text().splitlines()
+    lines.insert(1500, "")                          # a blank line, skipped by the reader, counted as a line
+    lines[1700] = "r9999,0.5,not-a-number"
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "cells"
+    assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}, line 1701: y is 'not-a-number', not a finite number" in err, err
+    assert not out.exists()
+
+
+def test_cli_names_the_parquet_file_and_row_of_a_bad_value(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    pts = generate("uniform", 3_000, seed=5)
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), 3)):
+        x = pts[chunk, 0].copy()
+        if k == 2:
+            x[417] = np.inf
+        pd.DataFrame({"x": x, "y": pts[chunk, 1]}).to_parquet(tmp_path / f"p{k}.parquet", row_group_size=300)
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'p2.parquet'}, row 417 (0-based): x is inf, not a finite number" in err, err
+
+
+def test_cli_names_a_csv_file_that_cannot_be_parsed(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    write_csv_parts(tmp_path, generate("uniform", 40_000, seed=2), 2)
+    path = tmp_path / "points-1.csv"
+    lines = path.read_text().splitlines()
+    lines[15_000] += ",1,2"                         # a row with extra fields, past the sample dask reads first
+    path.write_text("\n".join(lines) + "\n")
+    assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: cannot be read (ParserError: " in err and "line 15001" in err, err

@@ -140,6 +140,12 @@ def _as_frame(points, x: str | None, y: str | None):
     return points, chosen[0], chosen[1]
 
 
+def coordinate_columns(frame, x: str | None = None, y: str | None = None) -> tuple[str, str]:
+    """The names of a Dask DataFrame's x and y columns, as ``voronoi`` finds them."""
+    _, xname, yname = _as_frame(frame, x, y)
+    return xname, yname
+
+
 def _coordinates(part, column: str) -> np.ndarray:
     """A coordinate column as float64, NaN where a value is not a number."""
     import pandas as pd
