@@ -200,22 +200,26 @@ def _meets(extent: Region | None, region: Region) -> bool:
                                        or extent[1] > region[3])
 
 
-def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str], clip):
-    """The rows of one partition whose site lies in the closed ``region``, with their input rows."""
+def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str], clip) -> tuple:
+    """For each closed region, the rows of one partition whose site lies in it, with their input rows
+    (one pass over the partition serves every unit of a round)."""
     import pandas as pd
 
     xs, ys = _coordinates(part, x), _coordinates(part, y)
-    rows = np.flatnonzero(in_region(xs, ys, region))
-    frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
-    inside = np.ones(len(rows), bool)
-    if clip is not None and len(rows):
-        from tvoronoi.region import sites_inside
+    out = []
+    for region in regions:
+        rows = np.flatnonzero(in_region(xs, ys, region))
+        frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
+        inside = np.ones(len(rows), bool)
+        if clip is not None and len(rows):
+            from tvoronoi.region import sites_inside
 
-        inside = sites_inside(np.column_stack([xs[rows], ys[rows]]), clip)
-    frame["__tvoronoi_inside"] = inside
-    for name in keep:
-        frame[name] = part[name].to_numpy()[rows]
-    return frame
+            inside = sites_inside(np.column_stack([xs[rows], ys[rows]]), clip)
+        frame["__tvoronoi_inside"] = inside
+        for name in keep:
+            frame[name] = part[name].to_numpy()[rows]
+        out.append(frame)
+    return tuple(out)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -555,16 +559,25 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
         round_ += 1
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
+        regions = [plan.region(t, round_, box_needed) for t, _, box_needed, _ in units]
+        # each unit reads the partitions whose sites reach its region (all of them for shuffled input; a
+        # few for input sorted in space), one piece at least so that the task knows the columns; each
+        # partition is read once a round, for all the units it serves
+        reach = [[k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0] for region in regions]
+        serves: dict[int, list[int]] = {}
+        for u, ks in enumerate(reach):
+            for k in ks:
+                serves.setdefault(k, []).append(u)
+        pieces: list[list] = [[] for _ in units]
+        for k, us in serves.items():
+            chosen = dask.delayed(_select, nout=len(us))(parts[k], int(firsts[k]), xname, yname,
+                                                         [regions[u] for u in us], list(properties), clip)
+            for j, u in enumerate(us):
+                pieces[u].append(chosen[j])
         tasks = []
-        for g, (t, group, box_needed, kind) in enumerate(units):
-            region = plan.region(t, round_, box_needed)
-            # only the partitions whose sites reach the region (all of them for shuffled input; a few for
-            # input sorted in space); one piece at least, so that the task knows the columns
-            reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
-            pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
-                      for k in reach]
+        for g, (t, group, _, kind) in enumerate(units):
             name = f"part-r{round_:02d}-t{t:05d}" + ("" if group is None else f"-g{g:05d}")
-            tasks.append(dask.delayed(_run_tile, nout=4)(pieces, t, region, group, kind, job, round_, name))
+            tasks.append(dask.delayed(_run_tile, nout=4)(pieces[g], t, regions[g], group, kind, job, round_, name))
         k = len(tasks)
         futures = client.compute([task[j] for j in range(4) for task in tasks])
         left_cells, left_tris = client.gather(futures[2 * k:3 * k]), client.gather(futures[3 * k:])

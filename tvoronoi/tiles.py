@@ -160,22 +160,25 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     lengths = np.diff(offsets)
     if len(ring_xy) == 0:
         return np.ones(n_cells, bool)
-    owner = np.repeat(np.arange(n_cells), lengths)
     vx, vy = ring_xy[:, 0], ring_xy[:, 1]
-    sx, sy = sites[owner, 0], sites[owner, 1]
     with np.errstate(over="ignore", invalid="ignore"):
-        radius = np.hypot(vx - sx, vy - sy)
+        radius = np.hypot(vx - np.repeat(sites[:, 0], lengths), vy - np.repeat(sites[:, 1], lengths))
         # the ulp of the largest coordinate bounds every point's (ulps grow with magnitude)
         top = max(float(np.abs(vx).max()), float(np.abs(vy).max()))
         slack = 2 * CERTIFY_ULPS * float(np.spacing(top)) + 4 * float(np.spacing(0.0))
         need = radius * (1 + CERTIFY_RELATIVE) + slack
-        ok = np.isfinite(need)
+        # the room to the nearest finite side (the test below is monotone in the room: one comparison
+        # for the four sides); nothing lies beyond an infinite side
         x0, y0, x1, y1 = region
-        for room, side in ((vx - x0, x0), (vy - y0, y0), (x1 - vx, x1), (y1 - vy, y1)):
-            if math.isinf(side):                     # nothing lies beyond an infinite side
-                continue
-            ok &= np.isfinite(room) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
-    bad = np.bincount(owner[~ok], minlength=n_cells)
+        room = np.full(len(vx), np.inf)
+        for side, value, sign in ((x0, vx, 1.0), (y0, vy, 1.0), (x1, vx, -1.0), (y1, vy, -1.0)):
+            if not math.isinf(side):
+                np.minimum(room, (value - side) if sign > 0 else (side - value), out=room)
+        # a non-finite point or distance is never certified (NaN compares false)
+        ok = np.isfinite(need) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
+    if ok.all():
+        return np.ones(n_cells, bool)
+    bad = np.bincount(np.repeat(np.arange(n_cells), lengths)[~ok], minlength=n_cells)
     return bad == 0
 
 
@@ -246,25 +249,25 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
         empty = np.empty(0, np.int64)
         return TileCells(empty, np.zeros(1, np.int64), np.empty((0, 2)), empty)
     d = voronoi(pts, bbox=box, engine=engine, threads=threads) if diagram is None else diagram
-    starts, ends = d.cell_offsets[rows], d.cell_offsets[rows + 1]
-    lengths = ends - starts
+    # the wanted cells' rings (a mask over the CSR points: cheaper than an index when most are wanted)
+    all_lengths = np.diff(d.cell_offsets)
+    lengths = all_lengths[rows]
     offsets = np.zeros(len(rows) + 1, np.int64)
     np.cumsum(lengths, out=offsets[1:])
-    gather = np.repeat(starts - offsets[:-1], lengths) + np.arange(offsets[-1])
-    ring_xy = d.cell_points[d.cell_vertices[gather]]
+    vertices = d.cell_vertices if len(rows) == len(pts) else d.cell_vertices[np.repeat(want, all_lengths)]
+    ring_xy = d.cell_points[vertices]
     ok = np.ones(len(rows), bool) if everything else certified(ring_xy, offsets, pts[rows], region)
+    if ok.all():
+        return TileCells(ids[rows].astype(np.int64), offsets, ring_xy, np.empty(0, np.int64))
     keep = np.flatnonzero(ok)
-    k_len = lengths[keep]
     k_off = np.zeros(len(keep) + 1, np.int64)
-    np.cumsum(k_len, out=k_off[1:])
-    k_gather = np.repeat(offsets[keep] - k_off[:-1], k_len) + np.arange(k_off[-1])
+    np.cumsum(lengths[keep], out=k_off[1:])
     failed = np.flatnonzero(~ok)
     reaches = np.empty((len(failed), 4))
-    site_of_point = np.repeat(pts[rows], lengths, axis=0)
     for j, k in enumerate(failed.tolist()):
         a, b = offsets[k], offsets[k + 1]
-        reaches[j] = flower_box(ring_xy[a:b], site_of_point[a:b])
-    return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[k_gather],
+        reaches[j] = flower_box(ring_xy[a:b], np.repeat(pts[rows[k]][None], b - a, axis=0))
+    return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[np.repeat(ok, lengths)],
                      ids[rows[failed]].astype(np.int64), reaches)
 
 
