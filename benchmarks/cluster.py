@@ -42,6 +42,7 @@ from benchmarks.common import maxrss_mib
 import tvoronoi
 from tvoronoi.writers.geoparquet import write_cells_parquet
 n, out = int(sys.argv[1]), sys.argv[2]
+c0 = time.process_time()
 t0 = time.perf_counter()
 pts = np.concatenate([partition_points(k, n) for k in range((n + {PARTITION} - 1) // {PARTITION})])
 t1 = time.perf_counter()
@@ -49,7 +50,8 @@ d = tvoronoi.voronoi(pts, threads=1)
 t2 = time.perf_counter()
 write_cells_parquet(d, None, out)
 t3 = time.perf_counter()
-print(json.dumps({{"generate": t1 - t0, "build": t2 - t1, "write": t3 - t2, "total": t3 - t0, "peak_mib": maxrss_mib()}}))
+print(json.dumps({{"generate": t1 - t0, "build": t2 - t1, "write": t3 - t2, "total": t3 - t0,
+                  "cpu": time.process_time() - c0, "peak_mib": maxrss_mib()}}))
 """
 
 
@@ -98,19 +100,26 @@ def time_threads(n: int, repeats: int = 3) -> dict:
 
 
 def one_process(n: int) -> dict:
+    import os
+
+    load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
         run = subprocess.run([sys.executable, "-c", ONE_PROCESS, str(n), str(Path(tmp) / "cells.parquet"),
                               str(Path(__file__).resolve().parent.parent)],
                              capture_output=True, text=True, env=subprocess_env())
     if run.returncode != 0:
         raise RuntimeError(run.stderr)
-    return json.loads(run.stdout.strip().splitlines()[-1])
+    return {**json.loads(run.stdout.strip().splitlines()[-1]), "load_before": load, "load_after": os.getloadavg()[0]}
 
 
 def _worker_peak() -> float:
     from benchmarks.common import maxrss_mib
 
     return maxrss_mib()
+
+
+def _worker_cpu() -> float:
+    return time.process_time()
 
 
 def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
@@ -127,20 +136,29 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
     n_parts = (n + PARTITION - 1) // PARTITION
     frame = dd.from_delayed([dask.delayed(part)(k) for k in range(n_parts)],
                             meta=pd.DataFrame({"x": np.empty(0), "y": np.empty(0)}))
+    import os
+
     client = local_client(workers)
     try:
         client.run(lambda: sys.path.insert(0, str(Path(__file__).resolve().parent.parent)))
+        load = os.getloadavg()[0]
         with tempfile.TemporaryDirectory() as tmp:
+            cpu0 = client.run(_worker_cpu)
+            c0 = time.process_time()                # this process: the client and the LocalCluster's scheduler
             t0 = time.perf_counter()
             result = voronoi(frame, client=client, tiles=tiles, to=Path(tmp) / "cells")
             elapsed = time.perf_counter() - t0
+            here = time.process_time() - c0
+            cpu1 = client.run(_worker_cpu)
             written = sum(1 for p in result.parts if p)
         peaks = client.run(_worker_peak)
     finally:
         cluster = client.cluster
         client.close()
         cluster.close()
-    return {"seconds": elapsed, "tiles": result.n_tiles, "rounds": result.rounds,
+    return {"seconds": elapsed, "worker_cpu": sorted(round(cpu1[w] - cpu0[w], 1) for w in cpu1),
+            "scheduler_client_cpu": here, "load_before": load, "load_after": os.getloadavg()[0],
+            "tiles": result.n_tiles, "rounds": result.rounds,
             "pending_after": list(result.pending_after), "parts": written,
             "worker_peak_mib": sorted(round(v, 1) for v in peaks.values())}
 

@@ -155,6 +155,10 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     ``CERTIFY_ULPS`` ulps of the largest coordinate among the ring points, for each coordinate (an ulp
     only grows with the magnitude; plus the least subnormal, for results below the normal range) cover
     the ring's rounding. Any non-finite value fails the test: never certified.
+
+    Most cells are settled without the test at each point: the room to the nearest side changes by at
+    most |v - s| between s and v, so room(s) >= 2 max |v* - s| implies the test at every v*; the site's
+    room and the farthest distance carry the same margins as above.
     """
     n_cells = len(offsets) - 1
     lengths = np.diff(offsets)
@@ -166,20 +170,37 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
         # the ulp of the largest coordinate bounds every point's (ulps grow with magnitude)
         top = max(float(np.abs(vx).max()), float(np.abs(vy).max()))
         slack = 2 * CERTIFY_ULPS * float(np.spacing(top)) + 4 * float(np.spacing(0.0))
-        need = radius * (1 + CERTIFY_RELATIVE) + slack
-        # the room to the nearest finite side (the test below is monotone in the room: one comparison
-        # for the four sides); nothing lies beyond an infinite side
-        x0, y0, x1, y1 = region
-        room = np.full(len(vx), np.inf)
-        for side, value, sign in ((x0, vx, 1.0), (y0, vy, 1.0), (x1, vx, -1.0), (y1, vy, -1.0)):
-            if not math.isinf(side):
-                np.minimum(room, (value - side) if sign > 0 else (side - value), out=room)
+        # most cells lie far from every side: room(v) >= room(s) - |v - s| (the room to the nearest side
+        # moves no faster than the point), so a cell whose site has twice its farthest point's distance
+        # as room passes the test below at every point; the computed room of the site errs by one
+        # rounding, covered by the same relative slack
+        ok = np.ones(n_cells, bool)
+        has = lengths > 0
+        farthest = np.zeros(n_cells)
+        farthest[has] = np.maximum.reduceat(radius, offsets[:-1][has])
+        site_room = _room(sites[:, 0], sites[:, 1], region)
+        easy = np.isfinite(farthest) & (site_room * (1 - CERTIFY_RELATIVE) - slack
+                                        >= 2 * (farthest * (1 + CERTIFY_RELATIVE) + slack))
+        if easy.all():
+            return ok
+        hard = np.repeat(~easy, lengths)
+        need = radius[hard] * (1 + CERTIFY_RELATIVE) + slack
+        room = _room(vx[hard], vy[hard], region)
         # a non-finite point or distance is never certified (NaN compares false)
-        ok = np.isfinite(need) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
-    if ok.all():
-        return np.ones(n_cells, bool)
-    bad = np.bincount(np.repeat(np.arange(n_cells), lengths)[~ok], minlength=n_cells)
+        passed = np.isfinite(need) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
+    owner = np.repeat(np.arange(n_cells), lengths)[hard]
+    bad = np.bincount(owner[~passed], minlength=n_cells)
     return bad == 0
+
+
+def _room(xs: np.ndarray, ys: np.ndarray, region: Region) -> np.ndarray:
+    """How far each point lies inside the region from its nearest finite side (inf: no finite side)."""
+    x0, y0, x1, y1 = region
+    room = np.full(len(xs), np.inf)
+    for side, value, inward in ((x0, xs, True), (y0, ys, True), (x1, xs, False), (y1, ys, False)):
+        if not math.isinf(side):
+            np.minimum(room, (value - side) if inward else (side - value), out=room)
+    return room
 
 
 def flower_box(ring_xy: np.ndarray, sites: np.ndarray) -> Region:
