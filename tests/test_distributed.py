@@ -167,8 +167,18 @@ def test_geojsonseq_parts(client, tmp_path):
     import orjson
 
     pts = generate("uniform", 5_000, seed=2)
-    out = tmp_path / "seq"
-    voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq")
+    out, triangles = tmp_path / "seq", tmp_path / "triangles"
+    result = voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq", delaunay=triangles)
+    assert result.triangles is None and any(result.triangle_parts)
+    # the triangles' parts: features with "sites", as one process's GeoJSON --delaunay writes them
+    rows = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(triangles.iterdir())
+            for line in part.read_bytes().splitlines()]
+    sites = np.array([f["properties"]["sites"] for f in rows])
+    full_triangles = tvoronoi.voronoi(pts, threads=1).triangles
+    assert len(sites) == len(full_triangles)
+    assert {tuple(sorted(t)) for t in sites.tolist()} == {tuple(sorted(t)) for t in full_triangles.tolist()}
+    ring = np.array([f["geometry"]["coordinates"][0] for f in rows])
+    assert np.array_equal(ring[:, :3], pts[sites]) and np.array_equal(ring[:, 3], ring[:, 0])
     features = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(out.iterdir()) for line in part.read_bytes().splitlines()]
     features.sort(key=lambda f: f["properties"]["site"])
     assert [f["properties"]["site"] for f in features] == list(range(5_000))
@@ -195,6 +205,11 @@ def test_bad_input_is_named(client, tmp_path):
     (tmp_path / "full" / "old.parquet").write_bytes(b"x")
     with pytest.raises(TvoronoiError, match="not empty"):
         voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "full")
+    with pytest.raises(TvoronoiError, match="not empty"):
+        voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "new", delaunay=tmp_path / "full")
+    assert not (tmp_path / "new").exists()          # the cells' directory made first is removed again
+    with pytest.raises(TvoronoiError, match="would go to one directory"):
+        voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "same", delaunay=tmp_path / "same")
 
 
 def test_the_core_package_works_without_dask():

@@ -36,6 +36,9 @@ ID, X, Y = "__tvoronoi_site", "__tvoronoi_x", "__tvoronoi_y"
 # the cell columns tvoronoi adds; a property of the same name is renamed
 SITE, GEOMETRY = "site", "geometry"
 FORMATS = ("parquet", "geojsonseq")
+# a partition serving more regions than this in one round is sorted by x first (one sort, then each
+# region reads only its x range: a later round's many small groups cost little)
+SORT_ABOVE = 4
 
 
 def require_dask():
@@ -206,9 +209,18 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
     import pandas as pd
 
     xs, ys = _coordinates(part, x), _coordinates(part, y)
+    # many regions (the small groups of a later round): each looks only at the sites in its x range,
+    # found in the partition sorted by x once, not at the whole partition
+    by_x = np.argsort(xs, kind="stable") if len(regions) > SORT_ABOVE else None
+    sorted_x = xs[by_x] if by_x is not None else None
     out = []
     for region in regions:
-        rows = np.flatnonzero(in_region(xs, ys, region))
+        if by_x is None:
+            rows = np.flatnonzero(in_region(xs, ys, region))
+        else:
+            lo, hi = np.searchsorted(sorted_x, region[0], "left"), np.searchsorted(sorted_x, region[2], "right")
+            slab = by_x[lo:hi]
+            rows = np.sort(slab[(ys[slab] >= region[1]) & (ys[slab] <= region[3])])
         frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
         inside = np.ones(len(rows), bool)
         if clip is not None and len(rows):
