@@ -5,7 +5,8 @@ shape (n, 2). One pass over the partitions counts the rows (their order numbers 
 ``tvoronoi.voronoi``), finds the sites' extent and draws a sample, from which the tiles are cut. Then
 each round runs one task per tile that still has cells to emit: it gathers the sites of its region from
 every partition, builds their diagram, and emits the certified cells of its own sites with their
-properties (or writes them: ``to=``). No process ever holds the whole input or output.
+properties (or writes them: ``to=``), and with ``delaunay`` the final triangles whose lowest site is
+its own (tvoronoi.tile_delaunay). No process ever holds the whole input or output.
 """
 
 from __future__ import annotations
@@ -211,11 +212,12 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
     xs, ys = _coordinates(part, x), _coordinates(part, y)
     # many regions (the small groups of a later round): each looks only at the sites in its x range,
     # found in the partition sorted by x once, not at the whole partition
-    by_x = np.argsort(xs, kind="stable") if len(regions) > SORT_ABOVE else None
-    sorted_x = xs[by_x] if by_x is not None else None
+    sort = len(regions) > SORT_ABOVE
+    by_x = np.argsort(xs, kind="stable") if sort else np.empty(0, np.int64)
+    sorted_x = xs[by_x]
     out = []
     for region in regions:
-        if by_x is None:
+        if not sort:
             rows = np.flatnonzero(in_region(xs, ys, region))
         else:
             lo, hi = np.searchsorted(sorted_x, region[0], "left"), np.searchsorted(sorted_x, region[2], "right")
