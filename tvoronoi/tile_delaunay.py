@@ -65,7 +65,7 @@ def circumcentres(pts: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 
 def canonical_triangles(pts: np.ndarray, triangles: np.ndarray, n_vertices: int | None = None,
-                        centres: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                        centres: np.ndarray | None = None, sort: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """The canonical Delaunay triangulation: each polygon of cocircular sites a fan from its lowest index.
 
     Parameters
@@ -74,6 +74,7 @@ def canonical_triangles(pts: np.ndarray, triangles: np.ndarray, n_vertices: int 
     n_vertices : the number of distinct Voronoi vertices, when known (``len(diagram.vertices)``): equal
         to k, no two triangles share a circle and the triangles are returned as they are
     centres : (k, 2) their correctly rounded circumcentres, when known
+    sort : sort the triangles by rows (a task that only filters them skips it)
 
     Returns
     -------
@@ -86,6 +87,8 @@ def canonical_triangles(pts: np.ndarray, triangles: np.ndarray, n_vertices: int 
     if n_vertices is None or n_vertices < len(tri):
         tri, centres = _fan_cocircular(pts, tri, centres)
     tri = lowest_first(tri)
+    if not sort:
+        return tri, centres
     order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
     return tri[order], centres[order]
 
@@ -188,9 +191,8 @@ def certified_triangles(pts: np.ndarray, tri: np.ndarray, centres: np.ndarray, o
             failed |= finite & (room + err < low)
     unsure = ~passed & ~(failed & ~on_hull.any(axis=1))
     ok = passed.copy()
-    xy = pts.tolist()
     for t in np.flatnonzero(unsure).tolist():
-        corners = [xy[i] for i in tri[t].tolist()]
+        corners = pts[tri[t]].tolist()
         hull = [(corners[j], corners[(j + 1) % 3]) for j in range(3) if on_hull[t, j]]
         ok[t] = disk_inside(corners, hull, region)
     return ok
@@ -301,7 +303,7 @@ def tile_triangles(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: R
         reach = np.tile(np.array(region, np.float64), (int(live.sum()), 1))
         reach = _cut_to(reach, extent)
         return TileTriangles(np.empty((0, 3), np.int64), ids[want & duplicate], ids[live], reach)
-    tri, centres = canonical_triangles(pts, tri, len(diagram.vertices))
+    tri, centres = canonical_triangles(pts, tri, len(diagram.vertices), sort=False)
     open_site = np.zeros(m, bool)
     if everything:
         ok = np.ones(len(tri), bool)
