@@ -140,6 +140,13 @@ def test_boundary_hull_keeps_collinear_sites_and_the_lowest_of_repeats():
     assert boundary_hull(pts[hulls], hulls).tolist() == got.tolist()
 
 
+def test_the_hull_of_collinear_sites_has_no_edge():
+    line = np.array([[0.0, 0.0], [2.0, 2.0], [1.0, 1.0], [3.0, 3.0]])
+    assert Hull.of(line, np.arange(4)).edges == set() and Hull.of(line, np.arange(4)).collinear
+    square = Hull.of(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.0]]), np.arange(5))
+    assert square.edges == {(0, 4), (4, 1), (1, 2), (2, 3), (3, 0)} and not square.collinear
+
+
 def test_disk_inside_is_exact_at_tangency():
     corners = [(-1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]            # the unit circle about the origin
     assert disk_inside(corners, [], (-1.0, -1.0, 1.0, 1.0))       # tangent to every side: inside

@@ -267,13 +267,28 @@ class Hull:
 
     @cached_property
     def edges(self) -> set:
-        """The directed edges (p, q) as pairs of input rows (the sites on their left)."""
+        """The directed edges (p, q) as pairs of input rows (the sites on their left); none when every
+        site lies on one line (then there is no triangle either)."""
+        if self.collinear:
+            return set()
         return {(int(p), int(q)) for p, q in hull_edges(self.ids).tolist()}
+
+    @cached_property
+    def collinear(self) -> bool:
+        """Whether the sites span no area (fewer than three places, or all on one line)."""
+        if len(self.ids) < 3:
+            return True
+        from tvoronoi.kernels.predicates import orient2d_many
+
+        xy = np.ldexp(self.xy, -scale_exponent(self.xy))
+        a = np.ascontiguousarray(np.broadcast_to(xy[0], xy.shape))
+        b = np.ascontiguousarray(np.broadcast_to(xy[1], xy.shape))
+        return not orient2d_many(a, b, np.ascontiguousarray(xy)).any()
 
     @cached_property
     def edge_boxes(self) -> np.ndarray:
         """(h, 4) each edge's bounding box."""
-        if len(self.ids) < 3:
+        if self.collinear:
             return np.empty((0, 4))
         a, b = self.xy, np.roll(self.xy, -1, axis=0)
         return np.column_stack([np.minimum(a, b), np.maximum(a, b)])
