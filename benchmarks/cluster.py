@@ -42,6 +42,7 @@ from benchmarks.common import maxrss_mib
 import tvoronoi
 from tvoronoi.writers.geoparquet import write_cells_parquet
 n, out = int(sys.argv[1]), sys.argv[2]
+c0 = time.process_time()
 t0 = time.perf_counter()
 pts = np.concatenate([partition_points(k, n) for k in range((n + {PARTITION} - 1) // {PARTITION})])
 t1 = time.perf_counter()
@@ -49,7 +50,8 @@ d = tvoronoi.voronoi(pts, threads=1)
 t2 = time.perf_counter()
 write_cells_parquet(d, None, out)
 t3 = time.perf_counter()
-print(json.dumps({{"generate": t1 - t0, "build": t2 - t1, "write": t3 - t2, "total": t3 - t0, "peak_mib": maxrss_mib()}}))
+print(json.dumps({{"generate": t1 - t0, "build": t2 - t1, "write": t3 - t2, "total": t3 - t0,
+                  "cpu": time.process_time() - c0, "peak_mib": maxrss_mib()}}))
 """
 
 
@@ -98,19 +100,26 @@ def time_threads(n: int, repeats: int = 3) -> dict:
 
 
 def one_process(n: int) -> dict:
+    import os
+
+    load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
         run = subprocess.run([sys.executable, "-c", ONE_PROCESS, str(n), str(Path(tmp) / "cells.parquet"),
                               str(Path(__file__).resolve().parent.parent)],
                              capture_output=True, text=True, env=subprocess_env())
     if run.returncode != 0:
         raise RuntimeError(run.stderr)
-    return json.loads(run.stdout.strip().splitlines()[-1])
+    return {**json.loads(run.stdout.strip().splitlines()[-1]), "load_before": load, "load_after": os.getloadavg()[0]}
 
 
 def _worker_peak() -> float:
     from benchmarks.common import maxrss_mib
 
     return maxrss_mib()
+
+
+def _worker_cpu() -> float:
+    return time.process_time()
 
 
 def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
@@ -127,20 +136,29 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
     n_parts = (n + PARTITION - 1) // PARTITION
     frame = dd.from_delayed([dask.delayed(part)(k) for k in range(n_parts)],
                             meta=pd.DataFrame({"x": np.empty(0), "y": np.empty(0)}))
+    import os
+
     client = local_client(workers)
     try:
         client.run(lambda: sys.path.insert(0, str(Path(__file__).resolve().parent.parent)))
+        load = os.getloadavg()[0]
         with tempfile.TemporaryDirectory() as tmp:
+            cpu0 = client.run(_worker_cpu)
+            c0 = time.process_time()                # this process: the client and the LocalCluster's scheduler
             t0 = time.perf_counter()
             result = voronoi(frame, client=client, tiles=tiles, to=Path(tmp) / "cells")
             elapsed = time.perf_counter() - t0
+            here = time.process_time() - c0
+            cpu1 = client.run(_worker_cpu)
             written = sum(1 for p in result.parts if p)
         peaks = client.run(_worker_peak)
     finally:
         cluster = client.cluster
         client.close()
         cluster.close()
-    return {"seconds": elapsed, "tiles": result.n_tiles, "rounds": result.rounds,
+    return {"seconds": elapsed, "worker_cpu": sorted(round(cpu1[w] - cpu0[w], 1) for w in cpu1),
+            "scheduler_client_cpu": here, "load_before": load, "load_after": os.getloadavg()[0],
+            "tiles": result.n_tiles, "rounds": result.rounds,
             "pending_after": list(result.pending_after), "parts": written,
             "worker_peak_mib": sorted(round(v, 1) for v in peaks.values())}
 
@@ -163,12 +181,13 @@ cells, WKB and the Arrow table of its part), and builds about {rate:,.0f} sites 
   2-4 GiB each, one task per core, suffices; the output is written by the tasks (one part each).
 - Halos: a halo of 4 site spacings around a square tile of 10^6 sites (1,000 spacings a side) adds
   (1008^2 - 1000^2) / 1000^2 = 1.6% of the sites, read by a second task.
-- What does not scale as written: each tile's task asks every input partition for the sites of its
-  region (partitions whose extent misses the region are skipped). For shuffled input that is tiles x
-  partitions small tasks a round: 10^6 at 10^9 sites with partitions of 10^6, 10^8 at 10^10 -- beyond
-  what one Dask scheduler handles (~1 ms a task). At that scale the sites must first be shuffled to
-  their tile once (dask.dataframe's shuffle on the tile number, n x 24 bytes over the network), the
-  halos then taken from the 8 neighbouring tiles only (1.6% more); then 10^4 tasks a round at 10^10.
+- What does not scale as written: each partition is read once a round (one task serving every tile
+  whose region it reaches; partitions whose extent misses a region are skipped), but for shuffled input
+  every tile still takes a piece from every partition: tiles x partitions pieces a round, 10^6 at 10^9
+  sites with partitions of 10^6, 10^8 at 10^10 -- beyond what one Dask scheduler handles (~1 ms a
+  task). At that scale the sites must first be shuffled to their tile once (dask.dataframe's shuffle on
+  the tile number, n x 24 bytes over the network), the halos then taken from the 8 neighbouring tiles
+  only (1.6% more); then 10^4 tasks a round at 10^10.
 - Rounds: with the first halo of 4 spacings, uniform data finishes in 2 rounds: the second rebuilds
   each group of leftover cells (box corners and edges) with just the sites their disks reach, a few
   thousand per group.
@@ -211,6 +230,19 @@ def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | N
             "",
             f"Parallel efficiency: {efficiency:.0%} (t_one / ({workers} x t_cluster)).", "",
         ]
+        if "cpu" in one and "worker_cpu" in cluster:
+            spent = sum(cluster["worker_cpu"]) + cluster["scheduler_client_cpu"]
+            lines += [
+                f"CPU seconds: one process {one['cpu']:.1f}; the cluster {spent:.1f} (workers "
+                f"{' + '.join(f'{v:.1f}' for v in cluster['worker_cpu'])}, scheduler and client "
+                f"{cluster['scheduler_client_cpu']:.1f}): the tiles cost {spent / one['cpu']:.2f}x the work of one "
+                f"process, so on {workers} free cores the efficiency would be at most {one['cpu'] / spent:.0%}.",
+                f"Load average (1 min) before / after: one process {one['load_before']:.1f} / "
+                f"{one['load_after']:.1f}, cluster {cluster['load_before']:.1f} / {cluster['load_after']:.1f} on "
+                f"{info.get('cores_usable', 2)} cores: the machine was shared with other work, so the wall-clock "
+                f"figures above measure the share each run got, not the cores.",
+                "",
+            ]
         per_site = max(cluster["worker_peak_mib"]) * 2**20 / (n / cluster["tiles"] * 1.016)
         rate = n / cluster["seconds"] / workers
         lines.append(ESTIMATES.format(
@@ -227,7 +259,15 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--tiles", type=int, default=None)
     parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "results" / "cluster"))
+    parser.add_argument("--report-only", action="store_true", help="rewrite OUT.md from OUT.json (no run)")
     args = parser.parse_args(argv)
+    if args.report_only:
+        out = Path(args.out)
+        saved = json.loads(out.with_suffix(".json").read_text())
+        atomic_write(out.with_suffix(".md"), report(saved["machine"], saved["threads"], saved["one_process"],
+                                                    saved["cluster"], saved["n"], saved["workers"]))
+        print(out.with_suffix(".md").read_text())
+        return 0
     info = machine()
     threads = time_threads(parse_sizes(args.threads_n)[0]) if args.threads_n != "0" else None
     print(json.dumps(threads), flush=True)

@@ -14,6 +14,7 @@ import tvoronoi
 from tvoronoi.distributed import local_client, voronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import generate
+from tvoronoi.tile_delaunay import canonical_triangles
 
 # The issue's proof runs 200,000 sites per distribution; the special cases (a 1e-9 cluster, a grid, a clip
 # region) run on fewer, enough for several tiles of thousands of sites each.
@@ -46,39 +47,86 @@ def assert_same_cells(cells: pd.DataFrame, geoms: np.ndarray) -> None:
     assert not bad, f"{len(bad)} cells differ, first at site {bad[:5]}"
 
 
+def assert_same_triangles(result, full) -> None:
+    """Every triangle once, from one task, equal as site triples to one process's canonical triangles;
+    each row's geometry the triangle of its three sites."""
+    frame = result.triangles.compute()
+    tri = frame[["a", "b", "c"]].to_numpy()
+    assert (tri[:, 0] < tri[:, 1]).all() and (tri[:, 0] < tri[:, 2]).all()      # lowest first
+    tri = tri[np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))]
+    want, _ = canonical_triangles(np.asarray(full.sites), full.triangles, len(full.vertices))
+    assert tri.shape == want.shape and np.array_equal(tri, want)
+    # counter-clockwise polygons of the sites' own coordinates
+    geoms = shapely.from_wkb(frame["geometry"].to_numpy(dtype=object))
+    rows = frame[["a", "b", "c"]].to_numpy()
+    ring = shapely.get_coordinates(geoms).reshape(-1, 4, 2)
+    assert np.array_equal(ring[:, :3], np.asarray(full.sites)[rows])
+    assert (shapely.is_ccw(shapely.get_exterior_ring(geoms))).all()
+    assert result.triangles_pending_after[-1] == 0
+
+
 @pytest.mark.parametrize("distribution", ["uniform", "gaussian", "clustered"])
 def test_distributions_equal_one_process(client, distribution):
     pts = generate(distribution, N, seed=12)
-    result = voronoi(frame_of(pts), client=client, tiles=8)
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=8, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
     assert result.rounds == len(result.pending_after) and result.pending_after[-1] == 0
     if distribution == "gaussian":
         # the sparse corners of a gaussian cloud need a second round
         assert result.rounds > 1 and result.pending_after[0] > 0
+    # no four sites cocircular: the canonical triangles are the engine's own
+    assert len(full.vertices) == len(full.triangles)
+    assert_same_triangles(result, full)
 
 
 def test_a_1e9_cluster_with_repeats_equals_one_process(client):
     rng = np.random.default_rng(3)
     cluster = 0.5 + 1e-9 * rng.random((N_SMALL, 2))
     pts = np.concatenate([cluster, cluster[rng.integers(0, N_SMALL, 2_000)], generate("uniform", 2_000, seed=3)])
-    result = voronoi(frame_of(pts), client=client, tiles=6)
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=6, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
+    assert_same_triangles(result, full)
 
 
 def test_a_grid_with_a_tight_halo_needs_a_second_round_and_equals_one_process(client):
     side = 200
     pts = np.stack(np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float)), -1).reshape(-1, 2)
-    result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1)
-    assert result.rounds > 1 and result.pending_after[0] > 0
-    assert_same_cells(cells_of(result), tvoronoi.voronoi(pts, threads=1).to_shapely())
+    result = voronoi(frame_of(pts), client=client, tiles=5, halo_scale=0.1, delaunay=True)
+    assert result.rounds > 1 and result.pending_after[0] > 0 and result.triangles_pending_after[0] > 0
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert_same_cells(cells_of(result), full.to_shapely())
+    # every square's four corners are cocircular: each square cut along the diagonal from its lowest corner
+    assert len(full.vertices) < len(full.triangles)
+    assert_same_triangles(result, full)
+    tri = result.triangles.compute()[["a", "b", "c"]].to_numpy()
+    assert {int(t[2] - t[0]) for t in tri} | {int(t[1] - t[0]) for t in tri} == {1, side, side + 1}
+
+
+def test_cocircular_sites_on_circles_across_tiles_equal_the_canonical_triangles(client):
+    # concentric rings of 24 sites (every ring's sites cocircular), on a grid of centres spanning the tiles,
+    # and regular polygons sharing the circle of their neighbours
+    angles = 2 * np.pi * np.arange(24) / 24
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])
+    centres = np.stack(np.meshgrid(np.arange(12.0) * 3, np.arange(12.0) * 3), -1).reshape(-1, 2)
+    pts = np.concatenate([c + ring for c in centres] + [centres])
+    pts = pts[np.random.default_rng(1).permutation(len(pts))]
+    result = voronoi(frame_of(pts), client=client, tiles=6, delaunay=True)
+    full = tvoronoi.voronoi(pts, threads=1)
+    assert len(full.vertices) < len(full.triangles)
+    assert_same_triangles(result, full)
 
 
 def test_a_clip_region_equals_one_process(client):
     pts = generate("uniform", N_SMALL, seed=5, bounds=(0, 0, 10, 10))
     region = shapely.Polygon([(1, 1), (9, 2), (8, 9), (2, 7)], holes=[[(4, 4), (6, 4), (5, 6)]])
-    result = voronoi(frame_of(pts, id=np.arange(N_SMALL) * 3), client=client, tiles=6, clip=region)
+    result = voronoi(frame_of(pts, id=np.arange(N_SMALL) * 3), client=client, tiles=6, clip=region, delaunay=True)
     cells = cells_of(result)
-    assert_same_cells(cells, tvoronoi.voronoi(pts, clip=region, threads=1).to_shapely())
+    full = tvoronoi.voronoi(pts, clip=region, threads=1)
+    assert_same_cells(cells, full.to_shapely())
+    # the triangles of the sites inside the region, as one process gives them
+    assert_same_triangles(result, full)
     # properties travel with their sites
     assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
 
@@ -119,8 +167,18 @@ def test_geojsonseq_parts(client, tmp_path):
     import orjson
 
     pts = generate("uniform", 5_000, seed=2)
-    out = tmp_path / "seq"
-    voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq")
+    out, triangles = tmp_path / "seq", tmp_path / "triangles"
+    result = voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq", delaunay=triangles)
+    assert result.triangles is None and any(result.triangle_parts)
+    # the triangles' parts: features with "sites", as one process's GeoJSON --delaunay writes them
+    rows = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(triangles.iterdir())
+            for line in part.read_bytes().splitlines()]
+    sites = np.array([f["properties"]["sites"] for f in rows])
+    full_triangles = tvoronoi.voronoi(pts, threads=1).triangles
+    assert len(sites) == len(full_triangles)
+    assert {tuple(sorted(t)) for t in sites.tolist()} == {tuple(sorted(t)) for t in full_triangles.tolist()}
+    ring = np.array([f["geometry"]["coordinates"][0] for f in rows])
+    assert np.array_equal(ring[:, :3], pts[sites]) and np.array_equal(ring[:, 3], ring[:, 0])
     features = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(out.iterdir()) for line in part.read_bytes().splitlines()]
     features.sort(key=lambda f: f["properties"]["site"])
     assert [f["properties"]["site"] for f in features] == list(range(5_000))
@@ -147,6 +205,11 @@ def test_bad_input_is_named(client, tmp_path):
     (tmp_path / "full" / "old.parquet").write_bytes(b"x")
     with pytest.raises(TvoronoiError, match="not empty"):
         voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "full")
+    with pytest.raises(TvoronoiError, match="not empty"):
+        voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "new", delaunay=tmp_path / "full")
+    assert not (tmp_path / "new").exists()          # the cells' directory made first is removed again
+    with pytest.raises(TvoronoiError, match="would go to one directory"):
+        voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "same", delaunay=tmp_path / "same")
 
 
 def test_the_core_package_works_without_dask():
@@ -177,14 +240,22 @@ def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, 
 
     pts = generate("gaussian", 20_000, seed=4)
     write_csv_parts(tmp_path, pts, 3)
-    out = tmp_path / "cells.parquet"
+    out, triangles = tmp_path / "cells.parquet", tmp_path / "triangles"
     status = main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", client.scheduler.address,
-                   "--tiles", "5"])
-    assert status == 0, capsys.readouterr().err
-    assert "3 file(s)" in capsys.readouterr().err
+                   "--tiles", "5", "--delaunay", str(triangles)])
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert "3 file(s)" in err and f"Delaunay triangles -> {triangles}" in err
     frame = geopandas.read_parquet(out).sort_values("site").reset_index(drop=True)
     assert frame["label"].tolist() == [f"r{i}" for i in range(len(pts))]
-    assert shapely.equals_exact(frame.geometry.to_numpy(), tvoronoi.voronoi(pts).to_shapely(), tolerance=0).all()
+    full = tvoronoi.voronoi(pts)
+    assert shapely.equals_exact(frame.geometry.to_numpy(), full.to_shapely(), tolerance=0).all()
+    # the triangles' parts read as one table: the same site triples as one process's --delaunay output
+    tri = geopandas.read_parquet(triangles)
+    sites = np.stack(tri["sites"].to_numpy())
+    assert {tuple(sorted(t)) for t in sites.tolist()} == {tuple(sorted(t)) for t in full.triangles.tolist()}
+    assert len(sites) == len(full.triangles)
+    assert np.array_equal(shapely.get_coordinates(tri.geometry.to_numpy()).reshape(-1, 4, 2)[:, :3], pts[sites])
 
 
 def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path):
@@ -218,6 +289,7 @@ def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path)
     (["--tiles", "3"], "--tiles goes with --dask"),
     (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
     (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
+    (["--dask", "local", "--delaunay", "-"], "--delaunay names a new directory of parts"),
 ])
 def test_cli_errors_are_named(tmp_path, capsys, argv, message):
     from tvoronoi.cli import main
@@ -234,5 +306,51 @@ def test_cli_names_a_value_that_is_not_a_number_and_writes_nothing(tmp_path, cap
     out = tmp_path / "cells"
     assert main(["batch", str(tmp_path / "bad.csv"), "-o", str(out), "--dask", "local:1"]) == 2
     err = capsys.readouterr().err
-    assert "bad.csv: partition 0, row 1 (index 1): y is 'abc', not a finite number" in err
+    assert "bad.csv, line 3: y is 'abc', not a finite number" in err
     assert "Traceback" not in err and not out.exists()
+
+
+def test_cli_names_the_file_and_line_of_a_bad_value_in_a_later_block(tmp_path, capsys, monkeypatch):
+    from tvoronoi import cli_distributed
+    from tvoronoi.cli import main
+
+    # small blocks: each file is read in several partitions, and the bad row lies in a later one
+    monkeypatch.setattr(cli_distributed, "CSV_BLOCKSIZE", 20_000)
+    write_csv_parts(tmp_path, generate("uniform", 6_000, seed=3), 3)
+    path = tmp_path / "points-1.csv"
+    lines = path.read_text().splitlines()
+    lines.insert(1500, "")                          # a blank line, skipped by the reader, counted as a line
+    lines[1700] = "r9999,0.5,not-a-number"
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "cells"
+    assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}, line 1701: y is 'not-a-number', not a finite number" in err, err
+    assert not out.exists()
+
+
+def test_cli_names_the_parquet_file_and_row_of_a_bad_value(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    pts = generate("uniform", 3_000, seed=5)
+    for k, chunk in enumerate(np.array_split(np.arange(len(pts)), 3)):
+        x = pts[chunk, 0].copy()
+        if k == 2:
+            x[417] = np.inf
+        pd.DataFrame({"x": x, "y": pts[chunk, 1]}).to_parquet(tmp_path / f"p{k}.parquet", row_group_size=300)
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'p2.parquet'}, row 417 (0-based): x is inf, not a finite number" in err, err
+
+
+def test_cli_names_a_csv_file_that_cannot_be_parsed(tmp_path, capsys):
+    from tvoronoi.cli import main
+
+    write_csv_parts(tmp_path, generate("uniform", 40_000, seed=2), 2)
+    path = tmp_path / "points-1.csv"
+    lines = path.read_text().splitlines()
+    lines[15_000] += ",1,2"                         # a row with extra fields, past the sample dask reads first
+    path.write_text("\n".join(lines) + "\n")
+    assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: cannot be read (ParserError: " in err and "line 15001" in err, err

@@ -1,4 +1,5 @@
-"""`tvoronoi batch INPUT -o DIR --dask ...`: point files read in partitions, cells written as parts by the tasks."""
+"""`tvoronoi batch INPUT -o DIR --dask ... [--delaunay DIR]`: point files read in partitions, cells (and
+triangles) written as parts by the tasks."""
 
 from __future__ import annotations
 
@@ -6,6 +7,8 @@ import glob
 import os
 import re
 import sys
+
+import numpy as np
 
 from tvoronoi.errors import TvoronoiError
 
@@ -61,23 +64,101 @@ def input_files(spec: str) -> list[str]:
 
 
 def read_partitions(files: list[str], fmt: str | None, delimiter: str | None):
-    """A Dask DataFrame over the files (row order: the files in order, each from its start)."""
+    """A Dask DataFrame over the files (row order: the files in order, each from its start), and where each
+    partition comes from: [(path, kind, the file's first partition, separator)], to name the file and line of a bad row."""
     import dask.dataframe as dd
 
     kinds = {_kind(path, fmt) for path in files}
     if len(kinds) > 1:
         raise TvoronoiError(f"the input mixes CSV and Parquet files ({files[0]}, ...): give one kind")
     kind = kinds.pop()
+    sep = delimiter or ("\t" if files[0].lower().endswith(".tsv") else ",")
+    frames: list = []
+    sources: list[tuple[str, str, int, str]] = []
+    for path in files:
+        try:
+            if kind == "parquet":
+                frame = dd.read_parquet(path)
+                if "geometry" in frame.columns:
+                    frame = frame.map_partitions(_geometry_to_xy, meta=_geometry_meta(frame._meta))
+            else:
+                frame = dd.read_csv(path, sep=sep, blocksize=CSV_BLOCKSIZE)
+        except (OSError, ValueError) as exc:
+            raise TvoronoiError(f"{path}: cannot be read in partitions ({exc})") from None
+        first = len(sources)
+        sources += [(path, kind, first, sep)] * frame.npartitions
+        frames.append(frame)
+    return (frames[0] if len(frames) == 1 else dd.concat(frames)), sources
+
+
+def locate(error, frame, sources: list, client) -> str:
+    """Where a PartitionError happened: the file, and the line (CSV) or 0-based row (Parquet) in it."""
+    if error.partition is None or not 0 <= error.partition < len(sources):
+        return "the input"
+    path, kind, first, _ = sources[error.partition]
+    if error.row is None:
+        return path
+    # the rows of the same file's earlier partitions
+    before = 0
+    if error.partition > first:
+        lengths = frame.partitions[first:error.partition].map_partitions(len)
+        before = int(sum(client.compute(lengths).result()))
+    row = before + error.row
+    if kind == "parquet":
+        return f"{path}, row {row} (0-based)"
+    line = _csv_line(path, row)
+    return f"{path}, line {line}" if line is not None else f"{path}, data row {row} (0-based)"
+
+
+def _bad_csv_value(error, frame, sources: list, x: str | None, y: str | None) -> str | None:
+    """A CSV partition that failed as a whole because a coordinate is not a number where the first rows
+    were numbers (Dask took the column for numbers): the file's first such value, named by its line."""
+    import pandas as pd
+
+    from tvoronoi.distributed import coordinate_columns
+
+    if error.row is not None or error.partition is None or not 0 <= error.partition < len(sources):
+        return None
+    path, kind, _, _ = sources[error.partition]
+    if kind != "csv":
+        return None
+    names = coordinate_columns(frame, x, y)
+    seen = 0
     try:
-        if kind == "parquet":
-            frame = dd.read_parquet(files)
-            if "geometry" in frame.columns:
-                frame = frame.map_partitions(_geometry_to_xy, meta=_geometry_meta(frame._meta))
-            return frame
-        sep = delimiter or ("\t" if files[0].lower().endswith(".tsv") else ",")
-        return dd.read_csv(files, sep=sep, blocksize=CSV_BLOCKSIZE)
-    except (OSError, ValueError) as exc:
-        raise TvoronoiError(f"{files[0]}: cannot be read in partitions ({exc})") from None
+        chunks = pd.read_csv(path, sep=sources[error.partition][3], usecols=list(names), dtype=str, chunksize=1_000_000,
+                             keep_default_na=False)
+        for chunk in chunks:
+            for name in names:
+                text = chunk[name].to_numpy(object)
+                values = pd.to_numeric(chunk[name], errors="coerce").to_numpy(float)
+                bad = ~np.isfinite(values)
+                if bad.any():
+                    k = int(np.flatnonzero(bad)[0])
+                    line = _csv_line(path, seen + k)
+                    where = f"{path}, line {line}" if line is not None else f"{path}, data row {seen + k} (0-based)"
+                    return (f"{where}: {name} is {text[k]!r}, not a finite number; drop or fix that row "
+                            f"(and any like it)")
+            seen += len(chunk)
+    except (OSError, ValueError):
+        return None
+    return None
+
+
+def _csv_line(path: str, row: int) -> int | None:
+    """The line of a CSV file where data row ``row`` (0-based, after the header, blank lines skipped) starts."""
+    import csv
+
+    with open(path, newline="", encoding="utf-8", errors="replace") as stream:
+        reader = csv.reader(stream)
+        previous = 0
+        seen = -1                                   # the header is row -1
+        for record in reader:
+            if record:
+                if seen == row:
+                    return previous + 1
+                seen += 1
+            previous = reader.line_num
+    return None
 
 
 def _kind(path: str, fmt: str | None) -> str:
@@ -136,31 +217,33 @@ def client_for(spec: str):
 
 def run(args, output_format: str, bbox, region, quiet: bool) -> None:
     """The batch command on Dask: read INPUT in partitions, build tile by tile, write OUTPUT as a directory."""
-    from tvoronoi.distributed import require_dask, voronoi
+    from tvoronoi.distributed import PartitionError, require_dask, voronoi
 
     require_dask()
     parse_dask(args.dask)
     if args.tiles is not None and args.tiles < 1:
         raise TvoronoiError(f"--tiles {args.tiles}: give a positive number of tiles")
-    for flag, value in (("--lloyd", args.lloyd), ("--delaunay", args.delaunay), ("--precision", args.precision)):
+    for flag, value in (("--lloyd", args.lloyd), ("--precision", args.precision)):
         if value is not None:
             raise TvoronoiError(f"{flag} is not available with --dask yet; run without --dask for it")
     if output_format not in ("parquet", "geojsonseq"):
         raise TvoronoiError(
             "with --dask, OUTPUT is a directory of parts: --to parquet (GeoParquet, the default) or geojsonseq"
         )
+    if args.delaunay == "-":
+        raise TvoronoiError('with --dask, --delaunay names a new directory of parts, not "-"')
     files = input_files(args.input)
-    frame = read_partitions(files, args.format, args.delimiter)
+    frame, sources = read_partitions(files, args.format, args.delimiter)
     x, y = _column(frame, args.x), _column(frame, args.y)
     client = client_for(args.dask)
     try:
         result = voronoi(frame, client=client, bbox=bbox, tiles=args.tiles, to=args.output, format=output_format,
-                         clip=region, engine=args.engine, x=x, y=y, crs=args.crs)
-    except TvoronoiError as exc:
-        if str(exc).startswith(("partition ", "the points cannot be read")):
-            # partitions are numbered through the files in sorted order (a CSV file may hold several)
-            raise TvoronoiError(f"{args.input}: {exc}") from None
-        raise
+                         clip=region, engine=args.engine, x=x, y=y, crs=args.crs,
+                         delaunay=False if args.delaunay is None else args.delaunay)
+    except PartitionError as exc:
+        # partitions are numbered through the files in sorted order (a CSV file may hold several)
+        found = _bad_csv_value(exc, frame, sources, x, y)
+        raise TvoronoiError(found or exc.explain(locate(exc, frame, sources, client))) from None
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()
@@ -171,3 +254,7 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
         print(f"tvoronoi: {len(files)} file(s) -> {args.output}: {parts} parts from {result.n_tiles} tiles, "
               f"{result.rounds} round(s) (cells left after each: {', '.join(map(str, result.pending_after))})",
               file=sys.stderr)
+        if args.delaunay is not None:
+            parts = sum(1 for name in result.triangle_parts if name)
+            print(f"tvoronoi: Delaunay triangles -> {args.delaunay}: {parts} parts (sites with triangles left after "
+                  f"each round: {', '.join(map(str, result.triangles_pending_after))})", file=sys.stderr)

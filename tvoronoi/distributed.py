@@ -5,7 +5,8 @@ shape (n, 2). One pass over the partitions counts the rows (their order numbers 
 ``tvoronoi.voronoi``), finds the sites' extent and draws a sample, from which the tiles are cut. Then
 each round runs one task per tile that still has cells to emit: it gathers the sites of its region from
 every partition, builds their diagram, and emits the certified cells of its own sites with their
-properties (or writes them: ``to=``). No process ever holds the whole input or output.
+properties (or writes them: ``to=``), and with ``delaunay`` the final triangles whose lowest site is
+its own (tvoronoi.tile_delaunay). No process ever holds the whole input or output.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.tile_delaunay import Hull, tile_triangles
 from tvoronoi.tiles import (
     MAX_ROUNDS,
     SAMPLE_PER_TILE,
@@ -35,6 +37,9 @@ ID, X, Y = "__tvoronoi_site", "__tvoronoi_x", "__tvoronoi_y"
 # the cell columns tvoronoi adds; a property of the same name is renamed
 SITE, GEOMETRY = "site", "geometry"
 FORMATS = ("parquet", "geojsonseq")
+# a partition serving more regions than this in one round is sorted by x first (one sort, then each
+# region reads only its x range: a later round's many small groups cost little)
+SORT_ABOVE = 4
 
 
 def require_dask():
@@ -45,6 +50,29 @@ def require_dask():
     except ImportError:
         raise TvoronoiError(f"running on Dask needs dask and distributed, which are not installed: {INSTALL_HINT}") from None
     return distributed
+
+
+class PartitionError(TvoronoiError):
+    """A partition of the points that cannot be read, or a row of it without finite coordinates.
+
+    ``partition`` numbers the partitions from 0; ``row`` is the row within it (None when the partition
+    cannot be read at all); ``detail`` says what is wrong. A caller that knows where the partitions come
+    from words the message with :meth:`explain` (``tvoronoi batch --dask`` names the file and line).
+    """
+
+    def __init__(self, partition: int | None, row: int | None, detail: str, index=None):
+        self.partition, self.row, self.detail, self.index = partition, row, detail, index
+        where = "a partition" if partition is None else f"partition {partition}"
+        if row is not None:
+            where += f", row {row}" + ("" if index is None else f" (index {index!r})")
+        super().__init__(f"{where}: {detail}")
+
+    def __reduce__(self):
+        return (PartitionError, (self.partition, self.row, self.detail, self.index))
+
+    def explain(self, where: str) -> str:
+        """The message with ``where`` naming the place ("points.csv, line 7")."""
+        return f"{where}: {self.detail}"
 
 
 @dataclass(frozen=True)
@@ -61,17 +89,24 @@ class Job:
     to: str | None = None
     format: str = "parquet"
     crs: object = None
+    delaunay: bool = False
+    delaunay_to: str | None = None
+    hull: Hull | None = None
 
 
 @dataclass(frozen=True)
 class Result:
-    """What ``voronoi`` did: the cells (a Dask DataFrame, or None when written), rounds, parts written."""
+    """What ``voronoi`` did: the cells (a Dask DataFrame, or None when written), rounds, parts written;
+    with ``delaunay``, the triangles likewise."""
 
     cells: object
     rounds: int
     pending_after: tuple[int, ...]
     n_tiles: int
     parts: tuple[str, ...] = ()
+    triangles: object = None
+    triangles_pending_after: tuple[int, ...] = ()
+    triangle_parts: tuple[str, ...] = ()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -109,6 +144,12 @@ def _as_frame(points, x: str | None, y: str | None):
     return points, chosen[0], chosen[1]
 
 
+def coordinate_columns(frame, x: str | None = None, y: str | None = None) -> tuple[str, str]:
+    """The names of a Dask DataFrame's x and y columns, as ``voronoi`` finds them."""
+    _, xname, yname = _as_frame(frame, x, y)
+    return xname, yname
+
+
 def _coordinates(part, column: str) -> np.ndarray:
     """A coordinate column as float64, NaN where a value is not a number."""
     import pandas as pd
@@ -116,8 +157,9 @@ def _coordinates(part, column: str) -> np.ndarray:
     return pd.to_numeric(part[column], errors="coerce").to_numpy(np.float64, na_value=np.nan)
 
 
-def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) -> dict:
-    """One partition's row count, the extent of its sites (inside the clip region) and a sample of them."""
+def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int, hull: bool = False) -> dict:
+    """One partition's row count, the extent of its sites (inside the clip region) and a sample of them;
+    with ``hull``, the rows and places of the sites on their convex hull's boundary."""
     xs, ys = _coordinates(part, x), _coordinates(part, y)
     bad = ~(np.isfinite(xs) & np.isfinite(ys))
     if bad.any():
@@ -125,17 +167,23 @@ def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int) 
         column = x if not np.isfinite(xs[row]) else y
         value = part[column].iloc[row]
         value = float(value) if isinstance(value, (float, np.floating)) else value
-        raise TvoronoiError(
-            f"partition {number}, row {row} (index {part.index[row]!r}): {column} is {value!r}, not a finite "
-            f"number ({int(bad.sum())} such row(s) in this partition); drop or fix those rows"
-        )
+        raise PartitionError(number, row, f"{column} is {value!r}, not a finite number ({int(bad.sum())} such "
+                             f"row(s) in this partition); drop or fix those rows", part.index[row])
     out: dict = {"n": len(part), "extent_all": _extent(xs, ys)}
     if clip is not None:
         from tvoronoi.region import sites_inside
 
         keep = sites_inside(np.column_stack([xs, ys]), clip)
+        rows = np.flatnonzero(keep)
         xs, ys = xs[keep], ys[keep]
+    else:
+        rows = np.arange(len(xs))
     out.update(m=len(xs), extent=None, sample=np.empty((0, 2)))
+    if hull:
+        from tvoronoi.hull import boundary_hull
+
+        on = boundary_hull(np.column_stack([xs, ys]), np.arange(len(xs)))
+        out["hull"] = (rows[on].astype(np.int64), np.column_stack([xs[on], ys[on]]))
     if len(xs):
         out["extent"] = _extent(xs, ys)
         rng = np.random.default_rng([seed, number])
@@ -156,32 +204,54 @@ def _meets(extent: Region | None, region: Region) -> bool:
                                        or extent[1] > region[3])
 
 
-def _select(part, first_row: int, x: str, y: str, region: Region, keep: list[str], clip):
-    """The rows of one partition whose site lies in the closed ``region``, with their input rows."""
+def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str], clip) -> tuple:
+    """For each closed region, the rows of one partition whose site lies in it, with their input rows
+    (one pass over the partition serves every unit of a round)."""
     import pandas as pd
 
     xs, ys = _coordinates(part, x), _coordinates(part, y)
-    rows = np.flatnonzero(in_region(xs, ys, region))
-    frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
-    inside = np.ones(len(rows), bool)
-    if clip is not None and len(rows):
-        from tvoronoi.region import sites_inside
+    # many regions (the small groups of a later round): each looks only at the sites in its x range,
+    # found in the partition sorted by x once, not at the whole partition
+    sort = len(regions) > SORT_ABOVE
+    by_x = np.argsort(xs, kind="stable") if sort else np.empty(0, np.int64)
+    sorted_x = xs[by_x]
+    out = []
+    for region in regions:
+        if not sort:
+            rows = np.flatnonzero(in_region(xs, ys, region))
+        else:
+            lo, hi = np.searchsorted(sorted_x, region[0], "left"), np.searchsorted(sorted_x, region[2], "right")
+            slab = by_x[lo:hi]
+            rows = np.sort(slab[(ys[slab] >= region[1]) & (ys[slab] <= region[3])])
+        frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
+        inside = np.ones(len(rows), bool)
+        if clip is not None and len(rows):
+            from tvoronoi.region import sites_inside
 
-        inside = sites_inside(np.column_stack([xs[rows], ys[rows]]), clip)
-    frame["__tvoronoi_inside"] = inside
-    for name in keep:
-        frame[name] = part[name].to_numpy()[rows]
-    return frame
+            inside = sites_inside(np.column_stack([xs[rows], ys[rows]]), clip)
+        frame["__tvoronoi_inside"] = inside
+        for name in keep:
+            frame[name] = part[name].to_numpy()[rows]
+        out.append(frame)
+    return tuple(out)
 
 
 # ---------------------------------------------------------------------------------------------
 # one tile, one round (runs on a worker)
 
 
-def _run_tile(pieces: list, t: int, region: Region, group, job: Job, round_: int, name: str):
-    """Build a region of tile t for its own sites (``group``: those of a group of pending cells only);
-    return (cells frame or part name, (pending ids, their reaches))."""
+# what a unit of work emits: a tile's cells and triangles (the first round), or a group of its pending
+# cells, or of its sites with pending triangles (later rounds)
+BOTH, CELLS, TRIANGLES = "both", "cells", "triangles"
+
+
+def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, round_: int, name: str):
+    """Build a region of tile t for its own sites (``group``: those of a group of pending ones only);
+    return (cells frame or part name, triangles frame or part name, (pending cells, their reaches),
+    (sites with pending triangles, their reaches)); None for what ``kind`` does not ask."""
     import pandas as pd
+
+    from tvoronoi.api import voronoi as build
 
     sites = pd.concat(pieces, ignore_index=True) if pieces else pd.DataFrame()
     plan = job.plan
@@ -193,17 +263,51 @@ def _run_tile(pieces: list, t: int, region: Region, group, job: Job, round_: int
     inside = sites["__tvoronoi_inside"].to_numpy(bool)
     built = np.flatnonzero(inside)
     pts = np.column_stack([xs[built], ys[built]])
-    cells = build_tile(pts, ids[built], own[built], region, plan.box,
-                       everything=plan.sees_everything(region), engine=job.engine)
-    # the tile's own sites outside the clip region get no cell: written once, in the first round
-    outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
-    left = (cells.pending, cells.reaches)
-    if job.to is None:
-        return _cells_frame(sites, ids, cells, outside, job), left
-    from tvoronoi.writers.parts import write_part
+    everything = plan.sees_everything(region)
+    want = own[built]
+    diagram = build(pts, bbox=plan.box, engine=job.engine, threads=1) if want.any() else None
+    cells_out = tris_out = left_cells = left_tris = None
+    if kind in (BOTH, CELLS):
+        cells = build_tile(pts, ids[built], want, region, plan.box, everything=everything, engine=job.engine,
+                           diagram=diagram)
+        # the tile's own sites outside the clip region get no cell: written once, in the first round
+        outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
+        left_cells = (cells.pending, cells.reaches)
+        if job.to is None:
+            cells_out = _cells_frame(sites, ids, cells, outside, job)
+        else:
+            from tvoronoi.writers.parts import write_part
 
-    frame, geoms = _cells_frame(sites, ids, cells, outside, job)
-    return write_part(frame, geoms, job.to, name, job.format, job.crs), left
+            frame, geoms = _cells_frame(sites, ids, cells, outside, job)
+            cells_out = write_part(frame, geoms, job.to, name, job.format, job.crs)
+    if job.delaunay and kind in (BOTH, TRIANGLES):
+        if diagram is None:
+            tri = np.empty((0, 3), np.int64)
+            left_tris = (np.empty(0, np.int64), np.empty((0, 4)))
+        else:
+            assert job.hull is not None
+            got = tile_triangles(pts, ids[built], want, region, diagram, hull=job.hull, extent=plan.extent,
+                                 everything=everything)
+            tri, left_tris = got.triangles, (got.pending, got.reaches)
+        tris_out = _triangles_out(tri, ids[built], pts, job, name)
+    return cells_out, tris_out, left_cells, left_tris
+
+
+def _triangles_out(tri: np.ndarray, ids: np.ndarray, pts: np.ndarray, job: Job, name: str):
+    """A task's triangles: a frame (a, b, c: input rows, counter-clockwise, lowest first; geometry) or,
+    written, the part's name."""
+    import pandas as pd
+    import shapely
+
+    xy = pts[np.searchsorted(ids, tri)] if len(tri) else np.empty((0, 3, 2))
+    if job.delaunay_to is not None:
+        from tvoronoi.writers.parts import write_triangles_part
+
+        return write_triangles_part(tri, xy, job.delaunay_to, name, job.format, job.crs)
+    rings = shapely.polygons(np.concatenate([xy, xy[:, :1]], axis=1)) if len(tri) else np.empty(0, object)
+    wkb = shapely.to_wkb(rings) if len(tri) else np.empty(0, object)
+    return pd.DataFrame({"a": tri[:, 0], "b": tri[:, 1], "c": tri[:, 2],
+                         GEOMETRY: pd.array(wkb, dtype=_binary_dtype())})
 
 
 def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
@@ -289,10 +393,13 @@ def _meta(frame_meta, job: Job):
 
 def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None, format: str = "parquet",
             clip=None, engine: str = "incremental", x: str | None = None, y: str | None = None, crs=None,
-            seed: int = 0, halo_scale: float = 1.0) -> Result:
+            seed: int = 0, halo_scale: float = 1.0, delaunay=False) -> Result:
     """The clipped Voronoi cells of a Dask DataFrame or array of points, built tile by tile on a cluster.
 
     Every cell equals, bit for bit, the cell ``tvoronoi.voronoi`` gives the same row (see tvoronoi.tiles).
+    With ``delaunay``, also the Delaunay triangles, each from the task of its lowest-numbered site (see
+    tvoronoi.tile_delaunay): those of ``tvoronoi.voronoi``, with every polygon of four or more
+    cocircular sites cut into a fan from its lowest-numbered site (``canonical_triangles``).
 
     Parameters
     ----------
@@ -317,6 +424,9 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         The coordinates' CRS, recorded in the GeoParquet metadata.
     halo_scale : float
         Multiplies the first halos (tests use a small one to force more rounds).
+    delaunay : bool or str, optional
+        True: the triangles as a Dask DataFrame too; a directory: the triangles written there as parts
+        (in ``format``: GeoParquet with ``sites``, three input rows, or GeoJSONSeq with ``"sites"``).
 
     Returns
     -------
@@ -324,7 +434,9 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         ``cells``: a Dask DataFrame with one row per input row, in row order within each part:
         ``site`` (the input row), the properties, ``geometry`` (WKB polygon; None for a repeated point,
         a cell that misses the box, a site outside ``clip``); None when written with ``to``. Also the
-        rounds run and the cells still pending after each.
+        rounds run and the cells still pending after each. ``triangles`` (with ``delaunay=True``): a Dask
+        DataFrame of ``a``, ``b``, ``c`` (input rows, counter-clockwise, ``a`` the lowest) and ``geometry``;
+        ``triangles_pending_after``: the sites whose triangles were still pending after each round.
 
     Raises
     ------
@@ -343,6 +455,9 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
         from tvoronoi.region import as_region
 
         clip = as_region(clip)
+    delaunay_to = None if isinstance(delaunay, bool) or delaunay is None else delaunay
+    if delaunay_to is not None and to is not None and os.path.abspath(str(delaunay_to)) == os.path.abspath(str(to)):
+        raise TvoronoiError(f"the cells and the triangles would go to one directory {to}; choose two")
     client = client if client is not None else distributed.get_client()
     frame, xname, yname = _as_frame(points, x, y)
     properties = tuple(str(c) for c in frame.columns if str(c) not in (xname, yname))
@@ -355,14 +470,15 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     # one pass: counts, extent, sample
     n_tiles_guess = tiles if tiles is not None else 4 * workers
     per_part = max(1, (SAMPLE_PER_TILE * n_tiles_guess) // max(1, len(parts)))
+    futures = client.compute([dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k, bool(delaunay))
+                              for k, p in enumerate(parts)])
     try:
-        summaries = client.gather(client.compute(
-            [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k) for k, p in enumerate(parts)]
-        ))
+        summaries = client.gather(futures)
     except TvoronoiError:
         raise
-    except (ValueError, TypeError, OSError) as exc:          # a partition that cannot be read
-        raise TvoronoiError(f"the points cannot be read: {exc}") from None
+    except Exception as exc:                        # a partition that cannot be read: name the first that failed
+        failed = next((k for k, f in enumerate(futures) if f.status == "error"), None)
+        raise PartitionError(failed, None, f"cannot be read ({exc.__class__.__name__}: {exc})") from None
     counts = [s["n"] for s in summaries]
     m = int(sum(s["m"] for s in summaries))
     if m == 0:
@@ -385,66 +501,114 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     plan = plan_tiles(sample, tiles, extent, box, m)
     plan = Plan(plan.rects, plan.halos * halo_scale, plan.extent, plan.box)
     firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    if to is not None:
-        from tvoronoi.writers.parts import prepare_directory
+    hull = None
+    if delaunay:
+        ids = np.concatenate([firsts[k] + s["hull"][0] for k, s in enumerate(summaries)])
+        hull = Hull.of(np.concatenate([s["hull"][1] for s in summaries]), ids)
+    from tvoronoi.writers.parts import finish_directory, prepare_directory, remove_directory
 
-        to = prepare_directory(to)
-    job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs)
+    written = [d for d in (to, delaunay_to) if d is not None]
+    for k, directory in enumerate(written):
+        try:
+            prepare_directory(directory)
+        except TvoronoiError:
+            for done in written[:k]:
+                remove_directory(done)
+            raise
+    job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs,
+              bool(delaunay), None if delaunay_to is None else str(delaunay_to), hull)
 
     try:
-        outputs, rounds, pending_after = _rounds(client, plan, job, parts, summaries, firsts)
+        run = _rounds(client, plan, job, parts, summaries, firsts)
+        names: tuple[str, ...] = ()
+        tri_names: tuple[str, ...] = ()
         if to is not None:
-            from tvoronoi.writers.parts import finish_directory
-
-            names = tuple(client.gather(outputs))
+            names = tuple(client.gather(run.cells))
             finish_directory(to, [name for name in names if name], format, crs)
+        if delaunay_to is not None:
+            tri_names = tuple(client.gather(run.triangles))
+            finish_directory(delaunay_to, [name for name in tri_names if name], format, crs)
     except BaseException:
-        if to is not None:                          # no half-written dataset left behind
-            from tvoronoi.writers.parts import remove_directory
-
-            remove_directory(to)
+        for directory in written:                   # no half-written dataset left behind
+            remove_directory(directory)
         raise
-    if to is not None:
-        return Result(None, rounds, tuple(pending_after), plan.n_tiles, names)
     import dask.dataframe as dd
 
-    meta = _meta(frame._meta, job)
-    return Result(dd.from_delayed(outputs, meta=meta, verify_meta=False), rounds, tuple(pending_after), plan.n_tiles)
+    cells = None if to is not None else dd.from_delayed(run.cells, meta=_meta(frame._meta, job), verify_meta=False)
+    triangles = None
+    if delaunay and delaunay_to is None:
+        triangles = dd.from_delayed(run.triangles, meta=_triangles_meta(), verify_meta=False)
+    return Result(cells, run.rounds, tuple(run.pending_after), plan.n_tiles, names, triangles,
+                  tuple(run.triangles_pending_after), tri_names)
 
 
-def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: np.ndarray):
-    """Run the rounds; return (the tasks' outputs as futures, rounds, cells pending after each round)."""
+def _triangles_meta():
+    import pandas as pd
+
+    return pd.DataFrame({"a": pd.Series(dtype="int64"), "b": pd.Series(dtype="int64"),
+                         "c": pd.Series(dtype="int64"), GEOMETRY: pd.Series(dtype=_binary_dtype())})
+
+
+@dataclass
+class _Run:
+    cells: list
+    triangles: list
+    rounds: int
+    pending_after: list
+    triangles_pending_after: list
+
+
+def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: np.ndarray) -> _Run:
+    """Run the rounds: the tasks' outputs as futures (cells, triangles), rounds, what was pending after each."""
     import dask
 
     xname, yname, properties, clip = job.x, job.y, job.properties, job.clip
-    # rounds: every tile in the first; then each group of pending cells (group_reaches) with the box it
-    # needs, grown by the tile's halo doubled each round
-    units: list[tuple[int, np.ndarray | None, Region | None]] = [(t, None, None) for t in range(plan.n_tiles)]
-    outputs = []
-    pending_after = []
+    # rounds: every tile in the first; then each group of pending cells, or of sites with pending
+    # triangles (group_reaches), with the box it needs, grown by the tile's halo doubled each round
+    units: list[tuple[int, np.ndarray | None, Region | None, str]] = [
+        (t, None, None, BOTH) for t in range(plan.n_tiles)]
+    run = _Run([], [], 0, [], [])
     round_ = 0
     while units:
         round_ += 1
         if round_ > MAX_ROUNDS:
             raise TvoronoiError("the tiles' regions stopped growing before every cell was certified")
+        regions = [plan.region(t, round_, box_needed) for t, _, box_needed, _ in units]
+        # each unit reads the partitions whose sites reach its region (all of them for shuffled input; a
+        # few for input sorted in space), one piece at least so that the task knows the columns; each
+        # partition is read once a round, for all the units it serves
+        reach = [[k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0] for region in regions]
+        serves: dict[int, list[int]] = {}
+        for u, ks in enumerate(reach):
+            for k in ks:
+                serves.setdefault(k, []).append(u)
+        pieces: list[list] = [[] for _ in units]
+        for k, us in serves.items():
+            chosen = dask.delayed(_select, nout=len(us))(parts[k], int(firsts[k]), xname, yname,
+                                                         [regions[u] for u in us], list(properties), clip)
+            for j, u in enumerate(us):
+                pieces[u].append(chosen[j])
         tasks = []
-        for g, (t, group, box_needed) in enumerate(units):
-            region = plan.region(t, round_, box_needed)
-            # only the partitions whose sites reach the region (all of them for shuffled input; a few for
-            # input sorted in space); one piece at least, so that the task knows the columns
-            reach = [k for k, s in enumerate(summaries) if _meets(s["extent_all"], region)] or [0]
-            pieces = [dask.delayed(_select)(parts[k], int(firsts[k]), xname, yname, region, list(properties), clip)
-                      for k in reach]
+        for g, (t, group, _, kind) in enumerate(units):
             name = f"part-r{round_:02d}-t{t:05d}" + ("" if group is None else f"-g{g:05d}")
-            tasks.append(dask.delayed(_run_tile, nout=2)(pieces, t, region, group, job, round_, name))
-        futures = client.compute([task[0] for task in tasks] + [task[1] for task in tasks])
-        cells, left = futures[:len(tasks)], client.gather(futures[len(tasks):])
-        outputs.extend(cells)
-        units = [(t, ids, box_needed)
-                 for (t, _, _), (pending, reaches) in zip(units, left)
-                 for ids, box_needed in group_reaches(pending, reaches, plan.margin(t, round_))]
-        pending_after.append(sum(len(pending) for pending, _ in left))
-    return outputs, round_, pending_after
+            tasks.append(dask.delayed(_run_tile, nout=4)(pieces[g], t, regions[g], group, kind, job, round_, name))
+        k = len(tasks)
+        futures = client.compute([task[j] for j in range(4) for task in tasks])
+        left_cells, left_tris = client.gather(futures[2 * k:3 * k]), client.gather(futures[3 * k:])
+        next_units: list[tuple[int, np.ndarray | None, Region | None, str]] = []
+        for (t, _, _, kind), cells, tris, lc, lt in zip(units, futures[:k], futures[k:2 * k], left_cells, left_tris):
+            if kind != TRIANGLES:
+                run.cells.append(cells)
+                next_units += [(t, ids, b, CELLS) for ids, b in group_reaches(lc[0], lc[1], plan.margin(t, round_))]
+            if job.delaunay and kind != CELLS:
+                run.triangles.append(tris)
+                next_units += [(t, ids, b, TRIANGLES) for ids, b in group_reaches(lt[0], lt[1], plan.margin(t, round_))]
+        run.pending_after.append(sum(len(lc[0]) for lc in left_cells if lc is not None))
+        if job.delaunay:
+            run.triangles_pending_after.append(sum(len(lt[0]) for lt in left_tris if lt is not None))
+        units = next_units
+    run.rounds = round_
+    return run
 
 
 def local_client(workers: int | None = None, *, quiet: bool = False):

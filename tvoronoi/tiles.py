@@ -155,28 +155,52 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
     ``CERTIFY_ULPS`` ulps of the largest coordinate among the ring points, for each coordinate (an ulp
     only grows with the magnitude; plus the least subnormal, for results below the normal range) cover
     the ring's rounding. Any non-finite value fails the test: never certified.
+
+    Most cells are settled without the test at each point: the room to the nearest side changes by at
+    most |v - s| between s and v, so room(s) >= 2 max |v* - s| implies the test at every v*; the site's
+    room and the farthest distance carry the same margins as above.
     """
     n_cells = len(offsets) - 1
     lengths = np.diff(offsets)
     if len(ring_xy) == 0:
         return np.ones(n_cells, bool)
-    owner = np.repeat(np.arange(n_cells), lengths)
     vx, vy = ring_xy[:, 0], ring_xy[:, 1]
-    sx, sy = sites[owner, 0], sites[owner, 1]
     with np.errstate(over="ignore", invalid="ignore"):
-        radius = np.hypot(vx - sx, vy - sy)
+        radius = np.hypot(vx - np.repeat(sites[:, 0], lengths), vy - np.repeat(sites[:, 1], lengths))
         # the ulp of the largest coordinate bounds every point's (ulps grow with magnitude)
         top = max(float(np.abs(vx).max()), float(np.abs(vy).max()))
         slack = 2 * CERTIFY_ULPS * float(np.spacing(top)) + 4 * float(np.spacing(0.0))
-        need = radius * (1 + CERTIFY_RELATIVE) + slack
-        ok = np.isfinite(need)
-        x0, y0, x1, y1 = region
-        for room, side in ((vx - x0, x0), (vy - y0, y0), (x1 - vx, x1), (y1 - vy, y1)):
-            if math.isinf(side):                     # nothing lies beyond an infinite side
-                continue
-            ok &= np.isfinite(room) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
-    bad = np.bincount(owner[~ok], minlength=n_cells)
+        # most cells lie far from every side: room(v) >= room(s) - |v - s| (the room to the nearest side
+        # moves no faster than the point), so a cell whose site has twice its farthest point's distance
+        # as room passes the test below at every point; the computed room of the site errs by one
+        # rounding, covered by the same relative slack
+        ok = np.ones(n_cells, bool)
+        has = lengths > 0
+        farthest = np.zeros(n_cells)
+        farthest[has] = np.maximum.reduceat(radius, offsets[:-1][has])
+        site_room = _room(sites[:, 0], sites[:, 1], region)
+        easy = np.isfinite(farthest) & (site_room * (1 - CERTIFY_RELATIVE) - slack
+                                        >= 2 * (farthest * (1 + CERTIFY_RELATIVE) + slack))
+        if easy.all():
+            return ok
+        hard = np.repeat(~easy, lengths)
+        need = radius[hard] * (1 + CERTIFY_RELATIVE) + slack
+        room = _room(vx[hard], vy[hard], region)
+        # a non-finite point or distance is never certified (NaN compares false)
+        passed = np.isfinite(need) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
+    owner = np.repeat(np.arange(n_cells), lengths)[hard]
+    bad = np.bincount(owner[~passed], minlength=n_cells)
     return bad == 0
+
+
+def _room(xs: np.ndarray, ys: np.ndarray, region: Region) -> np.ndarray:
+    """How far each point lies inside the region from its nearest finite side (inf: no finite side)."""
+    x0, y0, x1, y1 = region
+    room = np.full(len(xs), np.inf)
+    for side, value, inward in ((x0, xs, True), (y0, ys, True), (x1, xs, False), (y1, ys, False)):
+        if not math.isinf(side):
+            np.minimum(room, (value - side) if inward else (side - value), out=room)
+    return room
 
 
 def flower_box(ring_xy: np.ndarray, sites: np.ndarray) -> Region:
@@ -218,7 +242,8 @@ class TileCells:
 
 
 def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Region, box, *,
-               everything: bool = False, engine: str = "incremental", threads: int = 1) -> TileCells:
+               everything: bool = False, engine: str = "incremental", threads: int = 1,
+               diagram=None) -> TileCells:
     """Build the diagram of the sites a task saw and certify the cells it must emit.
 
     Parameters
@@ -235,6 +260,8 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     box : the whole diagram's box
     everything : bool
         ``pts`` holds every site of the input: every cell is final.
+    diagram : Diagram, optional
+        The diagram of ``pts`` in ``box``, when already built (for the tile's Delaunay triangles too).
     """
     from tvoronoi.api import voronoi
 
@@ -242,26 +269,26 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     if len(rows) == 0:
         empty = np.empty(0, np.int64)
         return TileCells(empty, np.zeros(1, np.int64), np.empty((0, 2)), empty)
-    d = voronoi(pts, bbox=box, engine=engine, threads=threads)
-    starts, ends = d.cell_offsets[rows], d.cell_offsets[rows + 1]
-    lengths = ends - starts
+    d = voronoi(pts, bbox=box, engine=engine, threads=threads) if diagram is None else diagram
+    # the wanted cells' rings (a mask over the CSR points: cheaper than an index when most are wanted)
+    all_lengths = np.diff(d.cell_offsets)
+    lengths = all_lengths[rows]
     offsets = np.zeros(len(rows) + 1, np.int64)
     np.cumsum(lengths, out=offsets[1:])
-    gather = np.repeat(starts - offsets[:-1], lengths) + np.arange(offsets[-1])
-    ring_xy = d.cell_points[d.cell_vertices[gather]]
+    vertices = d.cell_vertices if len(rows) == len(pts) else d.cell_vertices[np.repeat(want, all_lengths)]
+    ring_xy = d.cell_points[vertices]
     ok = np.ones(len(rows), bool) if everything else certified(ring_xy, offsets, pts[rows], region)
+    if ok.all():
+        return TileCells(ids[rows].astype(np.int64), offsets, ring_xy, np.empty(0, np.int64))
     keep = np.flatnonzero(ok)
-    k_len = lengths[keep]
     k_off = np.zeros(len(keep) + 1, np.int64)
-    np.cumsum(k_len, out=k_off[1:])
-    k_gather = np.repeat(offsets[keep] - k_off[:-1], k_len) + np.arange(k_off[-1])
+    np.cumsum(lengths[keep], out=k_off[1:])
     failed = np.flatnonzero(~ok)
     reaches = np.empty((len(failed), 4))
-    site_of_point = np.repeat(pts[rows], lengths, axis=0)
     for j, k in enumerate(failed.tolist()):
         a, b = offsets[k], offsets[k + 1]
-        reaches[j] = flower_box(ring_xy[a:b], site_of_point[a:b])
-    return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[k_gather],
+        reaches[j] = flower_box(ring_xy[a:b], np.repeat(pts[rows[k]][None], b - a, axis=0))
+    return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[np.repeat(ok, lengths)],
                      ids[rows[failed]].astype(np.int64), reaches)
 
 

@@ -64,6 +64,38 @@ def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str
     return name
 
 
+def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem: str, format: str,
+                         crs=None) -> str:
+    """Write one task's Delaunay triangles ((k, 3) input rows, their places (k, 3, 2)); return the part's name.
+
+    The columns are those of the whole-diagram writers: GeoParquet ``sites`` (three input rows),
+    ``geometry``, ``bbox``; GeoJSONSeq features with ``"sites"``. Returns "" for a task without triangles.
+    """
+    if len(triangles) == 0:
+        return ""
+    name = stem + SUFFIXES[format]
+    path = os.path.join(str(directory), name)
+    closed = np.concatenate([xy, xy[:, :1]], axis=1)
+    if format == "parquet":
+        from tvoronoi.writers.geoparquet import _geo_metadata, _polygons, _write, require_pyarrow
+
+        pa = require_pyarrow()
+        ring_offsets = np.arange(0, 4 * len(triangles) + 1, 4, dtype=np.int64)
+        geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(closed.reshape(-1, 2)), ring_offsets,
+                                           np.ones(len(triangles), bool))
+        sites = pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(triangles, np.int64).ravel(), pa.int64()), 3)
+        table = pa.table({"sites": sites, "geometry": geometry, "bbox": bbox})
+        table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
+        _write(pa, table, path, overwrite=False)
+        return name
+    with open_output(path, overwrite=False) as stream:
+        for tri, ring in zip(np.asarray(triangles).tolist(), closed.tolist()):
+            feature = {"type": "Feature", "geometry": {"type": "Polygon", "coordinates": [ring]},
+                       "properties": {"sites": tri}}
+            stream.write(RS + orjson.dumps(feature) + b"\n")
+    return name
+
+
 def _write_parquet_part(frame, geoms, path: str, crs) -> None:
     from tvoronoi.writers.geoparquet import _geo_metadata, _shapely_cells, _write, require_pyarrow
 
