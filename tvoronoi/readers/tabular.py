@@ -28,6 +28,7 @@ from .columns import (
 )
 from tvoronoi.fileio import gc_paused
 
+from .bulk_csv import bulk_columns
 from .pointset import CATEGORY_SAMPLE, PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
@@ -335,10 +336,13 @@ def fast_table(body: str, kind: str, layout: _Layout):
         return (xy, {}) if np.isfinite(xy).all() else None
     with gc_paused():
         split = None
-        if kind == "csv" and len(body) >= ARROW_MIN_CHARS:
-            split = _arrow_columns(body, layout, n_cols)
-        if split is None and kind == "csv":
-            split = _unquoted_columns(body, layout, n_cols)
+        if kind == "csv":
+            bulk = bulk_columns(body, layout, n_cols, plain=_is_plain(body))
+            if bulk is not None:
+                xy, typed = bulk
+                if not np.isfinite(xy).all():
+                    return None
+                return xy, {name: typed[j] for j, name in enumerate(names) if j not in (ix, iy)}
     if split is not None:
         xy, columns = split
     else:
@@ -539,12 +543,17 @@ def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
 
 def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
     """The columns other than x and y, as JSON-ready values; ``text`` holds the rows they come from."""
-    plain = text.isascii() and "_" not in text
+    plain = _is_plain(text)
     return {
         name: convert_column(columns[j], plain)
         for j, name in enumerate(layout.names)
         if j not in (layout.ix, layout.iy)
     }
+
+
+def _is_plain(text: str) -> bool:
+    """Whether int() and float() read the numbers of a table text exactly as its literals (see convert_column)."""
+    return text.isascii() and "_" not in text
 
 
 def _floats_or_nan(values) -> np.ndarray:

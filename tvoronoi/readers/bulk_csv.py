@@ -1,0 +1,271 @@
+"""A CSV table read in bulk with numpy: fields found by byte masks, numbers parsed by array arithmetic.
+
+The table text is encoded once to UTF-8 and never split into Python strings: the field
+boundaries are the separators and line breaks outside quotes, the coordinates are parsed
+in bulk (a decimal of up to 16 digits is an exact integer divided by an exact power of ten,
+one correctly rounded division, the same double ``float`` gives), and a text column is kept
+as its bytes and offsets (:class:`TextColumn`). What this does not handle (blank lines, a
+quote inside an unquoted field, a lone carriage return, a field that is not a number where a
+number is due) returns None or raises ValueError, and the csv module, then the row walk that
+names the line, take over.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .pointset import _is_text, convert_column
+from .text_column import TextColumn
+
+QUOTE = ord('"')
+LF, CR = 0x0A, 0x0D
+# rows converted per step of the number parser (its scratch arrays stay a few megabytes)
+PARSE_ROWS = 1 << 16
+# a decimal of up to this many digits is an integer below 2**53: exact in a double
+MAX_DIGITS = 16
+# 10**k is exact in a double up to k = 22
+POW10 = 10.0 ** np.arange(23)
+# the bytes str.strip() removes that are ASCII
+_ASCII_SPACE = np.zeros(256, bool)
+_ASCII_SPACE[[0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x1C, 0x1D, 0x1E, 0x1F, 0x20]] = True
+
+
+def bulk_columns(body: str, layout, n_cols: int, *, plain: bool) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of the CSV rows in ``body`` (the text after the header).
+
+    Returns (xy, columns): ``columns[j]`` is the JSON-ready column j (a :class:`TextColumn`
+    or a list, see :func:`convert_column`), empty for the x and y columns. None when a row
+    does not hold ``n_cols`` fields or the text needs the csv module; ValueError at a
+    coordinate that is not a number. ``plain`` is as in :func:`convert_column`.
+    """
+    delimiter = layout.delimiter
+    if not body or len(delimiter) != 1 or not delimiter.isascii() or delimiter in '"\r\n' or "\0" in body:
+        return None
+    raw = np.frombuffer(body.encode(), np.uint8)
+    end = len(raw)
+    while end and raw[end - 1] in (LF, CR):
+        end -= 1  # the line breaks that end the file
+    raw = raw[:end]
+    if not end:
+        return None
+    fields = _fields(raw, ord(delimiter), n_cols)
+    if fields is None:
+        return None
+    starts, stops, unescape = fields
+    xy = np.empty((len(starts), 2), np.float64)
+    decimal_comma = delimiter == ";"
+    for k, j in enumerate((layout.ix, layout.iy)):
+        if unescape is not None and unescape[:, j].any():
+            return None  # a coordinate with a quote inside: the csv module reads it
+        xy[:, k] = parse_floats(raw, starts[:, j], stops[:, j], decimal_comma)
+    columns: list = []
+    for j in range(n_cols):
+        if j in (layout.ix, layout.iy):
+            columns.append([])
+        elif unescape is not None and unescape[:, j].any():
+            values = _unescaped(raw, starts[:, j], stops[:, j])
+            if values is None:
+                return None
+            columns.append(convert_column(values, plain))
+        else:
+            columns.append(_column(raw, starts[:, j], stops[:, j], plain))
+    return xy, columns
+
+
+def _fields(raw: np.ndarray, separator: int, n_cols: int):
+    """(starts, stops, unescape): (rows, n_cols) byte ranges of the fields, their quotes
+    taken off, and where a quoted field holds a doubled quote (None when none does); None
+    when the rows do not all hold n_cols fields or a quote is not where CSV puts one."""
+    quote = raw == QUOTE
+    has_quotes = bool(quote.any())
+    ends = (raw == separator) | (raw == LF)
+    if has_quotes:
+        # a separator or line break between an odd number of quotes is inside a quoted field;
+        # the parity of a uint8 running count is the parity of the count
+        inside = np.cumsum(quote, dtype=np.uint8) & 1
+        if inside[-1]:
+            return None  # a quote opened and not closed
+        ends &= inside == 0
+        del inside
+    cuts = np.flatnonzero(ends)
+    del ends
+    n_fields = len(cuts) + 1
+    if n_fields % n_cols:
+        return None
+    n_rows = n_fields // n_cols
+    starts = np.empty(n_fields, np.int64)
+    stops = np.empty(n_fields, np.int64)
+    starts[0] = 0
+    starts[1:] = cuts + 1
+    stops[:-1] = cuts
+    stops[-1] = len(raw)
+    starts = starts.reshape(n_rows, n_cols)
+    stops = stops.reshape(n_rows, n_cols)
+    # every row ends at a line break, every other field at a separator
+    if n_cols > 1 and not (raw[stops[:, :-1]] == separator).all():
+        return None
+    if n_rows > 1 and not (raw[stops[:-1, -1]] == LF).all():
+        return None
+    # Windows line ends: a carriage return before each line break is not part of the last field
+    carriage = np.flatnonzero(raw == CR)
+    if len(carriage):
+        last = stops[:, -1]
+        crlf = (last > starts[:, -1]) & (raw[np.maximum(last - 1, 0)] == CR)
+        last -= crlf
+        if has_quotes:
+            carriage = carriage[~_inside_fields(carriage, starts, stops, quote)]
+        if len(carriage) != int(crlf.sum()):
+            return None  # a lone carriage return ends a line for the csv module
+    unescape = None
+    if has_quotes:
+        opens = (starts < len(raw)) & (raw[np.minimum(starts, len(raw) - 1)] == QUOTE)
+        # a field with a quote must be quoted: "..." with its quotes doubled inside
+        at = np.flatnonzero(quote)
+        counts = np.searchsorted(at, stops) - np.searchsorted(at, starts)
+        quoted = counts > 0
+        closes = (stops - starts >= 2) & (raw[np.maximum(stops - 1, 0)] == QUOTE)
+        if not np.array_equal(quoted, opens) or not (closes | ~quoted).all() or (counts & 1).any():
+            return None
+        starts = starts + quoted
+        stops = stops - quoted
+        if (counts > 2).any():
+            unescape = counts > 2
+    return starts, stops, unescape
+
+
+def _inside_fields(positions: np.ndarray, starts: np.ndarray, stops: np.ndarray, quote: np.ndarray) -> np.ndarray:
+    """Whether each byte position lies inside a quoted field (between its quotes)."""
+    flat_starts, flat_stops = starts.ravel(), stops.ravel()
+    k = np.searchsorted(flat_starts, positions, side="right") - 1
+    quoted = quote[flat_starts[k]]
+    return quoted & (positions > flat_starts[k]) & (positions < flat_stops[k] - 1)
+
+
+def _gather(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The bytes of the fields, each followed by a line break, and their n + 1 offsets (as a
+    :class:`TextColumn` holds them): each field is gathered with the byte after it, which
+    becomes the line break."""
+    lengths = stops - starts + 1
+    offsets = np.zeros(len(lengths) + 1, np.int64)
+    np.cumsum(lengths, out=offsets[1:])
+    index = np.repeat(starts - offsets[:-1], lengths)
+    index += np.arange(int(offsets[-1]), dtype=np.int64)
+    np.minimum(index, len(raw) - 1, out=index)  # the last field of the text has no byte after it
+    data = raw[index]
+    data[offsets[1:] - 1] = LF
+    return data, offsets
+
+
+def _column(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, plain: bool):
+    """A column other than x and y: a TextColumn when its first non-blank value is text, else
+    the values typed by :func:`convert_column`."""
+    data, offsets = _gather(raw, starts, stops)
+    column = TextColumn(data, offsets)
+    blank = _blank(data, offsets)
+    first = np.flatnonzero(~blank)[:1]
+    if len(first) and _is_text((column[int(first[0])],)):
+        return TextColumn(data, offsets, ~blank)
+    return convert_column(column.tolist(), plain)
+
+
+def _blank(data: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Whether each field (laid out as :func:`_gather` gives them) is empty or white space
+    only (what ``str.strip`` empties)."""
+    lengths = np.diff(offsets) - 1
+    if not len(data):
+        return lengths == 0
+    # a field that opens with a printable ASCII byte is not blank: look closer only at the others
+    starts = offsets[:-1]
+    first = data[starts]  # an empty field's is its line break
+    maybe = np.flatnonzero((lengths == 0) | _ASCII_SPACE[first] | (first >= 0x80))
+    blank = np.zeros(len(lengths), bool)
+    if not len(maybe):
+        return blank
+    ends = offsets[1:][maybe] - 1
+    starts = starts[maybe]
+    # among those, a field with a printable ASCII byte is not blank either
+    # (reduceat over start, end pairs sums each field; its every other sum is a gap)
+    pairs = np.stack([starts, ends], axis=1).ravel()
+    solid = ~_ASCII_SPACE[data] & (data < 0x80)
+    counts = np.add.reduceat(solid, pairs, dtype=np.int64)[::2]
+    blank[maybe] = (ends == starts) | (counts == 0)
+    non_ascii = np.add.reduceat(data >= 0x80, pairs, dtype=np.int64)[::2] > 0
+    for i in maybe[non_ascii & (ends > starts) & blank[maybe]].tolist():
+        blank[i] = not data[offsets[i] : offsets[i + 1] - 1].tobytes().decode().strip()
+    return blank
+
+
+def _unescaped(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> list[str] | None:
+    """A column some of whose quoted fields hold doubled quotes, as str values; None when a
+    quote inside a field is not doubled (the csv module reads that its own way)."""
+    text = raw.tobytes()
+    fields = [text[a:b] for a, b in zip(starts.tolist(), stops.tolist())]
+    if any(b'"' in field.replace(b'""', b"") for field in fields):
+        return None
+    return [field.replace(b'""', b'"').decode() for field in fields]
+
+
+def parse_floats(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, decimal_comma: bool = False) -> np.ndarray:
+    """The numbers in ``raw[starts[i]:stops[i]]``, each as ``float`` reads it.
+
+    A plain decimal (an optional sign, up to 16 digits, at most one point) is parsed by
+    array arithmetic: its digits as an integer below 2**53 divided by a power of ten up to
+    10**22, both exact in a double, so the one division rounds correctly, as ``float`` does.
+    Any other field (an exponent, more digits, spaces, "nan") is given to ``float``; a
+    field ``float`` refuses raises ValueError. ``decimal_comma`` reads "1,5" as 1.5.
+    """
+    n = len(starts)
+    out = np.empty(n, np.float64)
+    lengths = stops - starts
+    width = int(min(lengths.max(initial=0), MAX_DIGITS + 2))
+    done = np.zeros(n, bool)
+    if width:
+        columns = np.arange(width)
+        for a in range(0, n, PARSE_ROWS):
+            b = min(n, a + PARSE_ROWS)
+            out[a:b], done[a:b] = _parse_block(raw, starts[a:b], lengths[a:b], columns, decimal_comma)
+    text = None
+    for i in np.flatnonzero(~done).tolist():
+        if text is None:
+            text = raw.tobytes()
+        field = text[starts[i] : stops[i]].decode()
+        if decimal_comma:
+            field = field.replace(",", ".")
+        out[i] = float(field)
+    return out
+
+
+def _parse_block(raw, starts, lengths, columns, decimal_comma):
+    """(values, parsed) of one block of fields: parsed is False where a field is not a plain decimal."""
+    width = len(columns)
+    inside = columns < lengths[:, None]
+    chars = raw[np.minimum(starts[:, None] + columns, len(raw) - 1)]
+    chars[~inside] = 0
+    chars = chars.T.copy()  # one row per character position: the loops below read rows
+    inside = inside.T
+    digit = chars - ord("0")
+    is_digit = digit < 10
+    is_point = chars == ord(".")
+    if decimal_comma:
+        is_point |= chars == ord(",")
+    sign = (chars[0] == ord("-")) | (chars[0] == ord("+"))
+    ok = (lengths > 0) & (lengths <= width)
+    # every character a digit or the point, but a sign first
+    allowed = is_digit | is_point
+    allowed[0] |= sign
+    ok &= (allowed | ~inside).all(axis=0)
+    ok &= is_point.sum(axis=0) <= 1
+    n_digits = is_digit.sum(axis=0)
+    ok &= (n_digits >= 1) & (n_digits <= MAX_DIGITS)
+    mantissa = np.zeros(len(starts), np.int64)
+    after_point = np.zeros(len(starts), bool)
+    decimals = np.zeros(len(starts), np.int64)
+    for k in range(width):
+        d = is_digit[k]
+        mantissa = np.where(d, mantissa * 10 + digit[k], mantissa)
+        decimals += d & after_point
+        after_point |= is_point[k]
+    ok &= mantissa <= (1 << 53)
+    values = mantissa.astype(np.float64) / POW10[np.minimum(decimals, 22)]
+    values[chars[0] == ord("-")] *= -1.0
+    return values, ok
