@@ -93,14 +93,14 @@ def _fields(raw: np.ndarray, separator: int, n_cols: int):
     if n_fields % n_cols:
         return None
     n_rows = n_fields // n_cols
-    starts = np.empty(n_fields, np.int64)
-    stops = np.empty(n_fields, np.int64)
-    starts[0] = 0
-    starts[1:] = cuts + 1
-    stops[:-1] = cuts
-    stops[-1] = len(raw)
-    starts = starts.reshape(n_rows, n_cols)
-    stops = stops.reshape(n_rows, n_cols)
+    flat_starts = np.empty(n_fields, np.int64)
+    flat_stops = np.empty(n_fields, np.int64)
+    flat_starts[0] = 0
+    flat_starts[1:] = cuts + 1
+    flat_stops[:-1] = cuts
+    flat_stops[-1] = len(raw)
+    starts = flat_starts.reshape(n_rows, n_cols)
+    stops = flat_stops.reshape(n_rows, n_cols)
     # every row ends at a line break, every other field at a separator
     if n_cols > 1 and not (raw[stops[:, :-1]] == separator).all():
         return None

@@ -99,10 +99,11 @@ class TextColumn(Sequence):
         """Values a..b-1 as a list of str and None."""
         if b <= a:
             return []
+        values: list[str | None]
         if self._multiline:
             values = [part.decode() for part in self.utf8(a, b)]
         else:
-            values = self.data[self.offsets[a] : self.offsets[b] - 1].tobytes().decode().split("\n")
+            values = list(self.data[self.offsets[a] : self.offsets[b] - 1].tobytes().decode().split("\n"))
         if self.valid is not None:
             for k in np.flatnonzero(~self.valid[a:b]).tolist():
                 values[k] = None
