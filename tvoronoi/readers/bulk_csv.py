@@ -25,6 +25,7 @@ PARSE_ROWS = 1 << 16
 MAX_DIGITS = 16
 # 10**k is exact in a double up to k = 22
 POW10 = 10.0 ** np.arange(23)
+_POW10_INT = 10 ** np.arange(MAX_DIGITS + 3, dtype=np.int64)
 # the bytes str.strip() removes that are ASCII
 _ASCII_SPACE = np.zeros(256, bool)
 _ASCII_SPACE[[0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x1C, 0x1D, 0x1E, 0x1F, 0x20]] = True
@@ -148,8 +149,12 @@ def _gather(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> tuple[np.
     lengths = stops - starts + 1
     offsets = np.zeros(len(lengths) + 1, np.int64)
     np.cumsum(lengths, out=offsets[1:])
-    index = np.repeat(starts - offsets[:-1], lengths)
-    index += np.arange(int(offsets[-1]), dtype=np.int64)
+    # the index of each byte: one more than the last, but where a field starts
+    kind = np.int32 if len(raw) < 2**31 else np.int64
+    step = np.ones(int(offsets[-1]), kind)
+    step[0] = starts[0]
+    step[offsets[1:-1]] = starts[1:] - stops[:-1]
+    index = np.cumsum(step, out=step)
     np.minimum(index, len(raw) - 1, out=index)  # the last field of the text has no byte after it
     data = raw[index]
     data[offsets[1:] - 1] = LF
@@ -220,7 +225,7 @@ def parse_floats(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, decimal
     width = int(min(lengths.max(initial=0), MAX_DIGITS + 2))
     done = np.zeros(n, bool)
     if width:
-        columns = np.arange(width)
+        columns = np.arange(width, dtype=np.int64)
         for a in range(0, n, PARSE_ROWS):
             b = min(n, a + PARSE_ROWS)
             out[a:b], done[a:b] = _parse_block(raw, starts[a:b], lengths[a:b], columns, decimal_comma)
@@ -236,36 +241,39 @@ def parse_floats(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, decimal
 
 
 def _parse_block(raw, starts, lengths, columns, decimal_comma):
-    """(values, parsed) of one block of fields: parsed is False where a field is not a plain decimal."""
+    """(values, parsed) of one block of fields: parsed is False where a field is not a plain decimal.
+
+    The fields are laid out right-aligned, one row per character position from the end: a
+    digit's weight is ten to the number of digits to its right, and the number of decimals
+    is the number of digits right of the point.
+    """
     width = len(columns)
-    inside = columns < lengths[:, None]
-    chars = raw[np.minimum(starts[:, None] + columns, len(raw) - 1)]
+    # row k holds each field's character k places before its end (NUL before its start)
+    back = columns[::-1, None]
+    inside = back < lengths
+    chars = raw[np.maximum(starts + lengths - 1 - back, 0)]
     chars[~inside] = 0
-    chars = chars.T.copy()  # one row per character position: the loops below read rows
-    inside = inside.T
     digit = chars - ord("0")
     is_digit = digit < 10
     is_point = chars == ord(".")
     if decimal_comma:
         is_point |= chars == ord(",")
-    sign = (chars[0] == ord("-")) | (chars[0] == ord("+"))
-    ok = (lengths > 0) & (lengths <= width)
-    # every character a digit or the point, but a sign first
-    allowed = is_digit | is_point
-    allowed[0] |= sign
-    ok &= (allowed | ~inside).all(axis=0)
+    # digits at or right of each position; a digit's own weight counts those right of it
+    right = is_digit.astype(np.int8)
+    for k in range(width - 2, -1, -1):
+        right[k] += right[k + 1]
+    n_digits = right[0].astype(np.int64)
+    digit[~is_digit] = 0
+    mantissa = (digit * _POW10_INT[np.maximum(right - 1, 0)]).sum(axis=0)
+    decimals = (right * is_point).sum(axis=0)
+    first = chars[width - lengths.clip(1, width), np.arange(len(starts))]
+    sign = (first == ord("-")) | (first == ord("+"))
+    # every character a digit or the point, but a sign first; at most one point
+    stray = inside & ~is_digit & ~is_point
+    ok = (lengths > 0) & (lengths <= width) & (n_digits >= 1) & (n_digits <= MAX_DIGITS)
+    ok &= stray.sum(axis=0) == sign
     ok &= is_point.sum(axis=0) <= 1
-    n_digits = is_digit.sum(axis=0)
-    ok &= (n_digits >= 1) & (n_digits <= MAX_DIGITS)
-    mantissa = np.zeros(len(starts), np.int64)
-    after_point = np.zeros(len(starts), bool)
-    decimals = np.zeros(len(starts), np.int64)
-    for k in range(width):
-        d = is_digit[k]
-        mantissa = np.where(d, mantissa * 10 + digit[k], mantissa)
-        decimals += d & after_point
-        after_point |= is_point[k]
     ok &= mantissa <= (1 << 53)
     values = mantissa.astype(np.float64) / POW10[np.minimum(decimals, 22)]
-    values[chars[0] == ord("-")] *= -1.0
+    values[first == ord("-")] *= -1.0
     return values, ok
