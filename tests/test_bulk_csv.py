@@ -218,3 +218,65 @@ def test_a_failing_stream_fails_the_write():
     diagram = voronoi(np.random.default_rng(1).random((30000, 2)))
     with pytest.raises(OSError, match="No space left"):
         write_cells(diagram, None, Full())
+
+
+@pytest.mark.skipif(not __import__("tvoronoi.writers.forked").writers.forked.can_fork(), reason="fork is used on Linux")
+@pytest.mark.parametrize("layout", ["collection", "seq", "lines"])
+@pytest.mark.parametrize("case", ["plain", "repeats_and_box", "clip"])
+def test_output_made_in_two_processes_is_the_same(monkeypatch, tmp_path, layout, case):
+    """The second half of the features made by a forked process: the same bytes, to a file and to a stream."""
+    import shapely
+
+    from tvoronoi import voronoi
+    from tvoronoi.readers import PointSet
+    from tvoronoi.writers import forked
+    from tvoronoi.writers.geojson_diagram import CHUNK_FEATURES, write_cells
+
+    rng = np.random.default_rng(5)
+    n = 3 * CHUNK_FEATURES + 17
+    xy = rng.random((n, 2)) * 100
+    options = {}
+    if case == "repeats_and_box":
+        xy[n - 40 :] = xy[:40]  # repeated sites in the second half
+        options["bbox"] = (10, 10, 90, 90)  # cells of sites outside miss the box
+    if case == "clip":
+        options["clip"] = shapely.Polygon([(0, 0), (100, 0), (50, 80)]).buffer(-5)
+    diagram = voronoi(xy, **options)
+    points = PointSet(xy, "t", {"name": TextColumn.from_strings([f"n{i}" for i in range(n)]),
+                                "k": [i % 7 for i in range(n)]})
+    outs = []
+    for minimum in (10**12, 1):
+        monkeypatch.setattr(forked, "MIN_FEATURES", minimum)
+        path = tmp_path / f"{minimum}.geojson"
+        seen: list = []
+        count = write_cells(diagram, points, str(path), layout=layout, precision=6 if case == "clip" else None,
+                            progress=lambda done, total, seen=seen: seen.append((done, total)))
+        stream = io.BytesIO()
+        assert write_cells(diagram, points, stream, layout=layout) == count
+        outs.append((path.read_bytes(), count, stream.getvalue()))
+        assert seen[-1] == (count, count)
+        assert all(done <= total for done, total in seen)
+        assert all(a[0] < b[0] for a, b in zip(seen, seen[1:])), "progress only moves forward"
+    assert outs[0] == outs[1]
+    if layout == "collection":
+        assert len(orjson.loads(outs[1][0])["features"]) == outs[1][1]
+
+
+@pytest.mark.skipif(not __import__("tvoronoi.writers.forked").writers.forked.can_fork(), reason="fork is used on Linux")
+def test_an_error_in_the_forked_half_is_raised(monkeypatch, tmp_path):
+    from tvoronoi import voronoi
+    from tvoronoi.errors import TvoronoiError
+    from tvoronoi.readers import PointSet
+    from tvoronoi.writers import forked
+    from tvoronoi.writers.geojson_diagram import CHUNK_FEATURES, write_cells
+
+    monkeypatch.setattr(forked, "MIN_FEATURES", 1)
+    n = 2 * CHUNK_FEATURES + 5
+    xy = np.random.default_rng(2).random((n, 2))
+    values: list = list(range(n))
+    values[n - 3] = object()  # not JSON, in the second half
+    path = tmp_path / "out.geojson"
+    with pytest.raises(TvoronoiError, match=f"site {n - 3}"):
+        write_cells(voronoi(xy), PointSet(xy, "t", {"v": values}), str(path))
+    assert not path.exists()
+    assert not list(tmp_path.iterdir())  # no temporary file left

@@ -10,6 +10,7 @@ import orjson
 from tvoronoi.fileio import gc_paused
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.readers.text_column import TextColumn
+from tvoronoi.writers import forked
 from tvoronoi.writers.background import background
 from tvoronoi.writers.targets import open_output
 
@@ -48,11 +49,12 @@ LAYOUTS = ("collection", "seq", "lines")
 class _Framing:
     """Writes features in chunks as a FeatureCollection or as a GeoJSON sequence."""
 
-    def __init__(self, stream, layout: str, bbox: bytes):
+    def __init__(self, stream, layout: str, bbox: bytes, *, opened: bool = False):
+        """``opened``: the features go on after others (a later part of an output): no header."""
         if layout not in LAYOUTS:
             raise TvoronoiError(f"unknown GeoJSON layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
-        self.stream, self.layout, self.first = stream, layout, True
-        if layout == "collection":
+        self.stream, self.layout, self.first = stream, layout, not opened
+        if layout == "collection" and not opened:
             stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
 
     def write(self, features: list[bytes]) -> None:
@@ -444,22 +446,20 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     distinct = diagram.site_of == rows
     has_ring, has_cut = ring_rows(diagram)
     total = int(distinct.sum())
-    done = 0
-    with open_output(out, overwrite=overwrite) as target, gc_paused(), background(target) as stream:
-        bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
-        frame = _Framing(stream, layout, bbox)
-        if progress is not None:
-            progress(0, total)
-        for a in range(0, n_sites, CHUNK_FEATURES):
-            b = min(a + CHUNK_FEATURES, n_sites)
+
+    def emit(frame: _Framing, start: int, stop: int, report: Callable[[int], None] | None) -> int:
+        """Write the features of rows start..stop-1; the number written."""
+        done = 0
+        for a in range(start, stop, CHUNK_FEATURES):
+            b = min(a + CHUNK_FEATURES, stop)
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
             if keep.all() and props.bulk(a, b):
                 # every row of the chunk is a distinct site with a ring: in bulk
                 props.ring_features(ring_chunk(diagram, a, b, precision), a, b, frame)
                 done += b - a
-                if progress is not None:
-                    progress(done, total)
+                if report is not None:
+                    report(done)
                 continue
             xy, first, last = closed_rings(diagram, a, b, keep)
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
@@ -469,8 +469,8 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
             chunk = distinct[a:b]
             for i, ring, is_cut in zip(rows[a:b][chunk].tolist(), keep[chunk].tolist(), has_cut[a:b][chunk].tolist()):
                 if ring:
-                    start, stop = next(spans)
-                    features.append(_POLYGON % (text[start:stop], properties(i)))
+                    start_, stop_ = next(spans)
+                    features.append(_POLYGON % (text[start_:stop_], properties(i)))
                 elif is_cut:  # a cell cut by a clip region
                     features.append(_GEOMETRY % (next(cut), properties(i)))
                 else:  # a cell that misses the box, or a site outside a clip region
@@ -479,9 +479,47 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
                 continue
             frame.write(features)
             done += len(features)
-            if progress is not None:
-                progress(done, total)
+            if report is not None:
+                report(done)
+        return done
+
+    # a large output is made in two halves at once: the second by a forked process
+    split = n_sites
+    if total >= forked.MIN_FEATURES and forked.can_fork():
+        split = (n_sites // 2 + CHUNK_FEATURES - 1) // CHUNK_FEATURES * CHUNK_FEATURES
+    share = int(distinct[:split].sum())
+    shown = [-1]
+
+    def report(done: int) -> None:
+        # the first part's share of the features stands for all of them; each count once
+        if progress is not None and done != shown[0]:
+            shown[0] = done
+            progress(done, total)
+
+    def report_share(done: int) -> None:
+        report(done * total // max(share, 1))
+
+    with open_output(out, overwrite=overwrite) as target, gc_paused():
+        bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
+        second = None
+        if split < n_sites:
+            second = forked.ForkedPart(target, lambda file: emit(_Framing(file, layout, b"", opened=True),
+                                                                 split, n_sites, None))
+        try:
+            report(0)
+            with background(target) as stream:
+                frame = _Framing(stream, layout, bbox)
+                done = emit(frame, 0, split, report_share)
+            if second is not None:
+                done += second.append_to(target)
+                second = None
+        except BaseException:
+            if second is not None:
+                second.abandon()
+            raise
+        frame.stream = target
         frame.close()
+        report(done)
     return done
 
 
