@@ -31,8 +31,8 @@ _ASCII_SPACE = np.zeros(256, bool)
 _ASCII_SPACE[[0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x1C, 0x1D, 0x1E, 0x1F, 0x20]] = True
 
 
-def bulk_columns(body: str, layout, n_cols: int, *, plain: bool) -> tuple[np.ndarray, list] | None:
-    """The sites and the other columns of the CSV rows in ``body`` (the text after the header).
+def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of the CSV rows in ``text[start:]`` (the text after the header).
 
     Returns (xy, columns): ``columns[j]`` is the JSON-ready column j (a :class:`TextColumn`
     or a list, see :func:`convert_column`), empty for the x and y columns. None when a row
@@ -40,16 +40,22 @@ def bulk_columns(body: str, layout, n_cols: int, *, plain: bool) -> tuple[np.nda
     coordinate that is not a number. ``plain`` is as in :func:`convert_column`.
     """
     delimiter = layout.delimiter
-    if not body or len(delimiter) != 1 or not delimiter.isascii() or delimiter in '"\r\n' or "\0" in body:
+    if len(text) <= start or len(delimiter) != 1 or not delimiter.isascii() or delimiter in '"\r\n':
         return None
-    raw = np.frombuffer(body.encode(), np.uint8)
+    encoded = text.encode()
+    if b"\0" in encoded:
+        return None
+    begin = start if len(encoded) == len(text) else len(text[:start].encode())
+    raw = np.frombuffer(encoded, np.uint8)[begin:]
     end = len(raw)
     while end and raw[end - 1] in (LF, CR):
         end -= 1  # the line breaks that end the file
     raw = raw[:end]
     if not end:
         return None
-    fields = _fields(raw, ord(delimiter), n_cols)
+    fields = _fields(raw, ord(delimiter), n_cols, has_quotes=encoded.find(b'"', begin) >= 0,
+                     has_cr=encoded.find(b"\r", begin) >= 0)
+    del encoded
     if fields is None:
         return None
     starts, stops, unescape = fields
@@ -69,17 +75,19 @@ def bulk_columns(body: str, layout, n_cols: int, *, plain: bool) -> tuple[np.nda
                 return None
             columns.append(convert_column(values, plain))
         else:
-            columns.append(_column(raw, starts[:, j], stops[:, j], plain))
+            columns.append(typed_column(raw, starts[:, j], stops[:, j], plain))
     return xy, columns
 
 
-def _fields(raw: np.ndarray, separator: int, n_cols: int):
+def _fields(raw: np.ndarray, separator: int, n_cols: int, has_quotes: bool, has_cr: bool):
     """(starts, stops, unescape): (rows, n_cols) byte ranges of the fields, their quotes
     taken off, and where a quoted field holds a doubled quote (None when none does); None
-    when the rows do not all hold n_cols fields or a quote is not where CSV puts one."""
-    quote = raw == QUOTE
-    has_quotes = bool(quote.any())
-    ends = (raw == separator) | (raw == LF)
+    when the rows do not all hold n_cols fields or a quote is not where CSV puts one.
+    ``has_quotes``, ``has_cr``: whether the text holds a quote, a carriage return."""
+    ends_field = np.zeros(256, bool)
+    ends_field[[separator, LF]] = True
+    ends = ends_field[raw]
+    quote = raw == QUOTE if has_quotes else np.zeros(0, bool)
     if has_quotes:
         # a separator or line break between an odd number of quotes is inside a quoted field;
         # the parity of a uint8 running count is the parity of the count
@@ -100,6 +108,7 @@ def _fields(raw: np.ndarray, separator: int, n_cols: int):
     flat_starts[1:] = cuts + 1
     flat_stops[:-1] = cuts
     flat_stops[-1] = len(raw)
+    del cuts
     starts = flat_starts.reshape(n_rows, n_cols)
     stops = flat_stops.reshape(n_rows, n_cols)
     # every row ends at a line break, every other field at a separator
@@ -108,7 +117,7 @@ def _fields(raw: np.ndarray, separator: int, n_cols: int):
     if n_rows > 1 and not (raw[stops[:-1, -1]] == LF).all():
         return None
     # Windows line ends: a carriage return before each line break is not part of the last field
-    carriage = np.flatnonzero(raw == CR)
+    carriage = np.flatnonzero(raw == CR) if has_cr else np.zeros(0, np.int64)
     if len(carriage):
         last = stops[:, -1]
         crlf = (last > starts[:, -1]) & (raw[np.maximum(last - 1, 0)] == CR)
@@ -161,7 +170,7 @@ def _gather(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray) -> tuple[np.
     return data, offsets
 
 
-def _column(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, plain: bool):
+def typed_column(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, plain: bool):
     """A column other than x and y: a TextColumn when its first non-blank value is text, else
     the values typed by :func:`convert_column`."""
     data, offsets = _gather(raw, starts, stops)
