@@ -12,6 +12,8 @@ names the line, take over.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from .pointset import _is_text, convert_column
@@ -19,6 +21,8 @@ from .text_column import TextColumn
 
 QUOTE = ord('"')
 LF, CR = 0x0A, 0x0D
+# a table of this many rows has its columns read by two threads
+THREAD_ROWS = 100_000
 # rows converted per step of the number parser (its scratch arrays stay a few megabytes)
 PARSE_ROWS = 1 << 16
 # a decimal of up to this many digits is an integer below 2**53: exact in a double
@@ -59,23 +63,30 @@ def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0)
     if fields is None:
         return None
     starts, stops, unescape = fields
-    xy = np.empty((len(starts), 2), np.float64)
+    coordinates = (layout.ix, layout.iy)
+    if unescape is not None and unescape[:, coordinates].any():
+        return None  # a coordinate with a quote inside: the csv module reads it
     decimal_comma = delimiter == ";"
-    for k, j in enumerate((layout.ix, layout.iy)):
+
+    def column(j: int):
+        if j in coordinates:
+            return parse_floats(raw, starts[:, j], stops[:, j], decimal_comma)
         if unescape is not None and unescape[:, j].any():
-            return None  # a coordinate with a quote inside: the csv module reads it
-        xy[:, k] = parse_floats(raw, starts[:, j], stops[:, j], decimal_comma)
-    columns: list = []
-    for j in range(n_cols):
-        if j in (layout.ix, layout.iy):
-            columns.append([])
-        elif unescape is not None and unescape[:, j].any():
             values = _unescaped(raw, starts[:, j], stops[:, j])
-            if values is None:
-                return None
-            columns.append(convert_column(values, plain))
-        else:
-            columns.append(typed_column(raw, starts[:, j], stops[:, j], plain))
+            return None if values is None else convert_column(values, plain)
+        return typed_column(raw, starts[:, j], stops[:, j], plain)
+
+    if len(starts) >= THREAD_ROWS:
+        # the columns two at a time: their numpy work releases the GIL
+        with ThreadPoolExecutor(2, thread_name_prefix="tvoronoi-csv") as pool:
+            done = list(pool.map(column, range(n_cols)))
+    else:
+        done = [column(j) for j in range(n_cols)]
+    if any(values is None for values in done):
+        return None
+    xy = np.empty((len(starts), 2), np.float64)
+    xy[:, 0], xy[:, 1] = done[layout.ix], done[layout.iy]
+    columns = [[] if j in coordinates else values for j, values in enumerate(done)]
     return xy, columns
 
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
 from tvoronoi.errors import TvoronoiError
@@ -291,6 +289,8 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     schema = pa.schema([pa.field(name, column.type) for name, column in columns.items()]
                        + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))])
     schema = schema.with_metadata({b"geo": _geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
+    from concurrent.futures import ThreadPoolExecutor
+
     import pyarrow.parquet as pq
 
     def row_group(a: int, b: int):
