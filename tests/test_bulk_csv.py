@@ -15,7 +15,6 @@ from hypothesis import strategies as st
 
 from tvoronoi import readers
 from tvoronoi.errors import InputFileError
-from tvoronoi.readers import bulk_csv
 from tvoronoi.readers.bulk_csv import bulk_columns, parse_floats
 from tvoronoi.readers.text_column import TextColumn
 
@@ -67,10 +66,9 @@ def _both(text, delimiter):
     quoting=st.sampled_from([csv.QUOTE_MINIMAL, csv.QUOTE_ALL]),
     line_end=st.sampled_from(["\n", "\r\n"]),
     last_line_end=st.booleans(),
-    threads=st.booleans(),
     data=st.data(),
 )
-def test_bulk_reader_agrees_with_the_row_walk(xy, n_extra, delimiter, quoting, line_end, last_line_end, threads, data):
+def test_bulk_reader_agrees_with_the_row_walk(xy, n_extra, delimiter, quoting, line_end, last_line_end, data):
     """Quoted fields with separators, quotes and line breaks inside, empty values, zip codes,
     Windows line ends, a file with or without its last line break: the same sites and the same
     typed columns as the csv module's rows, and the bulk reader does read them."""
@@ -79,10 +77,7 @@ def test_bulk_reader_agrees_with_the_row_walk(xy, n_extra, delimiter, quoting, l
     text = _table(rows, names, delimiter, quoting, line_end)
     if not last_line_end:
         text = text.removesuffix(line_end)
-    with pytest.MonkeyPatch.context() as patch:
-        # the columns read by two threads, as a large table's are
-        patch.setattr(bulk_csv, "THREAD_ROWS", 1 if threads else 10**12)
-        slow, bulk, layout = _both(text, delimiter)
+    slow, bulk, layout = _both(text, delimiter)
     if "\r" in "".join(v for row in rows for v in row[2:]) and line_end == "\r\n":
         # a carriage return in a value next to Windows line ends: the bulk reader may step aside
         if bulk is None:

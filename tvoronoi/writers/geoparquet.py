@@ -347,7 +347,7 @@ def _rings_extent(diagram, has_ring: np.ndarray) -> list[float] | None:
         return None
     used = np.zeros(len(diagram.cell_points), bool)
     used[ring] = True
-    xy = diagram.cell_points[used]
+    xy = diagram.cell_points if used.all() else diagram.cell_points[used]
     return [*xy.min(axis=0).tolist(), *xy.max(axis=0).tolist()]
 
 
