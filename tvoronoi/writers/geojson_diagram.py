@@ -301,7 +301,7 @@ class _Properties:
                 self.columns = [(renames.get(name, name), values) for name, values in points.columns.items()]
         self.row = _properties_writer(self.duplicates, self.columns, self.records, renames)
         self.repeated = np.array(sorted(self.duplicates), np.int64)
-        # a feature whose ring is the %b and whose properties follow: "site" and the columns
+        # each column with the text that comes before its value in a feature: ,"name":
         self.columns = [(b",%b:" % orjson.dumps(name), values) for name, values in self.columns]
 
     def bulk(self, a: int, b: int) -> bool:
