@@ -280,3 +280,26 @@ def test_an_error_in_the_forked_half_is_raised(monkeypatch, tmp_path):
         write_cells(voronoi(xy), PointSet(xy, "t", {"v": values}), str(path))
     assert not path.exists()
     assert not list(tmp_path.iterdir())  # no temporary file left
+
+
+def test_without_a_second_process_one_writes_it_all(monkeypatch):
+    """No temporary file or no process to be had for the second half: the same output from one process."""
+    from tvoronoi import voronoi
+    from tvoronoi.writers import forked
+    from tvoronoi.writers.geojson_diagram import CHUNK_FEATURES, write_cells
+
+    xy = np.random.default_rng(4).random((2 * CHUNK_FEATURES + 9, 2))
+    diagram = voronoi(xy)
+    monkeypatch.setattr(forked, "MIN_FEATURES", 10**12)
+    alone = io.BytesIO()
+    write_cells(diagram, None, alone)
+
+    def refuse(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(forked, "MIN_FEATURES", 1)
+    monkeypatch.setattr(forked, "can_fork", lambda: True)
+    monkeypatch.setattr(forked.tempfile, "TemporaryFile", refuse)
+    out = io.BytesIO()
+    assert write_cells(diagram, None, out) == len(xy)
+    assert out.getvalue() == alone.getvalue()

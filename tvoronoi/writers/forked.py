@@ -42,10 +42,20 @@ class ForkedPart:
     def __init__(self, stream: BinaryIO, write_part: Callable[[BinaryIO], int]):
         self.pid: int | None = None
         self.part = tempfile.TemporaryFile(dir=_directory_of(stream))
-        read_end, write_end = os.pipe()
+        try:
+            read_end, write_end = os.pipe()
+        except OSError:
+            self.part.close()
+            raise
         sys.stdout.flush()
         sys.stderr.flush()
-        pid = os.fork()
+        try:
+            pid = os.fork()
+        except OSError:
+            for fd in (read_end, write_end):
+                os.close(fd)
+            self.part.close()
+            raise
         if pid == 0:  # the child: write, report, and leave without running the parent's exit code
             os.close(read_end)
             status, report = 1, _TVORONOI + b" the second half of the output failed"

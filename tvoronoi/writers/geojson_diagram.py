@@ -503,8 +503,12 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
         bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
         second = None
         if split < n_sites:
-            second = forked.ForkedPart(target, lambda file: emit(_Framing(file, layout, b"", opened=True),
-                                                                 split, n_sites, None))
+            try:
+                second = forked.ForkedPart(target, lambda file: emit(_Framing(file, layout, b"", opened=True),
+                                                                     split, n_sites, None))
+            except OSError:
+                # no room for the temporary file, or no process to be had: one process writes it all
+                split, share = n_sites, total
         try:
             report(0)
             with background(target) as stream:
