@@ -303,3 +303,16 @@ def test_without_a_second_process_one_writes_it_all(monkeypatch):
     out = io.BytesIO()
     assert write_cells(diagram, None, out) == len(xy)
     assert out.getvalue() == alone.getvalue()
+
+
+def test_a_worker_thread_writes_in_one_process(monkeypatch):
+    """Saving from a worker thread (the terminal UI does) never forks."""
+    import threading
+
+    from tvoronoi.writers import forked
+
+    seen = []
+    worker = threading.Thread(target=lambda: seen.append(forked.can_fork()))
+    worker.start()
+    worker.join()
+    assert seen == [False]

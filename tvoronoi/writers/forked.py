@@ -15,6 +15,7 @@ import signal
 import stat
 import sys
 import tempfile
+import threading
 from typing import BinaryIO, Callable
 
 from tvoronoi.errors import TvoronoiError
@@ -27,9 +28,11 @@ _OK, _TVORONOI, _OS = b"ok", b"tvoronoi", b"os"
 
 
 def can_fork() -> bool:
-    """Whether a part of an output can be made by a forked process here (Linux: fork is cheap and safe
-    for a process whose other threads hold no lock the child needs)."""
-    return sys.platform.startswith("linux") and hasattr(os, "fork")
+    """Whether a part of an output can be made by a forked process here: on Linux (fork is cheap),
+    from the main thread (the batch command; an application saving from a worker thread, such
+    as the terminal UI, has threads of its own that may hold locks when it forks)."""
+    return (sys.platform.startswith("linux") and hasattr(os, "fork")
+            and threading.current_thread() is threading.main_thread())
 
 
 class ForkedPart:
