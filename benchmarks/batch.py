@@ -7,6 +7,10 @@ Times whole processes (start-up included) and their peak memory, for
 on the same file of n points (x, y and two text columns).
 
     python benchmarks/batch.py --n 1M --out benchmarks/results/batch
+    python benchmarks/batch.py --n 1M --before /tmp/old --before-label 'before, fbb596b'
+
+--before DIR runs an older checkout's package as well (``git archive REV tvoronoi | tar -x -C DIR``,
+its compiled kernels copied in), interleaved with this one, so that the two meet the same load.
 """
 
 from __future__ import annotations
@@ -55,11 +59,16 @@ def write_points(path: Path, n: int) -> None:
             f.write("".join(f"{xy[i, 0]:.6f},{xy[i, 1]:.6f},site {i},{kinds[i]}\n" for i in block))
 
 
-def run(cmd: list[str]) -> tuple[float, float, float]:
+def run(cmd: list[str], path: str | None = None) -> tuple[float, float, float]:
     """Wall seconds, peak MiB and CPU seconds (user + system, all threads) of one whole process,
-    its own peak and CPU from wait4. CPU time shows the work where other processes share the cores."""
+    its own peak and CPU from wait4. CPU time shows the work where other processes share the cores.
+    ``path``: the directory of an older checkout, run from there and first on PYTHONPATH (``-m``
+    puts the working directory first)."""
+    env = subprocess_env()
+    if path is not None:
+        env["PYTHONPATH"] = os.pathsep.join([path, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=subprocess_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(cmd, env=env, cwd=path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
     if status != 0:
@@ -73,6 +82,9 @@ def main(argv=None) -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--only-tvoronoi", action="store_true", help="leave out the pandas + shapely pipeline")
     ap.add_argument("--out", default="benchmarks/results/batch")
+    ap.add_argument("--before", metavar="DIR", help="also run the tvoronoi package found in DIR (an older "
+                    "checkout, its kernels built), interleaved with this one: before/after on the same load")
+    ap.add_argument("--before-label", default="before", help="how the rows of --before are named")
     args = ap.parse_args(argv)
     n = parse_sizes(args.n)[0]
     info = machine()
@@ -88,19 +100,25 @@ def main(argv=None) -> None:
             "pandas + shapely.voronoi_polygons + to_file (GeoJSON)": [
                 sys.executable, "-c", PANDAS_SHAPELY, str(src), str(Path(tmp) / "shapely.geojson")],
         }
+        if args.before:
+            before = {f"{name} ({args.before_label})": cmd for name, cmd in cases.items()
+                      if name.startswith("tvoronoi")}
+            cases = {**{name: cmd[:-1] + [str(Path(cmd[-1]).with_name("before-" + Path(cmd[-1]).name))]
+                        for name, cmd in before.items()}, **cases}
         if args.only_tvoronoi:
             cases = {name: cmd for name, cmd in cases.items() if name.startswith("tvoronoi")}
         rows: dict[str, list] = {name: [] for name in cases}
         for _ in range(args.repeats):            # interleaved rounds
             for name, cmd in cases.items():
-                rows[name].append(run(cmd))
+                rows[name].append(run(cmd, args.before if name.endswith(f"({args.before_label})") else None))
                 print(f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB, "
                       f"{rows[name][-1][2]:.2f} s CPU", flush=True)
         sizes = {name: (Path(cmd[-1]).stat().st_size if Path(cmd[-1]).exists() else 0) for name, cmd in cases.items()}
     lines = ["# Batch end to end", "", f"Machine: {describe_machine(info)}", "",
              f"{n:,} points in a CSV (x, y and two text columns), cells out; whole processes, start-up included; "
-             f"median of {args.repeats} interleaved runs, peak resident memory of the process; CPU is user + "
-             f"system time of all its threads (the work done, whatever else runs on the machine).", "",
+             f"median of {args.repeats} interleaved runs, peak resident memory of the largest of its processes; CPU is user + "
+             f"system time of all its threads and processes (the work done, whatever else runs on the "
+             f"machine); load average at the end {[round(v, 2) for v in os.getloadavg()]}.", "",
              "| pipeline | wall s | CPU s | peak MiB | output MB |", "|---|---:|---:|---:|---:|"]
     table = []
     for name, runs in rows.items():

@@ -552,7 +552,7 @@ def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
 )
 def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line, data):
     """pyarrow's CSV reader (used when pyarrow is loaded) gives the sites and typed columns the
-    bulk split and the row walk give, or steps aside; ";" files with decimal commas included."""
+    bulk reader and the row walk give, or steps aside; ";" files with decimal commas included."""
     pytest.importorskip("pyarrow")
     from tvoronoi.readers import tabular
 
@@ -566,20 +566,22 @@ def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line,
     text = "\n".join(lines) + "\n"
     layout = readers.table_layout(text, "t", "csv", None, None, delimiter)
     body = text[readers.line_offset(text, layout.header_lines):]
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(tabular, "ARROW_MIN_CHARS", 1 << 60)
-        try:
-            other = readers.fast_table(body, "csv", layout)
-        except ValueError:
-            other = None
-        patch.setattr(tabular, "ARROW_MIN_CHARS", 0)
-        arrow = tabular._arrow_columns(body, layout, len(layout.names))
-        if arrow is None:
-            return
-        assert other is not None, "Arrow read a table the other paths refuse"
-        fast = readers.fast_table(body, "csv", layout)
-    np.testing.assert_array_equal(fast[0], other[0])
-    assert fast[1] == other[1]
+    plain = text.isascii() and "_" not in text
+    arrow = tabular._arrow_columns(body, layout, len(layout.names), plain)
+    if arrow is None:
+        return
+    try:
+        other = tabular.bulk_columns(body, layout, len(layout.names), plain=plain)
+    except ValueError:
+        other = None
+    assert other is not None, "Arrow read a table the bulk reader refuses"
+    np.testing.assert_array_equal(arrow[0], other[0])
+    assert arrow[1] == other[1]
+    # and both as the row walk reads the table
+    slow = readers.slow_table(text, "t", "csv", layout)
+    np.testing.assert_array_equal(arrow[0], slow.xy)
+    typed = {name: arrow[1][j] for j, name in enumerate(layout.names) if j not in (layout.ix, layout.iy)}
+    assert typed == slow.columns
 
 
 # ---------------------------------------------------------------------------

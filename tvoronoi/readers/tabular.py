@@ -28,7 +28,8 @@ from .columns import (
 )
 from tvoronoi.fileio import gc_paused
 
-from .pointset import CATEGORY_SAMPLE, PointSet, convert_column
+from .bulk_csv import bulk_columns, typed_column
+from .pointset import PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
 # a table text up to this size is kept to name the line of a site in a later message
@@ -39,8 +40,6 @@ COMMENT = "#"
 DELIMITERS = (",", ";", "\t", "|")
 # rows the separator is guessed from
 SNIFF_ROWS = 20
-# a CSV text without quotes is split this many characters (about 100,000 rows) at a time
-BLOCK_CHARS = 4 << 20
 # a CSV text at least this long is read by pyarrow's reader when pyarrow is loaded
 ARROW_MIN_CHARS = 1 << 20
 
@@ -75,9 +74,12 @@ def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = 
             raise
         head = text
         layout = table_layout(text, source, kind, x, y, delimiter or ",")
-    body = text[line_offset(head, layout.header_lines) :]
+    offset = line_offset(head, layout.header_lines)
     try:
-        fast = fast_table(body, kind, layout)
+        # CSV in bulk, from the text as it is (no copy of the rows); else the other fast paths
+        fast = _bulk_table(text, offset, layout) if kind == "csv" else None
+        if fast is None:
+            fast = fast_table(text[offset:], kind, layout, bulk=False)
     except (ValueError, csv.Error):
         fast = None
     if fast is None:
@@ -86,7 +88,7 @@ def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = 
         points = slow_table(text, source, kind, layout)
     else:
         points = PointSet(fast[0], source, fast[1])
-        points.where = _fast_lines(text, body, source, kind, layout, len(points))
+        points.where = _fast_lines(text, offset, source, kind, layout, len(points))
     if points.where is not None:
         points.where = _line_label(points.where)
     names = [name.strip().lower() for name in (layout.names[layout.ix], layout.names[layout.iy])]
@@ -97,15 +99,17 @@ def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = 
     return points
 
 
-def _fast_lines(text: str, body: str, source: str, kind: str, layout: _Layout, n_rows: int):
+def _fast_lines(text: str, offset: int, source: str, kind: str, layout: _Layout, n_rows: int):
     """The line of each row, as a function of the row, for messages about a site.
 
     When every row is one line (no blank line, comment or field over lines) it is
     arithmetic; else a walk of the rows, kept only for a text of up to KEEP_TEXT_CHARS
     (a large text is not held for a message: None, and rows are named by index).
+    ``offset`` is where the rows start in ``text``.
     """
-    breaks = body.count("\n")
-    if "\r" not in body.replace("\r\n", "") and breaks - (0 if body.endswith("\n") else -1) == n_rows:
+    breaks = text.count("\n", offset)
+    lone_cr = text.find("\r", offset) >= 0 and "\r" in text[offset:].replace("\r\n", "")
+    if not lone_cr and breaks - (0 if text.endswith("\n") or len(text) == offset else -1) == n_rows:
         first = layout.first_line
         return lambda i: first + i
     if len(text) > KEEP_TEXT_CHARS:
@@ -314,8 +318,30 @@ def _unique_names(names: list[str]) -> list[str]:
 # the rows: in bulk, else one by one
 
 
-def fast_table(body: str, kind: str, layout: _Layout):
-    """Read the rows after the header in bulk; None (or ValueError) when a row needs a closer look."""
+def _bulk_table(text: str, offset: int, layout: _Layout):
+    """The rows of a CSV text from ``offset`` on read by :func:`bulk_columns`, as :func:`fast_table`
+    gives them; None when they need the csv module, ValueError at a value that is not a number."""
+    names, ix, iy = layout.names, layout.ix, layout.iy
+    if len(names) == 2 and layout.delimiter != ";":
+        return None  # only coordinates: numpy's loadtxt
+    plain = _is_plain(text)
+    with gc_paused():
+        bulk = None
+        if len(text) - offset >= ARROW_MIN_CHARS and "pyarrow" in sys.modules:
+            bulk = _arrow_columns(text[offset:], layout, len(names), plain)
+        if bulk is None:
+            bulk = bulk_columns(text, layout, len(names), plain=plain, start=offset)
+    if bulk is None:
+        return None
+    xy, typed = bulk
+    if not np.isfinite(xy).all():
+        return None
+    return xy, {name: typed[j] for j, name in enumerate(names) if j not in (ix, iy)}
+
+
+def fast_table(body: str, kind: str, layout: _Layout, *, bulk: bool = True):
+    """Read the rows after the header in bulk; None (or ValueError) when a row needs a closer look.
+    ``bulk=False`` leaves out :func:`bulk_columns` (already tried)."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     n_cols = len(names)
     if n_cols == 2 and layout.delimiter != ";":
@@ -333,12 +359,11 @@ def fast_table(body: str, kind: str, layout: _Layout):
             return None
         xy = np.ascontiguousarray(table[:, [ix, iy]] if ix else table)
         return (xy, {}) if np.isfinite(xy).all() else None
-    with gc_paused():
-        split = None
-        if kind == "csv" and len(body) >= ARROW_MIN_CHARS:
-            split = _arrow_columns(body, layout, n_cols)
-        if split is None and kind == "csv":
-            split = _unquoted_columns(body, layout, n_cols)
+    split = None
+    if kind == "csv" and bulk:
+        read = _bulk_table(body, 0, layout)
+        if read is not None:
+            return read
     if split is not None:
         xy, columns = split
     else:
@@ -362,16 +387,16 @@ def _coordinates(columns, layout: _Layout) -> np.ndarray:
     return xy
 
 
-def _arrow_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
-    """What :func:`_unquoted_columns` gives, read by pyarrow's CSV reader (on every core) when
+def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tuple[np.ndarray, list] | None:
+    """What :func:`bulk_columns` gives, read by pyarrow's CSV reader (on every core) when
     pyarrow is already loaded (a GeoParquet output loads it first); None when it is not, or the
     text needs a closer look. Loading pyarrow only to read would cost more memory (its libraries)
     than the time it saves.
 
-    Every field is read as text, so that the columns are typed as the other paths type them;
-    the coordinates are converted by Arrow, which accepts a subset of what ``float`` accepts
-    (no spaces or "_"), with the same correctly rounded result: a value it refuses sends the
-    file to the other paths, which read it or name its line.
+    Every field is read as text, and the columns other than x and y are typed from their
+    bytes as the bulk reader types them; the coordinates are converted by Arrow, which accepts
+    a subset of what ``float`` accepts (no spaces or "_"), with the same correctly rounded
+    result: a value it refuses sends the file to the other paths, which read it or name its line.
     """
     if "pyarrow" not in sys.modules or QUOTE in body or "\0" in body or "\r" in body or not layout.delimiter.isascii():
         return None
@@ -404,72 +429,18 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray,
             xy[:, k] = pc.cast(text, pa.float64(), memory_pool=pool).to_numpy()
         except (pa.ArrowInvalid, pa.ArrowTypeError):
             return None
-    columns: list = [[] if j in (layout.ix, layout.iy) else _arrow_texts(pa, pc, table.column(j), pool)
-                     for j in range(n_cols)]
+    columns: list = []
+    for j in range(n_cols):
+        if j in (layout.ix, layout.iy):
+            columns.append([])
+            continue
+        # the column's bytes and offsets, typed as the bulk reader types a column
+        values = table.column(j).combine_chunks(memory_pool=pool)
+        offsets = np.frombuffer(values.buffers()[1], np.int32)[values.offset : values.offset + len(values) + 1]
+        data = values.buffers()[2]
+        raw = np.frombuffer(data, np.uint8) if data is not None and data.size else np.zeros(1, np.uint8)
+        columns.append(typed_column(raw, offsets[:-1].astype(np.int64), offsets[1:].astype(np.int64), plain))
     return xy, columns
-
-
-def _arrow_texts(pa, pc, column, pool) -> list[str]:
-    """An Arrow text column as a list of str; a column that repeats its values (a category,
-    judged from its first rows) holds one object per distinct value."""
-    head = column.slice(0, CATEGORY_SAMPLE)
-    if pc.count_distinct(head).as_py() * 2 > min(len(column), CATEGORY_SAMPLE):
-        return column.to_pylist()
-    encoded = pc.dictionary_encode(column, memory_pool=pool).combine_chunks(memory_pool=pool)
-    values = np.array(encoded.dictionary.to_pylist() + [None], dtype=object)
-    return values[encoded.indices.to_numpy()].tolist()
-
-
-def _unquoted_columns(body: str, layout: _Layout, n_cols: int) -> tuple[np.ndarray, list] | None:
-    """The sites and the other columns of a CSV text without quotes, split in bulk a block of
-    lines at a time (the coordinates' text of a block is converted and dropped before the next).
-
-    None when the text needs the csv module (quotes, a lone carriage return, NUL, a separator
-    that is not ASCII) or a line does not hold ``n_cols`` fields (blank lines, a short
-    row): the csv reader, and then the row walk, take over there. ValueError at a coordinate
-    that is not a number.
-    """
-    delimiter = layout.delimiter
-    if not body or QUOTE in body or "\0" in body or not delimiter.isascii():
-        return None
-    if "\r" in body:
-        body = body.replace("\r\n", "\n")  # Windows line ends
-        if "\r" in body:
-            return None  # a line ending in a lone CR (old Mac)
-    columns: list[list[str]] = [[] for _ in range(n_cols)]
-    blocks: list[np.ndarray] = []
-    # one object per distinct value of a column that repeats its values (a category)
-    canonical: list[dict[str, str]] = [{} for _ in range(n_cols)]
-    separator = ord(delimiter)
-    start, end = 0, len(body)
-    while start < end:
-        stop = body.find("\n", start + BLOCK_CHARS)
-        stop = end if stop < 0 else stop + 1
-        block = body[start:stop].removesuffix("\n")
-        start = stop
-        # every line holds n_cols - 1 separators: count them between line breaks
-        raw = np.frombuffer(block.encode(), np.uint8)
-        breaks = np.flatnonzero(raw == ord("\n"))
-        seps = np.flatnonzero(raw == separator)
-        if len(seps) != (len(breaks) + 1) * (n_cols - 1):
-            return None
-        if len(breaks) and not np.array_equal(np.searchsorted(seps, breaks),
-                                              np.arange(1, len(breaks) + 1) * (n_cols - 1)):
-            return None
-        fields = block.replace("\n", delimiter).split(delimiter)
-        del block, raw
-        block_columns = [fields[j::n_cols] for j in range(n_cols)]
-        del fields
-        blocks.append(_coordinates(block_columns, layout))
-        for j, column in enumerate(columns):
-            if j in (layout.ix, layout.iy):
-                continue
-            values = block_columns[j]
-            if len(set(values[:CATEGORY_SAMPLE])) * 2 <= min(len(values), CATEGORY_SAMPLE):
-                memo = canonical[j]
-                values = [memo.setdefault(v, v) for v in values]
-            column.extend(values)
-    return np.concatenate(blocks), columns
 
 
 def _row_columns(body: str, kind: str, layout: _Layout) -> list | None:
@@ -539,12 +510,17 @@ def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
 
 def _extras(columns: list, layout: _Layout, text: str) -> dict[str, list]:
     """The columns other than x and y, as JSON-ready values; ``text`` holds the rows they come from."""
-    plain = text.isascii() and "_" not in text
+    plain = _is_plain(text)
     return {
         name: convert_column(columns[j], plain)
         for j, name in enumerate(layout.names)
         if j not in (layout.ix, layout.iy)
     }
+
+
+def _is_plain(text: str) -> bool:
+    """Whether int() and float() read the numbers of a table text exactly as its literals (see convert_column)."""
+    return text.isascii() and "_" not in text
 
 
 def _floats_or_nan(values) -> np.ndarray:

@@ -9,6 +9,9 @@ import orjson
 
 from tvoronoi.fileio import gc_paused
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.readers.text_column import TextColumn
+from tvoronoi.writers import forked
+from tvoronoi.writers.background import background
 from tvoronoi.writers.targets import open_output
 
 __all__ = ["write_cells", "write_delaunay", "missing_cells"]
@@ -31,7 +34,11 @@ _NULL = b'{"type":"Feature","geometry":null,"properties":%b}'
 _GEOMETRY = b'{"type":"Feature","geometry":%b,"properties":%b}'
 _TRIANGLE = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[[%b]]},"properties":{"sites":[%d,%d,%d]}}'
 _SEPARATOR = b",\n"
-# the text of a NaN row between two rings (see ring_list)
+# a Polygon feature up to its ring, and from its ring to the value of "site"
+_FEATURE_OPEN = b'{"type":"Feature","geometry":{"type":"Polygon","coordinates":[['
+_RING_CLOSE = b']]},"properties":{"site":'
+
+# the text of a NaN row between two rings (see ring_chunk)
 _RING_BREAK = b",[null,null],"
 # GeoJSON text sequences (RFC 8142): each feature opens with a record separator and ends a line
 RS = b"\x1e"
@@ -42,11 +49,12 @@ LAYOUTS = ("collection", "seq", "lines")
 class _Framing:
     """Writes features in chunks as a FeatureCollection or as a GeoJSON sequence."""
 
-    def __init__(self, stream, layout: str, bbox: bytes):
+    def __init__(self, stream, layout: str, bbox: bytes, *, opened: bool = False):
+        """``opened``: the features go on after others (a later part of an output): no header."""
         if layout not in LAYOUTS:
             raise TvoronoiError(f"unknown GeoJSON layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
-        self.stream, self.layout, self.first = stream, layout, True
-        if layout == "collection":
+        self.stream, self.layout, self.first = stream, layout, not opened
+        if layout == "collection" and not opened:
             stream.write(b'{"type":"FeatureCollection",%b"features":[\n' % bbox)
 
     def write(self, features: list[bytes]) -> None:
@@ -60,6 +68,25 @@ class _Framing:
             prefix = RS if self.layout == "seq" else b""
             self.stream.write(b"".join(b"%b%b\n" % (prefix, feature) for feature in features))
         self.first = False
+
+    def joined(self, pieces: list[bytes], feature_start: bytes, feature_end: bytes) -> None:
+        """Write a chunk of features given as one list of pieces: each feature's own pieces, the
+        last of which (``feature_end`` + the break + ``feature_start``) closes it and opens the next.
+        ``feature_start`` opens the first feature and ``feature_end`` closes the last."""
+        if not pieces:
+            return
+        if self.layout == "collection":
+            lead, tail = (b"" if self.first else _SEPARATOR), b""
+        else:
+            lead, tail = (RS if self.layout == "seq" else b""), b"\n"
+        pieces[-1] = feature_end + tail
+        pieces.insert(0, lead + feature_start)
+        self.stream.write(b"".join(pieces))
+        self.first = False
+
+    def between(self) -> bytes:
+        """The bytes between two features."""
+        return _SEPARATOR if self.layout == "collection" else (b"\n" + RS if self.layout == "seq" else b"\n")
 
     def close(self) -> None:
         if self.layout == "collection":
@@ -102,19 +129,6 @@ def _ring_texts(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> tuple[me
     return memoryview(text), open_[first].tolist(), (close[last] + 1).tolist()
 
 
-def ring_list(xy: np.ndarray, first: np.ndarray, last: np.ndarray) -> list[bytes]:
-    """Closed rings as JSON texts ``[x,y],...,[x,y]``, one per ring, in one orjson call.
-
-    Ring k is ``xy[first[k]:last[k] + 1]`` and the rings follow each other. A row of NaN
-    (written ``[null,null]``) between two rings marks where the text is cut.
-    """
-    if not len(first):
-        return []
-    marked = np.insert(np.ascontiguousarray(xy, dtype=np.float64), last[:-1] + 1, np.nan, axis=0)
-    text = orjson.dumps(marked, option=_OPT_NUMPY)
-    return text[1:-1].split(_RING_BREAK)
-
-
 def closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closed rings of the cells of rows a..b-1 where ``keep`` (a (b-a,) bool mask) holds.
 
@@ -133,6 +147,28 @@ def closed_rings(diagram, a: int, b: int, keep: np.ndarray) -> tuple[np.ndarray,
     shift = np.arange(len(lengths), dtype=np.int64)
     # np.take is much faster than fancy indexing for gathering rows
     return np.take(diagram.cell_points, index, axis=0), starts + shift, stops + shift
+
+
+def ring_chunk(diagram, a: int, b: int, precision: int | None) -> list[bytes]:
+    """The closed rings of the cells of rows a..b-1 (each with a ring) as JSON texts
+    ``[x,y],...,[x,y]``, one per row, in one gather and one orjson call.
+
+    The positions are gathered with each ring's first point repeated after its last and a
+    NaN row (written ``[null,null]``) after that, where the text is cut.
+    """
+    offsets = diagram.cell_offsets
+    lengths = np.diff(offsets[a : b + 1])
+    ring = diagram.cell_vertices[offsets[a] : offsets[b]]
+    stops = np.cumsum(lengths)
+    # after each ring: its first vertex, then -1 for the cut
+    extra = np.empty((len(lengths), 2), ring.dtype)
+    extra[:, 0] = ring[stops - lengths]
+    extra[:, 1] = -1
+    index = np.insert(ring, np.repeat(stops, 2), extra.ravel())[:-1]
+    xy = np.take(diagram.cell_points, index, axis=0)
+    xy[index < 0] = np.nan
+    text = orjson.dumps(_rounded(xy, precision), option=_OPT_NUMPY)
+    return text[1:-1].split(_RING_BREAK)
 
 
 def cut_geometries(diagram, rows: np.ndarray, precision: int | None = None) -> list[bytes]:
@@ -265,30 +301,54 @@ class _Properties:
                 self.columns = [(renames.get(name, name), values) for name, values in points.columns.items()]
         self.row = _properties_writer(self.duplicates, self.columns, self.records, renames)
         self.repeated = np.array(sorted(self.duplicates), np.int64)
-        # a feature whose ring is the %b and whose properties follow: "site" and the columns
-        self.columns = [(b",%b:" % orjson.dumps(name).replace(b"%", b"%%"), values) for name, values in self.columns]
-        # a feature whose ring is the first %b, then "site" and the columns (see ring_features)
-        self.ring_feature = _POLYGON.replace(b"%b}", b"") + b'{"site":%d'
+        # each column with the text that comes before its value in a feature: ,"name":
+        self.columns = [(b",%b:" % orjson.dumps(name), values) for name, values in self.columns]
 
     def bulk(self, a: int, b: int) -> bool:
         """Whether rows a..b-1 can be written by :meth:`ring_features` (table columns, no repeats)."""
         repeats = np.searchsorted(self.repeated, [a, b])
         return self.records is None and repeats[0] == repeats[1]
 
-    def ring_features(self, rings: list, a: int, b: int) -> list[bytes]:
-        """The features of rows a..b-1, each with its ring, the column values serialized in bulk."""
-        texts, keys = [], []
+    def ring_features(self, rings: list, a: int, b: int, frame: _Framing) -> None:
+        """Write the features of rows a..b-1, each with its ring, as one list of pieces joined
+        once: the column values serialized in bulk, no formatting per feature."""
+        variables: list[list] = [rings, orjson.dumps(np.arange(a, b, dtype=np.int64), option=_OPT_NUMPY)[1:-1].split(b",")]
+        # constants[k] comes before variables[k] (constants[0] opens the feature); the last closes it
+        constants = [_FEATURE_OPEN, _RING_CLOSE, b""]
         try:
             for key, values in self.columns:
-                chunk = values[a:b]
-                contents = _string_contents(chunk)
-                texts.append(json_texts(chunk) if contents is None else contents)
-                keys.append(key + (b"%b" if contents is None else b'"%b"'))
+                contents = _column_contents(values, a, b)
+                if contents is None:
+                    constants[-1] += key
+                    variables.append(json_texts(values[a:b]))
+                    constants.append(b"")
+                else:
+                    constants[-1] += key + b'"'
+                    variables.append(contents)
+                    constants.append(b'"')
         except orjson.JSONEncodeError:
             # the message names the row: written one by one
-            return [_POLYGON % (ring, self.row(i)) for ring, i in zip(rings, range(a, b))]
-        template = self.ring_feature + b"".join(keys) + b"}}"
-        return [template % args for args in zip(rings, range(a, b), *texts)]
+            frame.write([_POLYGON % (ring, self.row(i)) for ring, i in zip(rings, range(a, b))])
+            return
+        constants[-1] += b"}}"
+        width = 2 * len(variables)
+        pieces: list = [None] * (width * (b - a))
+        for k, values in enumerate(variables):
+            pieces[2 * k :: width] = values
+            if k + 1 < len(variables):
+                pieces[2 * k + 1 :: width] = [constants[k + 1]] * (b - a)
+        pieces[width - 1 :: width] = [constants[-1] + frame.between() + constants[0]] * (b - a)
+        frame.joined(pieces, constants[0], constants[-1])
+
+
+def _column_contents(values, a: int, b: int) -> list[bytes] | None:
+    """The text JSON writes between quotes for each value a..b-1 of a column of strings with
+    nothing to escape (and no None); None for other columns."""
+    if isinstance(values, TextColumn):
+        if values.json_plain and (values.valid is None or values.valid[a:b].all()):
+            return values.utf8(a, b)
+        return None
+    return _string_contents(values[a:b])
 
 
 def _properties_writer(duplicates, columns, records, renames) -> Callable[[int], bytes]:
@@ -386,25 +446,22 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     distinct = diagram.site_of == rows
     has_ring, has_cut = ring_rows(diagram)
     total = int(distinct.sum())
-    done = 0
-    with open_output(out, overwrite=overwrite) as stream, gc_paused():
-        bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
-        frame = _Framing(stream, layout, bbox)
-        if progress is not None:
-            progress(0, total)
-        for a in range(0, n_sites, CHUNK_FEATURES):
-            b = min(a + CHUNK_FEATURES, n_sites)
+
+    def emit(frame: _Framing, start: int, stop: int, report: Callable[[int], None] | None) -> int:
+        """Write the features of rows start..stop-1; the number written."""
+        done = 0
+        for a in range(start, stop, CHUNK_FEATURES):
+            b = min(a + CHUNK_FEATURES, stop)
             # the rings of this chunk, serialized together
             keep = has_ring[a:b]
-            xy, first, last = closed_rings(diagram, a, b, keep)
-            if b - a == len(first) and props.bulk(a, b):
+            if keep.all() and props.bulk(a, b):
                 # every row of the chunk is a distinct site with a ring: in bulk
-                features = props.ring_features(ring_list(_rounded(xy, precision), first, last), a, b)
-                frame.write(features)
-                done += len(features)
-                if progress is not None:
-                    progress(done, total)
+                props.ring_features(ring_chunk(diagram, a, b, precision), a, b, frame)
+                done += b - a
+                if report is not None:
+                    report(done)
                 continue
+            xy, first, last = closed_rings(diagram, a, b, keep)
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, last)
             spans = zip(starts, stops)
             cut = iter(cut_geometries(diagram, rows[a:b][has_cut[a:b]], precision) if has_cut[a:b].any() else ())
@@ -412,8 +469,8 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
             chunk = distinct[a:b]
             for i, ring, is_cut in zip(rows[a:b][chunk].tolist(), keep[chunk].tolist(), has_cut[a:b][chunk].tolist()):
                 if ring:
-                    start, stop = next(spans)
-                    features.append(_POLYGON % (text[start:stop], properties(i)))
+                    start_, stop_ = next(spans)
+                    features.append(_POLYGON % (text[start_:stop_], properties(i)))
                 elif is_cut:  # a cell cut by a clip region
                     features.append(_GEOMETRY % (next(cut), properties(i)))
                 else:  # a cell that misses the box, or a site outside a clip region
@@ -422,9 +479,51 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
                 continue
             frame.write(features)
             done += len(features)
-            if progress is not None:
-                progress(done, total)
+            if report is not None:
+                report(done)
+        return done
+
+    # a large output is made in two halves at once: the second by a forked process
+    split = n_sites
+    if total >= forked.MIN_FEATURES and forked.can_fork():
+        split = (n_sites // 2 + CHUNK_FEATURES - 1) // CHUNK_FEATURES * CHUNK_FEATURES
+    share = int(distinct[:split].sum())
+    shown = [-1]
+
+    def report(done: int) -> None:
+        # the first part's share of the features stands for all of them; each count once
+        if progress is not None and done != shown[0]:
+            shown[0] = done
+            progress(done, total)
+
+    def report_share(done: int) -> None:
+        report(done * total // max(share, 1))
+
+    with open_output(out, overwrite=overwrite) as target, gc_paused():
+        bbox = _bbox_member(_rounded(cells_extent(diagram), precision)) if (has_ring | has_cut).any() else b""
+        second = None
+        if split < n_sites:
+            try:
+                second = forked.ForkedPart(target, lambda file: emit(_Framing(file, layout, b"", opened=True),
+                                                                     split, n_sites, None))
+            except OSError:
+                # no room for the temporary file, or no process to be had: one process writes it all
+                split, share = n_sites, total
+        try:
+            report(0)
+            with background(target) as stream:
+                frame = _Framing(stream, layout, bbox)
+                done = emit(frame, 0, split, report_share)
+            if second is not None:
+                done += second.append_to(target)
+                second = None
+        except BaseException:
+            if second is not None:
+                second.abandon()
+            raise
+        frame.stream = target
         frame.close()
+        report(done)
     return done
 
 
@@ -443,7 +542,7 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
     """
     triangles = np.asarray(diagram.triangles, dtype=np.int64).reshape(-1, 3)
     total = len(triangles)
-    with open_output(out, overwrite=overwrite) as stream, gc_paused():
+    with open_output(out, overwrite=overwrite) as target, gc_paused(), background(target) as stream:
         bbox = b""
         if total:
             used = np.zeros(diagram.n_sites, bool)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.readers.text_column import TextColumn
 
 from .targets import open_output
 
@@ -110,6 +111,8 @@ def projjson(crs) -> dict | None:
 
 def _typed_column(pa, values: list):
     """An Arrow array of one property: its own type when the values share one, else JSON text."""
+    if isinstance(values, TextColumn):
+        return values.to_arrow()
     try:
         return pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
@@ -221,7 +224,7 @@ def _write(pa, table, out, overwrite: bool) -> None:
     import pyarrow.parquet as pq
 
     with open_output(out, overwrite=overwrite) as stream:
-        pq.write_table(table, pa.PythonFile(stream, mode="w"), compression="zstd")
+        pq.write_table(table, pa.PythonFile(stream, mode="w"), **_parquet_options(table.schema))
 
 
 def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=None) -> int:
@@ -269,7 +272,8 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
                 values = [points.records[i].get(name) for i in kept.tolist()]
             else:
                 values = points.columns[name]
-                values = values if len(kept) == n_sites else [values[i] for i in kept.tolist()]
+                if len(kept) < n_sites:
+                    values = [values[i] for i in kept.tolist()]
             columns[renames.get(name, name)] = _typed_column(pa, values)
     columns["duplicates"] = _duplicates_column(pa, diagram, kept)
     if getattr(diagram, "clipped", None) is not None:
@@ -285,25 +289,49 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     schema = pa.schema([pa.field(name, column.type) for name, column in columns.items()]
                        + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))])
     schema = schema.with_metadata({b"geo": _geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
+    from concurrent.futures import ThreadPoolExecutor
+
     import pyarrow.parquet as pq
 
-    with open_output(out, overwrite=overwrite) as stream:
-        with pq.ParquetWriter(pa.PythonFile(stream, mode="w"), schema, compression="zstd") as writer:
-            for a in range(0, max(len(kept), 1), ROW_GROUP):
-                b = min(a + ROW_GROUP, len(kept))
-                if a == b:
-                    writer.write_table(schema.empty_table())
-                    break
-                # rows ra..rb-1 hold the kept rows a..b-1 and the repeats between them (no ring)
-                ra, rb = int(kept[a]), int(kept[b - 1]) + 1
-                xy, first, last = closed_rings(diagram, ra, rb, has_ring[ra:rb])
-                ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
-                geometry, bbox, _ = _polygons(pa, xy, ring_offsets, present[a:b])
-                del xy
-                group = {name: column.slice(a, b - a) for name, column in columns.items()}
-                group["geometry"], group["bbox"] = geometry, bbox
-                writer.write_table(pa.table(group, schema=schema))
+    def row_group(a: int, b: int):
+        # rows ra..rb-1 hold the kept rows a..b-1 and the repeats between them (no ring)
+        ra, rb = int(kept[a]), int(kept[b - 1]) + 1
+        xy, first, last = closed_rings(diagram, ra, rb, has_ring[ra:rb])
+        ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
+        geometry, bbox, _ = _polygons(pa, xy, ring_offsets, present[a:b])
+        group = {name: column.slice(a, b - a) for name, column in columns.items()}
+        group["geometry"], group["bbox"] = geometry, bbox
+        return pa.table(group, schema=schema)
+
+    with open_output(out, overwrite=overwrite) as stream, ThreadPoolExecutor(1) as pool:
+        with pq.ParquetWriter(pa.PythonFile(stream, mode="w"), schema, **_parquet_options(schema)) as writer:
+            if not len(kept):
+                writer.write_table(schema.empty_table())
+            # a row group is encoded and compressed (without the GIL) while the next one is made
+            pending = None
+            for a in range(0, len(kept), ROW_GROUP):
+                group = row_group(a, min(a + ROW_GROUP, len(kept)))
+                if pending is not None:
+                    pending.result()
+                pending = pool.submit(writer.write_table, group)
+                del group
+            if pending is not None:
+                pending.result()
     return len(kept)
+
+
+def _parquet_options(schema) -> dict:
+    """How the columns are written: zstd at level 1 (at the default level compressing the
+    geometry takes twice as long for a file a few percent smaller), dictionaries for the
+    properties only (a geometry, a bbox or a site number hardly repeats), statistics for
+    every column but the geometry (the bbox columns' let a reader skip row groups)."""
+    own = {"site", "duplicates", "geometry", "bbox", "sites"}
+    properties = [name for name in schema.names if name not in own]
+    statistics = [name for name in schema.names if name not in ("geometry", "bbox")]
+    if "bbox" in schema.names:
+        statistics += [f"bbox.{k}" for k in ("xmin", "ymin", "xmax", "ymax")]
+    return dict(compression="zstd", compression_level=1, use_dictionary=properties or False,
+                write_statistics=statistics)
 
 
 def _BBOX_TYPE(pa):
@@ -319,7 +347,7 @@ def _rings_extent(diagram, has_ring: np.ndarray) -> list[float] | None:
         return None
     used = np.zeros(len(diagram.cell_points), bool)
     used[ring] = True
-    xy = diagram.cell_points[used]
+    xy = diagram.cell_points if used.all() else diagram.cell_points[used]
     return [*xy.min(axis=0).tolist(), *xy.max(axis=0).tolist()]
 
 

@@ -1,0 +1,157 @@
+"""The second half of an output made by a forked process, on the second core, and appended when the first half is written.
+
+Serializing a million cells to JSON holds the GIL (orjson, bytes joins), so a thread cannot
+share the work; a forked child can: it sees the diagram as it is (copy on write, nothing is
+copied), writes its part to an unnamed temporary file, and the parent appends that file to
+the output once its own part is written (``sendfile``, within the kernel).
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import shutil
+import signal
+import stat
+import sys
+import tempfile
+import threading
+from typing import BinaryIO, Callable
+
+from tvoronoi.errors import TvoronoiError
+
+# outputs of fewer features are written by one process: a fork costs a few milliseconds
+MIN_FEATURES = 100_000
+WRITE_BUFFER = 1 << 20
+# what the child reports on its pipe: "ok COUNT", or the kind of error and its message
+_OK, _TVORONOI, _OS = b"ok", b"tvoronoi", b"os"
+
+
+def can_fork() -> bool:
+    """Whether a part of an output can be made by a forked process here: on Linux (fork is cheap),
+    from the main thread (the batch command; an application saving from a worker thread, such
+    as the terminal UI, has threads of its own that may hold locks when it forks)."""
+    return (sys.platform.startswith("linux") and hasattr(os, "fork")
+            and threading.current_thread() is threading.main_thread())
+
+
+class ForkedPart:
+    """Runs ``write_part(file)`` in a forked child, into a temporary file, while the caller goes on.
+
+    ``write_part`` returns a count (of features written), handed back by :meth:`append_to`.
+    Fork before starting any thread of one's own: the child has only the forking thread.
+    """
+
+    def __init__(self, stream: BinaryIO, write_part: Callable[[BinaryIO], int]):
+        self.pid: int | None = None
+        self.part = tempfile.TemporaryFile(dir=_directory_of(stream))
+        try:
+            read_end, write_end = os.pipe()
+        except OSError:
+            self.part.close()
+            raise
+        sys.stdout.flush()
+        sys.stderr.flush()
+        try:
+            pid = os.fork()
+        except OSError:
+            for fd in (read_end, write_end):
+                os.close(fd)
+            self.part.close()
+            raise
+        if pid == 0:  # the child: write, report, and leave without running the parent's exit code
+            os.close(read_end)
+            status, report = 1, _TVORONOI + b" the second half of the output failed"
+            try:
+                signal.signal(signal.SIGINT, signal.SIG_DFL)
+                with os.fdopen(os.dup(self.part.fileno()), "wb", buffering=WRITE_BUFFER) as file:
+                    count = write_part(file)
+                status, report = 0, b"%b %d" % (_OK, count)
+            except TvoronoiError as e:
+                report = _TVORONOI + b" " + str(e).encode()
+            except OSError as e:
+                report = b"%b %d %b" % (_OS, e.errno or 0, (e.strerror or str(e)).encode())
+            except BaseException as e:  # noqa: BLE001 (reported to the parent, which raises)
+                report = _TVORONOI + b" " + f"the second half of the output failed: {e!r}".encode()
+            finally:
+                try:
+                    os.write(write_end, report)
+                finally:
+                    os._exit(status)
+        os.close(write_end)
+        self.pid, self.reports = pid, read_end
+
+    def append_to(self, stream: BinaryIO) -> int:
+        """Wait for the child, append its part to ``stream``; return its count. Raise its error."""
+        report = self._wait()
+        kind, _, rest = report.partition(b" ")
+        if kind == _OS:
+            code, _, message = rest.partition(b" ")
+            raise OSError(int(code), message.decode(errors="replace"))
+        if kind != _OK:
+            raise TvoronoiError(rest.decode(errors="replace"))
+        try:
+            _copy(self.part, stream)
+        finally:
+            self.part.close()
+        return int(rest)
+
+    def abandon(self) -> None:
+        """Stop the child (the run failed) and drop its part."""
+        if self.pid is not None:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            self._wait()
+        self.part.close()
+
+    def _wait(self) -> bytes:
+        chunks = []
+        while chunk := os.read(self.reports, 1 << 16):
+            chunks.append(chunk)
+        os.close(self.reports)
+        assert self.pid is not None
+        os.waitpid(self.pid, 0)
+        self.pid = None
+        return b"".join(chunks)
+
+
+def _directory_of(stream) -> str | None:
+    """The directory of a regular file being written (its part goes beside it, on the same disk);
+    None (the temporary directory) for anything else."""
+    try:
+        fd = stream.fileno()
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            return os.path.dirname(os.readlink(f"/proc/self/fd/{fd}"))
+    except (OSError, AttributeError, ValueError):
+        pass
+    return None
+
+
+def _copy(part: BinaryIO, stream: BinaryIO) -> None:
+    """Append the whole of ``part`` to ``stream``: in the kernel when both are descriptors."""
+    part.seek(0, os.SEEK_END)
+    size = part.tell()
+    part.seek(0)
+    try:
+        fd = stream.fileno()
+    except (OSError, AttributeError, ValueError):
+        fd = None
+    if fd is None:
+        shutil.copyfileobj(part, stream, WRITE_BUFFER)
+        return
+    stream.flush()
+    offset = 0
+    while offset < size:
+        try:
+            sent = os.sendfile(fd, part.fileno(), offset, size - offset)
+        except OSError as e:
+            if offset or e.errno not in (errno.EINVAL, errno.ENOSYS):
+                raise
+            # a descriptor sendfile does not write to
+            shutil.copyfileobj(part, stream, WRITE_BUFFER)
+            return
+        if sent == 0:
+            raise OSError(f"the output took no more bytes after {offset} of {size}")
+        offset += sent
