@@ -143,7 +143,8 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--lloyd", type=int, metavar="N",
                        help="Lloyd relaxation: move each site to its cell's centroid N times, then write the cells")
     batch.add_argument("--delaunay", metavar="FILE",
-                       help='also write the Delaunay triangles as GeoJSON ("-" for stdout)')
+                       help='also write the Delaunay triangles, in the format of its extension or --to ("-" for '
+                            'stdout); with --dask, a new directory of parts')
     batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
     batch.add_argument("--y", metavar="COL", help="y column of a table: a name, a 0-based index or colN")
     batch.add_argument("--format", choices=FORMATS, help="input format; default: from the extension, else the content")
