@@ -494,3 +494,49 @@ def test_the_scene_finds_its_delaunay_edges_when_first_shown():
     expected = {frozenset(map(tuple, points[[a, b]].tolist())) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
     got = [frozenset(map(tuple, (e[:2].tolist(), e[2:].tolist()))) for e in edges]
     assert len(got) == len(set(got)) and set(got) == expected
+
+
+@pytest.mark.parametrize("name", ["uniform-2000", "clustered", "grid"])
+def test_a_scene_drawn_from_its_edge_mesh_equals_one_drawn_from_its_segments(name):
+    """The edges drawn as pairs of points (each point mapped once, a side within one dot left to
+    its ends) set the same dots as the same edges drawn as segments, zoomed out and in, panned
+    by parts of characters, and in windows of the canvas."""
+    from tvoronoi.tui.raster import redraw_part
+
+    points = generate("uniform", 2000, seed=12) if name == "uniform-2000" else DATASETS[name]
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    assert scene.edge_mesh is not None
+    plain = Scene(sites=scene.sites, edges=scene.edge_mesh.segments(), vertices=scene.vertices,
+                  colours=scene.colours, bbox=scene.bbox)
+    cols, rows = 50, 20
+    fit = View.fit(scene.bbox, cols, rows)
+    x0, y0, x1, y1 = scene.bbox
+    views = [fit, fit.zoomed(0.3), fit.zoomed(7.0), fit.zoomed(60.0, (x0, y1)),
+             fit.zoomed(4.0).panned(3.5, -17.25), fit.zoomed(2.0, (x1, y0)).panned(2, 4)]
+    for view in views:
+        got = rasterize(scene, view, cols, rows, vertices=False)
+        want = rasterize(plain, view, cols, rows, vertices=False)
+        assert np.array_equal(got.codes, want.codes) and np.array_equal(got.mark, want.mark)
+        assert got.codes.any()
+        for span in [(0, 0, 7, 5), (13, 4, 40, 19), (cols - 3, rows - 2, cols, rows)]:
+            redraw_part(got, scene, view, cols, rows, span, vertices=False)
+            assert np.array_equal(got.codes, want.codes)
+
+
+def test_an_edge_mesh_sets_the_ends_it_names_and_no_other_point():
+    """A mesh draws the dots of its sides (a long one: the dots between its ends; a short one
+    crossing into the next dot row: its two ends) and no dot of a point that ends no side."""
+    from tvoronoi.tui.raster import EdgeMesh, Painter
+
+    view = View.fit((0.0, 0.0, 1.0, 1.0), 20, 10)
+    # in dots: a long flat side, a short side across a dot row, a lone point
+    u = np.array([3.5, 30.5, 5.2, 5.8, 12.5])
+    v = np.array([20.5, 21.5, 5.9, 6.3, 30.5])
+    points = np.column_stack(view.to_world(u, v, 20, 10))
+    mesh = EdgeMesh(points, np.array([0, 2]), np.array([1, 3]), ends=np.array([0, 1, 2, 3]))
+    paint = Painter(view, 20, 10)
+    paint.mesh(EDGE, mesh)
+    dots = np.zeros((40, 40), bool)
+    segment_dots(dots, u[[0, 2]], v[[0, 2]], u[[1, 3]], v[[1, 3]])
+    assert dots[5, 5] and dots[6, 5] and not dots[30, 12]
+    assert np.array_equal(paint.codes, pack_braille(dots))

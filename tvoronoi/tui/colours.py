@@ -184,11 +184,12 @@ def cell_adjacency(diagram) -> tuple[np.ndarray, np.ndarray]:
 
     Returns
     -------
-    (a, b) : two (k,) int64 arrays with ``a < b``, in half-edge order.
+    (a, b) : two (k,) integer arrays (the half-edges' type) with ``a < b``, in half-edge order.
     """
-    faces = np.asarray(diagram.he_face, np.int64)
-    twins = np.asarray(diagram.he_twin, np.int64)
-    keep = (twins > np.arange(twins.size)) & (faces >= 0)
+    faces = np.asarray(diagram.he_face)
+    twins = np.asarray(diagram.he_twin)
+    keep = twins > np.arange(twins.size, dtype=twins.dtype)
+    keep &= faces >= 0
     a = faces[keep]
     b = faces[twins[keep]]
     keep = (b >= 0) & (a != b)
@@ -309,9 +310,7 @@ def colour_graph(n: int, a: np.ndarray, b: np.ndarray, n_colours: int = MAX_COLO
 
 def _add_colours(taken: np.ndarray, owners: np.ndarray, colours: np.ndarray, n_colours: int) -> None:
     """Set bit ``colours[j]`` of ``taken[owners[j]]`` for every j (owners may repeat)."""
-    for c in range(n_colours):
-        # repeated owners all write the same value, so one fancy-index update is exact
-        taken[owners[colours == c]] |= np.uint8(1 << c)
+    np.bitwise_or.at(taken, owners, np.left_shift(np.uint8(1), colours.astype(np.uint8)))
 
 
 def _lowest_bit(x: np.ndarray) -> np.ndarray:

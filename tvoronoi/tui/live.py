@@ -190,6 +190,11 @@ class LiveScene:
         return self._cells.array
 
     @property
+    def edge_mesh(self) -> None:
+        """The edges are kept cell by cell, as segments (``edges``)."""
+        return None
+
+    @property
     def delaunay(self) -> np.ndarray:
         return self._links.array
 
