@@ -314,6 +314,13 @@ class EdgeMesh:
     b: np.ndarray
     ends: np.ndarray | None = None
 
+    def box(self) -> tuple[float, float, float, float]:
+        """The box (xmin, ymin, xmax, ymax) around the points."""
+        if not len(self.points):
+            return (np.inf, np.inf, -np.inf, -np.inf)
+        xs, ys = self.points[:, 0], self.points[:, 1]  # a column at a time: much faster than axis=0
+        return float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max())
+
     def segments(self) -> np.ndarray:
         """The sides as (k, 4) segments x0, y0, x1, y1."""
         if not self.a.size:
@@ -651,6 +658,7 @@ class Painter:
         each point is mapped to the screen once, each end's dot set once, and a side with both
         ends in one dot (most of them, zoomed out) adds no dot beyond its ends."""
         points, a, b = mesh.points, mesh.a, mesh.b
+        box = mesh.box()
 
         def draw(dots, origin, world) -> None:
             height, width = dots.shape
@@ -659,16 +667,21 @@ class Painter:
             col, row = np.floor(u) - ou, np.floor(v) - ov
             inside = (col >= 0) & (col < width) & (row >= 0) & (row < height)  # False for NaN
             # the dot of each point in the window; beyond it a number no other point has
-            dot = np.where(inside, row * width + col, -1.0 - np.arange(len(points)))
+            dot = (row * width + col).astype(np.int32) if inside.all() else np.where(
+                inside, row * width + col, -1.0 - np.arange(len(points))).astype(np.int64)
             # the ends, each point once
-            ends = np.flatnonzero(inside) if mesh.ends is None else mesh.ends[inside[mesh.ends]]
-            dots.ravel()[dot[ends].astype(np.int64)] = True
+            ends = dot[inside] if mesh.ends is None else dot[mesh.ends[inside[mesh.ends]]]
+            dots.ravel()[ends] = True
             # a side within one dot has no dot but its ends'
+            apart = dot[a] != dot[b]
             x0, y0, x1, y1 = world
-            beyond = (((points[:, 0] < x0).astype(np.uint8)) | ((points[:, 0] > x1).astype(np.uint8) << 1)
-                      | ((points[:, 1] < y0).astype(np.uint8) << 2) | ((points[:, 1] > y1).astype(np.uint8) << 3))
-            # ... and one whose ends lie beyond one side of the window has none here
-            rest = np.flatnonzero((dot[a] != dot[b]) & ((beyond[a] & beyond[b]) == 0))
+            if not (x0 <= box[0] and y0 <= box[1] and box[2] <= x1 and box[3] <= y1):
+                # ... and one whose ends lie beyond one side of the window has none here
+                xs, ys = points[:, 0], points[:, 1]
+                beyond = ((xs < x0).view(np.uint8) | ((xs > x1).view(np.uint8) << 1)
+                          | ((ys < y0).view(np.uint8) << 2) | ((ys > y1).view(np.uint8) << 3))
+                apart &= (beyond[a] & beyond[b]) == 0
+            rest = np.flatnonzero(apart)
             if rest.size:
                 ra, rb = a[rest], b[rest]
                 segment_dots(dots, u[ra], v[ra], u[rb], v[rb], origin=origin, ends=False)
