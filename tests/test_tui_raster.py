@@ -164,6 +164,30 @@ def test_every_site_lies_in_a_character_of_its_own_fill():
     assert agree.mean() > 0.8
 
 
+def test_a_dense_diagram_fills_every_character_inside_its_box():
+    """Zoomed out on many sites, the characters without a dot (inside the large cells of the
+    box's corners, beyond the sites' extent) still show their cell's colour: every character
+    whose centre lies in the box has the fill of the cell of the nearest site, and the others
+    none."""
+    from scipy.spatial import cKDTree
+
+    from tvoronoi.tui.raster import char_centres
+
+    points = generate("uniform", 60_000, seed=2)
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    cols, rows = 80, 22
+    view = View.fit(scene.bbox, cols, rows)
+    frame = rasterize(scene, view, cols, rows)
+    xs, ys = char_centres(view, cols, rows)
+    gx, gy = np.meshgrid(xs, ys)
+    x0, y0, x1, y1 = scene.bbox
+    inside = (gx >= x0) & (gx <= x1) & (gy >= y0) & (gy <= y1)
+    _, nearest = cKDTree(points).query(np.column_stack([gx[inside], gy[inside]]))
+    assert np.array_equal(frame.fill[inside], scene.colours[nearest])
+    assert (frame.fill[~inside] == -1).all()
+    assert ((frame.codes == 0) & inside).any()  # some characters inside are blank and filled
+
+
 @pytest.mark.parametrize("name", ["uniform", "clustered", "grid", "circle", "collinear", "duplicates", "two"])
 def test_neighbouring_cells_never_share_a_colour(name):
     diagram = tvoronoi.voronoi(DATASETS[name])
