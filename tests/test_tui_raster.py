@@ -10,7 +10,11 @@ from conftest import DATASETS
 from tvoronoi.generators import generate
 from tvoronoi.tui.colours import DARK, LIGHT, cell_adjacency, cell_colours, colour_graph
 from tvoronoi.tui.dots import BRAILLE_BLANK, DOT_COLS, DOT_ROWS, braille_text, pack_braille, point_dots, segment_dots
-from tvoronoi.tui.raster import EDGE, SITE, Scene, View, frame_lines, rasterize
+from tvoronoi.tui.layers import EDGE, SITE
+from tvoronoi.tui.raster import rasterize
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.styles import frame_lines
+from tvoronoi.tui.viewport import View
 
 
 def test_dot_bits_follow_the_braille_standard():
@@ -171,7 +175,7 @@ def test_a_dense_diagram_fills_every_character_inside_its_box():
     none."""
     from scipy.spatial import cKDTree
 
-    from tvoronoi.tui.raster import char_centres
+    from tvoronoi.tui.viewport import char_centres
 
     points = generate("uniform", 60_000, seed=2)
     scene = Scene.from_diagram(tvoronoi.voronoi(points))
@@ -294,7 +298,7 @@ def test_the_keyboard_cursor_lights_up_its_cell_and_keeps_the_site_under_it():
     """The cursor on a site: the site's character keeps its mark and the cell's own colour,
     lit up, not a block of the cursor's colour."""
     from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-    from tvoronoi.tui.raster import CURSOR, HIGHLIGHTED, N_FILLS
+    from tvoronoi.tui.layers import CURSOR, HIGHLIGHTED, N_FILLS
 
     diagram = tvoronoi.voronoi(generate("uniform", 30, seed=3))
     scene = Scene.from_diagram(diagram)
@@ -332,7 +336,7 @@ def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(mon
     """Frames drawn through a LayerCache equal frames drawn afresh; a frame that only shows the
     Delaunay edges again draws no other layer, and another scene, view or size draws all."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     diagram = tvoronoi.voronoi(generate("uniform", 500, seed=3))
     scene = Scene.from_diagram(diagram)
@@ -368,7 +372,7 @@ def test_the_layer_cache_keeps_recent_views_and_lets_other_scenes_go(monkeypatch
     draws nothing again and gives the same frame as a fresh drawing; an older view, or a view of
     a scene replaced since, is drawn again."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LAYER_FRAMES_KEPT, LayerCache
+    from tvoronoi.tui.layers import LAYER_FRAMES_KEPT, LayerCache
 
     scene = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=6)))
     other = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=7)))
@@ -426,7 +430,7 @@ def test_a_panned_layer_shifted_from_the_cache_equals_a_fresh_drawing(monkeypatc
     the canvas; only the strips are drawn (few sites and edges), and a pan by part of a
     character draws the whole layer."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     diagram = tvoronoi.voronoi(generate("uniform", 3000, seed=8))
     scene = Scene.from_diagram(diagram)
@@ -457,7 +461,7 @@ def test_a_panned_layer_shifted_from_the_cache_equals_a_fresh_drawing(monkeypatc
 def test_the_layer_cache_follows_a_live_scene_edited_in_place():
     from tvoronoi.tui.building import build
     from tvoronoi.tui.editing import make_live
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     built = build(generate("uniform", 200, seed=5), "incremental", "test", clock=lambda: 0.0)
     live = make_live(built)
@@ -474,7 +478,7 @@ def test_the_layer_cache_follows_a_live_scene_edited_in_place():
 def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
     """The one rings-to-sides routine: each entry's successor is the next of its ring, the last
     going back to the first, whatever the empty rings between."""
-    from tvoronoi.tui.raster import ring_next, ring_segments
+    from tvoronoi.tui.scene import ring_next, ring_segments
 
     sizes = [3, 0, 1, 4, 0, 2]
     offsets = np.concatenate([[0], np.cumsum(sizes)])
@@ -490,7 +494,7 @@ def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
 def test_scene_edges_are_each_cell_side_once(name):
     """The scene keeps each side of the cells once (a side between two cells from one of them, a
     side along the box from its cell): the same set as sorting every side and dropping repeats."""
-    from tvoronoi.tui.raster import _unique_pairs, ring_next
+    from tvoronoi.tui.scene import _unique_pairs, ring_next
 
     diagram = tvoronoi.voronoi(DATASETS[name])
     offsets = np.asarray(diagram.cell_offsets, np.int64)
@@ -550,7 +554,8 @@ def test_a_scene_drawn_from_its_edge_mesh_equals_one_drawn_from_its_segments(nam
 def test_an_edge_mesh_sets_the_ends_it_names_and_no_other_point():
     """A mesh draws the dots of its sides (a long one: the dots between its ends; a short one
     crossing into the next dot row: its two ends) and no dot of a point that ends no side."""
-    from tvoronoi.tui.raster import EdgeMesh, Painter
+    from tvoronoi.tui.raster import Painter
+    from tvoronoi.tui.scene import EdgeMesh
 
     view = View.fit((0.0, 0.0, 1.0, 1.0), 20, 10)
     # in dots: a long flat side, a short side across a dot row, a lone point

@@ -20,7 +20,7 @@ import numpy.typing as npt
 from tvoronoi.trace import FortuneStep, IncrementalStep, parabola_y
 from tvoronoi.tui.colours import adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, clip_segments
-from tvoronoi.tui.raster import (
+from tvoronoi.tui.layers import (
     BEACH,
     CIRCLE,
     CONFLICT,
@@ -28,17 +28,13 @@ from tvoronoi.tui.raster import (
     EVENT,
     FUTURE,
     GROWING,
-    SPARSE_SITES_PER_CHAR,
     SWEEP,
     TINTED,
     WALK,
-    Painter,
-    Scene,
-    View,
-    ViewLike,
-    char_centres,
-    per_char,
 )
+from tvoronoi.tui.raster import SPARSE_SITES_PER_CHAR, Painter, per_char
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.viewport import View, ViewLike, char_centres
 
 # Circles are drawn as polygons with about one corner per this many dots of
 # circumference, and between these many corners.
