@@ -14,7 +14,7 @@ import tvoronoi
 from tvoronoi.errors import EngineError
 from tvoronoi.generators import generate
 from tvoronoi.tui.app import VoronoiApp
-from tvoronoi.tui.raster import View
+from tvoronoi.tui.viewport import View
 from tvoronoi.tui.screens import HelpScreen, PathDialog
 
 SIZE = (100, 40)
@@ -624,7 +624,7 @@ async def test_no_color_draws_no_fills_and_sites_stand_out(monkeypatch):
     """With NO_COLOR the cells are not filled (their greys would look alike) and every
     site is a bold block of dots in the brightest colour."""
     from tvoronoi.tui.colours import PLAIN_DARK
-    from tvoronoi.tui.raster import SITE
+    from tvoronoi.tui.layers import SITE
 
     monkeypatch.setenv("NO_COLOR", "1")
     app = make_app(points=generate("uniform", 300, seed=0))

@@ -15,7 +15,9 @@ from tvoronoi.generators import generate
 from tvoronoi.tui.building import build
 from tvoronoi.tui.editing import make_live
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-from tvoronoi.tui.raster import View, cell_owner, rasterize, redraw_part
+from tvoronoi.tui.raster import rasterize, redraw_part
+from tvoronoi.tui.scene import cell_owner
+from tvoronoi.tui.viewport import View
 
 
 def toasts(app) -> list[str]:

@@ -18,7 +18,8 @@ from tvoronoi.tui.colours import DARK, LIGHT
 from tvoronoi.tui.commands import app_commands
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.export import PX_PER_DOT, picture, png_bytes, rasterise, to_svg, view_window
-from tvoronoi.tui.raster import Scene, View
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.viewport import View
 from tvoronoi.tui.screens import PathDialog
 
 SVG = "{http://www.w3.org/2000/svg}"

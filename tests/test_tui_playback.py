@@ -15,7 +15,7 @@ from tvoronoi.tui import playback
 from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
 from tvoronoi.tui.screens import SampleDialog
-from tvoronoi.tui.raster import (
+from tvoronoi.tui.layers import (
     BEACH,
     CIRCLE,
     CONFLICT,
@@ -26,11 +26,11 @@ from tvoronoi.tui.raster import (
     SWEEP,
     TINTED,
     WALK,
-    Scene,
-    View,
-    frame_lines,
-    rasterize,
 )
+from tvoronoi.tui.raster import rasterize
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.styles import frame_lines
+from tvoronoi.tui.viewport import View
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 
 

@@ -10,7 +10,11 @@ from conftest import DATASETS
 from tvoronoi.generators import generate
 from tvoronoi.tui.colours import DARK, LIGHT, cell_adjacency, cell_colours, colour_graph
 from tvoronoi.tui.dots import BRAILLE_BLANK, DOT_COLS, DOT_ROWS, braille_text, pack_braille, point_dots, segment_dots
-from tvoronoi.tui.raster import EDGE, SITE, Scene, View, frame_lines, rasterize
+from tvoronoi.tui.layers import EDGE, SITE
+from tvoronoi.tui.raster import rasterize
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.styles import frame_lines
+from tvoronoi.tui.viewport import View
 
 
 def test_dot_bits_follow_the_braille_standard():
@@ -164,6 +168,30 @@ def test_every_site_lies_in_a_character_of_its_own_fill():
     assert agree.mean() > 0.8
 
 
+def test_a_dense_diagram_fills_every_character_inside_its_box():
+    """Zoomed out on many sites, the characters without a dot (inside the large cells of the
+    box's corners, beyond the sites' extent) still show their cell's colour: every character
+    whose centre lies in the box has the fill of the cell of the nearest site, and the others
+    none."""
+    from scipy.spatial import cKDTree
+
+    from tvoronoi.tui.viewport import char_centres
+
+    points = generate("uniform", 60_000, seed=2)
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    cols, rows = 80, 22
+    view = View.fit(scene.bbox, cols, rows)
+    frame = rasterize(scene, view, cols, rows)
+    xs, ys = char_centres(view, cols, rows)
+    gx, gy = np.meshgrid(xs, ys)
+    x0, y0, x1, y1 = scene.bbox
+    inside = (gx >= x0) & (gx <= x1) & (gy >= y0) & (gy <= y1)
+    _, nearest = cKDTree(points).query(np.column_stack([gx[inside], gy[inside]]))
+    assert np.array_equal(frame.fill[inside], scene.colours[nearest])
+    assert (frame.fill[~inside] == -1).all()
+    assert ((frame.codes == 0) & inside).any()  # some characters inside are blank and filled
+
+
 @pytest.mark.parametrize("name", ["uniform", "clustered", "grid", "circle", "collinear", "duplicates", "two"])
 def test_neighbouring_cells_never_share_a_colour(name):
     diagram = tvoronoi.voronoi(DATASETS[name])
@@ -270,7 +298,7 @@ def test_the_keyboard_cursor_lights_up_its_cell_and_keeps_the_site_under_it():
     """The cursor on a site: the site's character keeps its mark and the cell's own colour,
     lit up, not a block of the cursor's colour."""
     from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-    from tvoronoi.tui.raster import CURSOR, HIGHLIGHTED, N_FILLS
+    from tvoronoi.tui.layers import CURSOR, HIGHLIGHTED, N_FILLS
 
     diagram = tvoronoi.voronoi(generate("uniform", 30, seed=3))
     scene = Scene.from_diagram(diagram)
@@ -308,7 +336,7 @@ def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(mon
     """Frames drawn through a LayerCache equal frames drawn afresh; a frame that only shows the
     Delaunay edges again draws no other layer, and another scene, view or size draws all."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     diagram = tvoronoi.voronoi(generate("uniform", 500, seed=3))
     scene = Scene.from_diagram(diagram)
@@ -344,7 +372,7 @@ def test_the_layer_cache_keeps_recent_views_and_lets_other_scenes_go(monkeypatch
     draws nothing again and gives the same frame as a fresh drawing; an older view, or a view of
     a scene replaced since, is drawn again."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LAYER_FRAMES_KEPT, LayerCache
+    from tvoronoi.tui.layers import LAYER_FRAMES_KEPT, LayerCache
 
     scene = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=6)))
     other = Scene.from_diagram(tvoronoi.voronoi(generate("uniform", 400, seed=7)))
@@ -402,7 +430,7 @@ def test_a_panned_layer_shifted_from_the_cache_equals_a_fresh_drawing(monkeypatc
     the canvas; only the strips are drawn (few sites and edges), and a pan by part of a
     character draws the whole layer."""
     from tvoronoi.tui import raster
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     diagram = tvoronoi.voronoi(generate("uniform", 3000, seed=8))
     scene = Scene.from_diagram(diagram)
@@ -433,7 +461,7 @@ def test_a_panned_layer_shifted_from_the_cache_equals_a_fresh_drawing(monkeypatc
 def test_the_layer_cache_follows_a_live_scene_edited_in_place():
     from tvoronoi.tui.building import build
     from tvoronoi.tui.editing import make_live
-    from tvoronoi.tui.raster import LayerCache
+    from tvoronoi.tui.layers import LayerCache
 
     built = build(generate("uniform", 200, seed=5), "incremental", "test", clock=lambda: 0.0)
     live = make_live(built)
@@ -450,7 +478,7 @@ def test_the_layer_cache_follows_a_live_scene_edited_in_place():
 def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
     """The one rings-to-sides routine: each entry's successor is the next of its ring, the last
     going back to the first, whatever the empty rings between."""
-    from tvoronoi.tui.raster import ring_next, ring_segments
+    from tvoronoi.tui.scene import ring_next, ring_segments
 
     sizes = [3, 0, 1, 4, 0, 2]
     offsets = np.concatenate([[0], np.cumsum(sizes)])
@@ -466,7 +494,7 @@ def test_ring_next_goes_round_each_ring_and_skips_empty_ones():
 def test_scene_edges_are_each_cell_side_once(name):
     """The scene keeps each side of the cells once (a side between two cells from one of them, a
     side along the box from its cell): the same set as sorting every side and dropping repeats."""
-    from tvoronoi.tui.raster import _unique_pairs, ring_next
+    from tvoronoi.tui.scene import _unique_pairs, ring_next
 
     diagram = tvoronoi.voronoi(DATASETS[name])
     offsets = np.asarray(diagram.cell_offsets, np.int64)
@@ -494,3 +522,50 @@ def test_the_scene_finds_its_delaunay_edges_when_first_shown():
     expected = {frozenset(map(tuple, points[[a, b]].tolist())) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
     got = [frozenset(map(tuple, (e[:2].tolist(), e[2:].tolist()))) for e in edges]
     assert len(got) == len(set(got)) and set(got) == expected
+
+
+@pytest.mark.parametrize("name", ["uniform-2000", "clustered", "grid"])
+def test_a_scene_drawn_from_its_edge_mesh_equals_one_drawn_from_its_segments(name):
+    """The edges drawn as pairs of points (each point mapped once, a side within one dot left to
+    its ends) set the same dots as the same edges drawn as segments, zoomed out and in, panned
+    by parts of characters, and in windows of the canvas."""
+    from tvoronoi.tui.raster import redraw_part
+
+    points = generate("uniform", 2000, seed=12) if name == "uniform-2000" else DATASETS[name]
+    scene = Scene.from_diagram(tvoronoi.voronoi(points))
+    assert scene.edge_mesh is not None
+    plain = Scene(sites=scene.sites, edges=scene.edge_mesh.segments(), vertices=scene.vertices,
+                  colours=scene.colours, bbox=scene.bbox)
+    cols, rows = 50, 20
+    fit = View.fit(scene.bbox, cols, rows)
+    x0, y0, x1, y1 = scene.bbox
+    views = [fit, fit.zoomed(0.3), fit.zoomed(7.0), fit.zoomed(60.0, (x0, y1)),
+             fit.zoomed(4.0).panned(3.5, -17.25), fit.zoomed(2.0, (x1, y0)).panned(2, 4)]
+    for view in views:
+        got = rasterize(scene, view, cols, rows, vertices=False)
+        want = rasterize(plain, view, cols, rows, vertices=False)
+        assert np.array_equal(got.codes, want.codes) and np.array_equal(got.mark, want.mark)
+        assert got.codes.any()
+        for span in [(0, 0, 7, 5), (13, 4, 40, 19), (cols - 3, rows - 2, cols, rows)]:
+            redraw_part(got, scene, view, cols, rows, span, vertices=False)
+            assert np.array_equal(got.codes, want.codes)
+
+
+def test_an_edge_mesh_sets_the_ends_it_names_and_no_other_point():
+    """A mesh draws the dots of its sides (a long one: the dots between its ends; a short one
+    crossing into the next dot row: its two ends) and no dot of a point that ends no side."""
+    from tvoronoi.tui.raster import Painter
+    from tvoronoi.tui.scene import EdgeMesh
+
+    view = View.fit((0.0, 0.0, 1.0, 1.0), 20, 10)
+    # in dots: a long flat side, a short side across a dot row, a lone point
+    u = np.array([3.5, 30.5, 5.2, 5.8, 12.5])
+    v = np.array([20.5, 21.5, 5.9, 6.3, 30.5])
+    points = np.column_stack(view.to_world(u, v, 20, 10))
+    mesh = EdgeMesh(points, np.array([0, 2]), np.array([1, 3]), ends=np.array([0, 1, 2, 3]))
+    paint = Painter(view, 20, 10)
+    paint.mesh(EDGE, mesh)
+    dots = np.zeros((40, 40), bool)
+    segment_dots(dots, u[[0, 2]], v[[0, 2]], u[[1, 3]], v[[1, 3]])
+    assert dots[5, 5] and dots[6, 5] and not dots[30, 12]
+    assert np.array_equal(paint.codes, pack_braille(dots))

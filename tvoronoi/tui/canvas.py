@@ -18,16 +18,11 @@ from textual.widget import Widget
 from tvoronoi.tui.colours import Palette, palette_for
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.follow import follow_view
-from tvoronoi.tui.raster import (
-    CURSOR_ARM,
-    Drawable,
-    Frame,
-    LayerCache,
-    View,
-    frame_lines,
-    rasterize,
-    redraw_part,
-)
+from tvoronoi.tui.layers import LayerCache
+from tvoronoi.tui.raster import CURSOR_ARM, Frame, rasterize, redraw_part
+from tvoronoi.tui.scene import Drawable
+from tvoronoi.tui.styles import frame_lines
+from tvoronoi.tui.viewport import View
 
 # One key press pans by this fraction of the canvas.
 PAN_STEP = 0.10
@@ -57,7 +52,7 @@ def plain_terminal(app) -> bool:
 
 if TYPE_CHECKING:
     from tvoronoi.tui.live import LiveScene
-    from tvoronoi.tui.raster import Scene
+    from tvoronoi.tui.scene import Scene
 
     def _drawables(scene: Scene, live: LiveScene) -> tuple[Drawable, Drawable]:
         """For mypy: both kinds of scene are what the canvas draws."""

@@ -184,11 +184,12 @@ def cell_adjacency(diagram) -> tuple[np.ndarray, np.ndarray]:
 
     Returns
     -------
-    (a, b) : two (k,) int64 arrays with ``a < b``, in half-edge order.
+    (a, b) : two (k,) integer arrays (the half-edges' type) with ``a < b``, in half-edge order.
     """
-    faces = np.asarray(diagram.he_face, np.int64)
-    twins = np.asarray(diagram.he_twin, np.int64)
-    keep = (twins > np.arange(twins.size)) & (faces >= 0)
+    faces = np.asarray(diagram.he_face)
+    twins = np.asarray(diagram.he_twin)
+    keep = twins > np.arange(twins.size, dtype=twins.dtype)
+    keep &= faces >= 0
     a = faces[keep]
     b = faces[twins[keep]]
     keep = (b >= 0) & (a != b)
@@ -258,16 +259,17 @@ def colour_graph(n: int, a: np.ndarray, b: np.ndarray, n_colours: int = MAX_COLO
     colour = np.full(n, -1, np.int8)
     taken = np.zeros(n, np.uint8)  # bit c set: a coloured neighbour has colour c
     # an edge between rounds matters only to its end peeled first (coloured later);
-    # an edge inside a round matters to both ends
+    # an edge inside a round only to its end of lower priority, which waits for the other
     ra, rb = round_of[a], round_of[b]
     cross = ra != rb
     owner = np.where(ra < rb, a, b)[cross]
     other = np.where(ra < rb, b, a)[cross]
     owner_round = np.minimum(ra, rb)[cross]
     inner = ~cross
-    in_src = np.concatenate([a[inner], b[inner]])
-    in_dst = np.concatenate([b[inner], a[inner]])
-    in_round = round_of[in_src]
+    ia, ib = a[inner], b[inner]
+    up = priority[ib] > priority[ia]
+    all_wait_s, all_wait_d = np.where(up, ia, ib), np.where(up, ib, ia)
+    wait_round = round_of[all_wait_s]
 
     # colour the rounds back, the last peeled first
     for k in range(n_rounds - 1, -1, -1):
@@ -275,14 +277,12 @@ def colour_graph(n: int, a: np.ndarray, b: np.ndarray, n_colours: int = MAX_COLO
         # neighbours in later rounds are coloured for good: note their colours once
         mine = owner_round == k
         _add_colours(taken, owner[mine], colour[other[mine]], n_colours)
-        # neighbours in this round: es waits for ed while ed is uncoloured and goes first
-        mine = in_round == k
-        es, ed = in_src[mine], in_dst[mine]
-        first = priority[ed] > priority[es]
-        wait_s, wait_d = es[first], ed[first]
+        # neighbours in this round: wait_s waits for wait_d while wait_d is uncoloured
+        mine = wait_round == k
+        wait_s, wait_d = all_wait_s[mine], all_wait_d[mine]
         while members.size:
             blocked = np.zeros(n, bool)
-            blocked[wait_s[colour[wait_d] < 0]] = True
+            blocked[wait_s] = True
             ready = members[~blocked[members]]
             # the free colour nearest after the scattered first choice
             used = taken[ready].astype(np.int64) & full
@@ -294,24 +294,19 @@ def colour_graph(n: int, a: np.ndarray, b: np.ndarray, n_colours: int = MAX_COLO
             crowded = rotated == full
             pick[crowded] = off[crowded]
             colour[ready] = pick
-            # tell the neighbours in this round what was just taken
+            # tell those that waited for them what was just taken; they wait no more
             just = np.zeros(n, bool)
             just[ready] = True
-            told = just[ed]
-            _add_colours(taken, es[told], colour[ed[told]], n_colours)
             members = members[~just[members]]
-            left = ~just[es] & ~told
-            es, ed = es[left], ed[left]
-            left = ~just[wait_s]
-            wait_s, wait_d = wait_s[left], wait_d[left]
+            told = just[wait_d]
+            _add_colours(taken, wait_s[told], colour[wait_d[told]], n_colours)
+            wait_s, wait_d = wait_s[~told], wait_d[~told]
     return colour
 
 
 def _add_colours(taken: np.ndarray, owners: np.ndarray, colours: np.ndarray, n_colours: int) -> None:
     """Set bit ``colours[j]`` of ``taken[owners[j]]`` for every j (owners may repeat)."""
-    for c in range(n_colours):
-        # repeated owners all write the same value, so one fancy-index update is exact
-        taken[owners[colours == c]] |= np.uint8(1 << c)
+    np.bitwise_or.at(taken, owners, np.left_shift(np.uint8(1), colours.astype(np.uint8)))
 
 
 def _lowest_bit(x: np.ndarray) -> np.ndarray:

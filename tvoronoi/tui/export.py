@@ -20,7 +20,8 @@ import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.colours import Palette
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-from tvoronoi.tui.raster import View, ring_next
+from tvoronoi.tui.scene import ring_next
+from tvoronoi.tui.viewport import View
 
 # Pixels per braille dot of the canvas: a 120 x 40 canvas (240 x 160 dots) exports at 960 x 640.
 PX_PER_DOT = 4

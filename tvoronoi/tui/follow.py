@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
-from tvoronoi.tui.raster import View
+from tvoronoi.tui.viewport import View
 
 # The region shown is at least this many typical site spacings (sqrt(box area / n)) across.
 MIN_SPACINGS = 6.0

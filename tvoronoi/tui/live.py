@@ -15,7 +15,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tvoronoi.tui.colours import cell_adjacency, repair_colours
-from tvoronoi.tui.raster import char_centres, ring_next, ring_segments
+from tvoronoi.tui.scene import ring_next, ring_segments
+from tvoronoi.tui.viewport import char_centres
 
 # A ring point within this fraction of the box size of a box side lies on it.
 ON_BOX = 1e-9
@@ -188,6 +189,11 @@ class LiveScene:
     @property
     def edges(self) -> np.ndarray:
         return self._cells.array
+
+    @property
+    def edge_mesh(self) -> None:
+        """The edges are kept cell by cell, as segments (``edges``)."""
+        return None
 
     @property
     def delaunay(self) -> np.ndarray:

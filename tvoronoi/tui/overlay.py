@@ -20,7 +20,7 @@ import numpy.typing as npt
 from tvoronoi.trace import FortuneStep, IncrementalStep, parabola_y
 from tvoronoi.tui.colours import adjacency_lists, cell_adjacency, repair_colours
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS, clip_segments
-from tvoronoi.tui.raster import (
+from tvoronoi.tui.layers import (
     BEACH,
     CIRCLE,
     CONFLICT,
@@ -28,17 +28,13 @@ from tvoronoi.tui.raster import (
     EVENT,
     FUTURE,
     GROWING,
-    SPARSE_SITES_PER_CHAR,
     SWEEP,
     TINTED,
     WALK,
-    Painter,
-    Scene,
-    View,
-    ViewLike,
-    char_centres,
-    per_char,
 )
+from tvoronoi.tui.raster import SPARSE_SITES_PER_CHAR, Painter, per_char
+from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.viewport import View, ViewLike, char_centres
 
 # Circles are drawn as polygons with about one corner per this many dots of
 # circumference, and between these many corners.
@@ -327,13 +323,13 @@ def fortune_picture(step, points: np.ndarray, colours: np.ndarray, bbox) -> tupl
                         [xmax, ymax, xmin, ymax], [xmin, ymax, xmin, ymin]])
     finished = clip_segments(np.asarray(step.finished_edges, np.float64).reshape(-1, 4), box)
     scene = _SubScene(
+        rows,
         sites=points[rows],
         edges=np.concatenate([outline, finished]),
         delaunay_edges=_empty_segments(),
         vertices=vertices[inside],
         colours=np.asarray(colours)[rows],
         bbox=tuple(float(c) for c in bbox),
-        rows=rows,
     )
     return scene, FortuneOverlay(step, points, points[~swept], box)
 
@@ -356,13 +352,13 @@ def incremental_picture(step, points: np.ndarray, colours: np.ndarray) -> tuple[
         repair_colours(mine, adjacency_lists(len(points), a, b), clash)
     full = Scene.from_diagram(diagram, colours=mine)
     scene = _SubScene(
+        rows,
         sites=points[rows],
-        edges=full.edges,
+        edge_mesh=full.edge_mesh,
         delaunay_edges=full.delaunay,
         vertices=full.vertices,
         colours=mine[rows],
         bbox=full.bbox,
-        rows=rows,
     )
     pending = np.ones(len(points), bool)
     pending[rows] = False
@@ -381,11 +377,12 @@ def incremental_picture(step, points: np.ndarray, colours: np.ndarray) -> tuple[
     return scene, overlay
 
 
-@dataclass(eq=False)
 class _SubScene(Scene):
     """A scene of some of the sites: ``rows`` gives each drawn site's id."""
 
-    rows: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0, np.int64))
+    def __init__(self, rows: np.ndarray, **scene) -> None:
+        super().__init__(**scene)
+        self.rows = rows
 
     def site_ids(self) -> np.ndarray:
         return self.rows
