@@ -44,6 +44,7 @@ run: setup
 
 test: setup checked
 	$(BIN)/ruff check tvoronoi tests benchmarks
+	$(BIN)/ruff format --check tvoronoi tests benchmarks
 	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
 

@@ -82,8 +82,12 @@ def main(argv=None) -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--only-tvoronoi", action="store_true", help="leave out the pandas + shapely pipeline")
     ap.add_argument("--out", default="benchmarks/results/batch")
-    ap.add_argument("--before", metavar="DIR", help="also run the tvoronoi package found in DIR (an older "
-                    "checkout, its kernels built), interleaved with this one: before/after on the same load")
+    ap.add_argument(
+        "--before",
+        metavar="DIR",
+        help="also run the tvoronoi package found in DIR (an older "
+        "checkout, its kernels built), interleaved with this one: before/after on the same load",
+    )
     ap.add_argument("--before-label", default="before", help="how the rows of --before are named")
     args = ap.parse_args(argv)
     n = parse_sizes(args.n)[0]
@@ -98,34 +102,63 @@ def main(argv=None) -> None:
             "tvoronoi batch -> GeoJSON": tv + [str(Path(tmp) / "cells.geojson")],
             "tvoronoi batch -> GeoParquet": tv + [str(Path(tmp) / "cells.parquet")],
             "pandas + shapely.voronoi_polygons + to_file (GeoJSON)": [
-                sys.executable, "-c", PANDAS_SHAPELY, str(src), str(Path(tmp) / "shapely.geojson")],
+                sys.executable,
+                "-c",
+                PANDAS_SHAPELY,
+                str(src),
+                str(Path(tmp) / "shapely.geojson"),
+            ],
         }
         if args.before:
-            before = {f"{name} ({args.before_label})": cmd for name, cmd in cases.items()
-                      if name.startswith("tvoronoi")}
-            cases = {**{name: cmd[:-1] + [str(Path(cmd[-1]).with_name("before-" + Path(cmd[-1]).name))]
-                        for name, cmd in before.items()}, **cases}
+            before = {
+                f"{name} ({args.before_label})": cmd for name, cmd in cases.items() if name.startswith("tvoronoi")
+            }
+            cases = {
+                **{
+                    name: cmd[:-1] + [str(Path(cmd[-1]).with_name("before-" + Path(cmd[-1]).name))]
+                    for name, cmd in before.items()
+                },
+                **cases,
+            }
         if args.only_tvoronoi:
             cases = {name: cmd for name, cmd in cases.items() if name.startswith("tvoronoi")}
         rows: dict[str, list] = {name: [] for name in cases}
-        for _ in range(args.repeats):            # interleaved rounds
+        for _ in range(args.repeats):  # interleaved rounds
             for name, cmd in cases.items():
                 rows[name].append(run(cmd, args.before if name.endswith(f"({args.before_label})") else None))
-                print(f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB, "
-                      f"{rows[name][-1][2]:.2f} s CPU", flush=True)
+                print(
+                    f"{name}: {rows[name][-1][0]:.2f} s, {rows[name][-1][1]:.0f} MiB, {rows[name][-1][2]:.2f} s CPU",
+                    flush=True,
+                )
         sizes = {name: (Path(cmd[-1]).stat().st_size if Path(cmd[-1]).exists() else 0) for name, cmd in cases.items()}
-    lines = ["# Batch end to end", "", f"Machine: {describe_machine(info)}", "",
-             f"{n:,} points in a CSV (x, y and two text columns), cells out; whole processes, start-up included; "
-             f"median of {args.repeats} interleaved runs, peak resident memory of the largest of its processes; CPU is user + "
-             f"system time of all its threads and processes (the work done, whatever else runs on the "
-             f"machine); load average at the end {[round(v, 2) for v in os.getloadavg()]}.", "",
-             "| pipeline | wall s | CPU s | peak MiB | output MB |", "|---|---:|---:|---:|---:|"]
+    lines = [
+        "# Batch end to end",
+        "",
+        f"Machine: {describe_machine(info)}",
+        "",
+        f"{n:,} points in a CSV (x, y and two text columns), cells out; whole processes, start-up included; "
+        f"median of {args.repeats} interleaved runs, peak resident memory of the largest of its processes; CPU is user + "
+        f"system time of all its threads and processes (the work done, whatever else runs on the "
+        f"machine); load average at the end {[round(v, 2) for v in os.getloadavg()]}.",
+        "",
+        "| pipeline | wall s | CPU s | peak MiB | output MB |",
+        "|---|---:|---:|---:|---:|",
+    ]
     table = []
     for name, runs in rows.items():
         wall, peak, cpu = (statistics.median(r[k] for r in runs) for k in range(3))
         lines.append(f"| {name} | {wall:.2f} | {cpu:.2f} | {peak:.0f} | {sizes[name] / 1e6:.0f} |")
-        table.append({"pipeline": name, "n": n, "repeats": len(runs), "wall_s": round(wall, 3),
-                      "cpu_s": round(cpu, 3), "peak_mib": round(peak, 1), "output_bytes": sizes[name]})
+        table.append(
+            {
+                "pipeline": name,
+                "n": n,
+                "repeats": len(runs),
+                "wall_s": round(wall, 3),
+                "cpu_s": round(cpu, 3),
+                "peak_mib": round(peak, 1),
+                "output_bytes": sizes[name],
+            }
+        )
     atomic_write(out_dir / "batch.md", "\n".join(lines) + "\n")
     write_csv(out_dir / "batch.csv", table, columns=list(table[0]))
     print(f"# wrote {out_dir / 'batch.md'}")

@@ -63,8 +63,16 @@ def main(argv=None) -> None:
         rows.append({"n": n, "case": "plain", "wall_s": round(wall, 3), "cpu_s": round(cpu, 3)})
         d, wall, cpu = timed(tvoronoi.voronoi, pts, clip=region)
         crossing = int(np.count_nonzero(d.reshaped & (d.clipped != None)))  # noqa: E711
-        rows.append({"n": n, "case": "clip", "wall_s": round(wall, 3), "cpu_s": round(cpu, 3),
-                     "inside": int(d.inside.sum()), "crossing": crossing})
+        rows.append(
+            {
+                "n": n,
+                "case": "clip",
+                "wall_s": round(wall, 3),
+                "cpu_s": round(cpu, 3),
+                "inside": int(d.inside.sum()),
+                "crossing": crossing,
+            }
+        )
         del d
         if n in whole_sizes:
             local = region_module.local_intersection
@@ -81,15 +89,27 @@ def main(argv=None) -> None:
     out.mkdir(parents=True, exist_ok=True)
     columns = ["n", "case", "wall_s", "cpu_s", "inside", "crossing"]
     write_csv(out / "clip.csv", rows, columns=columns)
-    names = {"plain": "voronoi(sites), no clip", "clip": "voronoi(sites, clip=coast): cells cut locally",
-             "whole": "the same, each crossing cell cut against the whole outline"}
-    lines = ["# Clip to a detailed outline", "", f"Machine: {describe_machine(info)}", "",
-             f"Region: `tvoronoi.generators.coastline()`, {n_vertices:,} vertices (a coast of 4,000 with 300 "
-             f"thin spikes, lakes, islands). Sites uniform in its bounds; one run each, in one process.", "",
-             "| sites | case | wall s | CPU s | inside | cut cells |", "|---:|---|---:|---:|---:|---:|"]
+    names = {
+        "plain": "voronoi(sites), no clip",
+        "clip": "voronoi(sites, clip=coast): cells cut locally",
+        "whole": "the same, each crossing cell cut against the whole outline",
+    }
+    lines = [
+        "# Clip to a detailed outline",
+        "",
+        f"Machine: {describe_machine(info)}",
+        "",
+        f"Region: `tvoronoi.generators.coastline()`, {n_vertices:,} vertices (a coast of 4,000 with 300 "
+        f"thin spikes, lakes, islands). Sites uniform in its bounds; one run each, in one process.",
+        "",
+        "| sites | case | wall s | CPU s | inside | cut cells |",
+        "|---:|---|---:|---:|---:|---:|",
+    ]
     for row in rows:
-        lines.append(f"| {row['n']:,} | {names[row['case']]} | {row['wall_s']:.2f} | {row['cpu_s']:.2f} | "
-                     f"{row.get('inside', '')} | {row.get('crossing', '')} |")
+        lines.append(
+            f"| {row['n']:,} | {names[row['case']]} | {row['wall_s']:.2f} | {row['cpu_s']:.2f} | "
+            f"{row.get('inside', '')} | {row.get('crossing', '')} |"
+        )
     atomic_write(out / "clip.md", "\n".join(lines) + "\n")
     print(f"# wrote {out / 'clip.md'}")
 

@@ -104,9 +104,19 @@ def one_process(n: int) -> dict:
 
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
-        run = subprocess.run([sys.executable, "-c", ONE_PROCESS, str(n), str(Path(tmp) / "cells.parquet"),
-                              str(Path(__file__).resolve().parent.parent)],
-                             capture_output=True, text=True, env=subprocess_env())
+        run = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                ONE_PROCESS,
+                str(n),
+                str(Path(tmp) / "cells.parquet"),
+                str(Path(__file__).resolve().parent.parent),
+            ],
+            capture_output=True,
+            text=True,
+            env=subprocess_env(),
+        )
     if run.returncode != 0:
         raise RuntimeError(run.stderr)
     return {**json.loads(run.stdout.strip().splitlines()[-1]), "load_before": load, "load_after": os.getloadavg()[0]}
@@ -134,8 +144,9 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
         return pd.DataFrame({"x": xy[:, 0], "y": xy[:, 1]})
 
     n_parts = (n + PARTITION - 1) // PARTITION
-    frame = dd.from_delayed([dask.delayed(part)(k) for k in range(n_parts)],
-                            meta=pd.DataFrame({"x": np.empty(0), "y": np.empty(0)}))
+    frame = dd.from_delayed(
+        [dask.delayed(part)(k) for k in range(n_parts)], meta=pd.DataFrame({"x": np.empty(0), "y": np.empty(0)})
+    )
     import os
 
     client = local_client(workers)
@@ -144,7 +155,7 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
         load = os.getloadavg()[0]
         with tempfile.TemporaryDirectory() as tmp:
             cpu0 = client.run(_worker_cpu)
-            c0 = time.process_time()                # this process: the client and the LocalCluster's scheduler
+            c0 = time.process_time()  # this process: the client and the LocalCluster's scheduler
             t0 = time.perf_counter()
             result = voronoi(frame, client=client, tiles=tiles, to=Path(tmp) / "cells")
             elapsed = time.perf_counter() - t0
@@ -156,11 +167,18 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
         cluster = client.cluster
         client.close()
         cluster.close()
-    return {"seconds": elapsed, "worker_cpu": sorted(round(cpu1[w] - cpu0[w], 1) for w in cpu1),
-            "scheduler_client_cpu": here, "load_before": load, "load_after": os.getloadavg()[0],
-            "tiles": result.n_tiles, "rounds": result.rounds,
-            "pending_after": list(result.pending_after), "parts": written,
-            "worker_peak_mib": sorted(round(v, 1) for v in peaks.values())}
+    return {
+        "seconds": elapsed,
+        "worker_cpu": sorted(round(cpu1[w] - cpu0[w], 1) for w in cpu1),
+        "scheduler_client_cpu": here,
+        "load_before": load,
+        "load_after": os.getloadavg()[0],
+        "tiles": result.n_tiles,
+        "rounds": result.rounds,
+        "pending_after": list(result.pending_after),
+        "parts": written,
+        "worker_peak_mib": sorted(round(v, 1) for v in peaks.values()),
+    }
 
 
 ESTIMATES = """\
@@ -196,19 +214,27 @@ cells, WKB and the Arrow table of its part), and builds about {rate:,.0f} sites 
 """
 
 
-def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | None, n: int | None,
-           workers: int) -> str:
+def report(
+    info: dict, threads: dict | None, one: dict | None, cluster: dict | None, n: int | None, workers: int
+) -> str:
     import os
 
-    lines = ["# Tiles on more than one core", "", describe_machine(info),
-             f"Load average at the end: {[round(v, 2) for v in os.getloadavg()]} (the machine is shared: other "
-             f"work ran on the same 2 cores during these runs, so the figures are upper bounds).", ""]
+    lines = [
+        "# Tiles on more than one core",
+        "",
+        describe_machine(info),
+        f"Load average at the end: {[round(v, 2) for v in os.getloadavg()]} (the machine is shared: other "
+        f"work ran on the same 2 cores during these runs, so the figures are upper bounds).",
+        "",
+    ]
     if threads:
         ratio = threads["threads_2"] / threads["threads_1"]
         tiles_ratio = threads["tiles_in_2_threads"] / threads["threads_1"]
         lines += [
-            f"## threads at {threads['n']:,} uniform sites (median of 3)", "",
-            "| build | seconds | vs threads=1 |", "| --- | --- | --- |",
+            f"## threads at {threads['n']:,} uniform sites (median of 3)",
+            "",
+            "| build | seconds | vs threads=1 |",
+            "| --- | --- | --- |",
             f"| voronoi(threads=1) | {threads['threads_1']:.3f} | 1.00 |",
             f"| voronoi(threads=2): OpenMP phases (dual, clip) | {threads['threads_2']:.3f} | {ratio:.2f} |",
             f"| two tiles in two Python threads (build_tile, threads=1 each; "
@@ -219,8 +245,10 @@ def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | N
     if one and cluster and n:
         efficiency = one["total"] / (workers * cluster["seconds"])
         lines += [
-            f"## {n:,} uniform sites: one process against {workers} Dask workers", "",
-            "| run | seconds | peak memory | sites per second per core |", "| --- | --- | --- | --- |",
+            f"## {n:,} uniform sites: one process against {workers} Dask workers",
+            "",
+            "| run | seconds | peak memory | sites per second per core |",
+            "| --- | --- | --- | --- |",
             f"| one process: generate {one['generate']:.1f} s, build {one['build']:.1f} s, write GeoParquet "
             f"{one['write']:.1f} s | {one['total']:.1f} | {one['peak_mib']:,.0f} MiB | {n / one['total']:,.0f} |",
             f"| LocalCluster, {workers} worker processes, {cluster['tiles']} tiles, {cluster['rounds']} rounds "
@@ -228,7 +256,8 @@ def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | N
             f"{cluster['seconds']:.1f} | {' / '.join(f'{v:,.0f}' for v in cluster['worker_peak_mib'])} MiB per worker "
             f"| {n / cluster['seconds'] / workers:,.0f} |",
             "",
-            f"Parallel efficiency: {efficiency:.0%} (t_one / ({workers} x t_cluster)).", "",
+            f"Parallel efficiency: {efficiency:.0%} (t_one / ({workers} x t_cluster)).",
+            "",
         ]
         if "cpu" in one and "worker_cpu" in cluster:
             spent = sum(cluster["worker_cpu"]) + cluster["scheduler_client_cpu"]
@@ -245,10 +274,18 @@ def report(info: dict, threads: dict | None, one: dict | None, cluster: dict | N
             ]
         per_site = max(cluster["worker_peak_mib"]) * 2**20 / (n / cluster["tiles"] * 1.016)
         rate = n / cluster["seconds"] / workers
-        lines.append(ESTIMATES.format(
-            per_site=per_site, rate=rate, mem_gib=per_site * 1.016e6 / 2**30,
-            h8=1e8 / rate / 3600 / workers, h9=1e9 / rate / 3600, h10=1e10 / rate / 3600, pending=cluster["pending_after"][0], n=n,
-        ))
+        lines.append(
+            ESTIMATES.format(
+                per_site=per_site,
+                rate=rate,
+                mem_gib=per_site * 1.016e6 / 2**30,
+                h8=1e8 / rate / 3600 / workers,
+                h9=1e9 / rate / 3600,
+                h10=1e10 / rate / 3600,
+                pending=cluster["pending_after"][0],
+                n=n,
+            )
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -264,8 +301,12 @@ def main(argv=None) -> int:
     if args.report_only:
         out = Path(args.out)
         saved = json.loads(out.with_suffix(".json").read_text())
-        atomic_write(out.with_suffix(".md"), report(saved["machine"], saved["threads"], saved["one_process"],
-                                                    saved["cluster"], saved["n"], saved["workers"]))
+        atomic_write(
+            out.with_suffix(".md"),
+            report(
+                saved["machine"], saved["threads"], saved["one_process"], saved["cluster"], saved["n"], saved["workers"]
+            ),
+        )
         print(out.with_suffix(".md").read_text())
         return 0
     info = machine()
@@ -279,9 +320,20 @@ def main(argv=None) -> int:
         cluster = on_cluster(n, args.workers, args.tiles)
         print(json.dumps(cluster), flush=True)
     out = Path(args.out)
-    atomic_write(out.with_suffix(".json"), json.dumps(
-        {"machine": info, "threads": threads, "one_process": one, "cluster": cluster, "n": n,
-         "workers": args.workers}, indent=1))
+    atomic_write(
+        out.with_suffix(".json"),
+        json.dumps(
+            {
+                "machine": info,
+                "threads": threads,
+                "one_process": one,
+                "cluster": cluster,
+                "n": n,
+                "workers": args.workers,
+            },
+            indent=1,
+        ),
+    )
     atomic_write(out.with_suffix(".md"), report(info, threads, one, cluster, n, args.workers))
     print(out.with_suffix(".md").read_text())
     return 0

@@ -94,7 +94,7 @@ def maxrss_mib() -> float:
     except (OSError, ValueError, IndexError):
         pass
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return peak / 2**20 if sys.platform == "darwin" else peak / 1024.0   # bytes on macOS, KiB on Linux
+    return peak / 2**20 if sys.platform == "darwin" else peak / 1024.0  # bytes on macOS, KiB on Linux
 
 
 def subprocess_env() -> dict:
@@ -158,14 +158,21 @@ def describe_machine(info: dict) -> str:
     v = info.get("versions", {})
     pools = info.get("threadpools")
     if isinstance(pools, list):
-        pools = ", ".join(f"{p['internal_api']} {p.get('version') or ''} {p['num_threads']} threads".replace("  ", " ")
-                          for p in pools) or "none loaded"
+        pools = (
+            ", ".join(
+                f"{p['internal_api']} {p.get('version') or ''} {p['num_threads']} threads".replace("  ", " ")
+                for p in pools
+            )
+            or "none loaded"
+        )
     env = ", ".join(f"{k}={val}" for k, val in info.get("thread_env", {}).items())
     libs = ", ".join(f"{k} {val}" for k, val in v.items() if val)
-    return (f"{info.get('cpu')}, {info.get('cores')} cores ({info.get('cores_usable', '?')} usable), "
-            f"{info.get('memory_gib', '?')} GiB; load average at start {info.get('load_average')}; "
-            f"Python {info.get('python')} on {info.get('platform')}; {libs}. "
-            f"Thread pools: {pools}; {env}. Run {info.get('date')}.")
+    return (
+        f"{info.get('cpu')}, {info.get('cores')} cores ({info.get('cores_usable', '?')} usable), "
+        f"{info.get('memory_gib', '?')} GiB; load average at start {info.get('load_average')}; "
+        f"Python {info.get('python')} on {info.get('platform')}; {libs}. "
+        f"Thread pools: {pools}; {env}. Run {info.get('date')}."
+    )
 
 
 def send(stream, obj) -> None:

@@ -82,7 +82,7 @@ def fortune_panel(ax, pts, step, box) -> None:
         ax.add_collection(LineCollection(step.finished_edges, colors="black", linewidths=1.2))
     if len(step.growing_edges):
         growing = step.growing_edges.copy()
-        growing[~np.isfinite(growing)] = ymin - (ymax - ymin)      # edges that began at y = -inf
+        growing[~np.isfinite(growing)] = ymin - (ymax - ymin)  # edges that began at y = -inf
         ax.add_collection(LineCollection(growing, colors="tab:orange", linewidths=1.6))
     # the beach line: arc k of site beach[k] runs between breakpoints k - 1 and k
     if len(step.beach) and np.isfinite(L):
@@ -91,7 +91,7 @@ def fortune_panel(ax, pts, step, box) -> None:
         rights = np.concatenate((bx, [xmax]))
         for site, lo, hi in zip(step.beach.tolist(), lefts, rights):
             sx, sy = pts[site]
-            if sy == L:                                  # a site on the sweep line: a vertical arc
+            if sy == L:  # a site on the sweep line: a vertical arc
                 k = int(np.argmin(np.abs(bx - sx))) if len(bx) else -1
                 y0 = step.breakpoints[k, 1] if k >= 0 else ymin
                 ax.plot([sx, sx], [y0, sy], color="tab:blue", lw=1.4)
@@ -123,24 +123,31 @@ def incremental_panel(ax, pts, step, box) -> None:
     inserted = step.inserted.tolist()
     stolen = set(step.stolen_from.tolist())
     cells = {i: d.cell_polygon(i) for i in inserted}
-    ax.add_collection(PolyCollection([cells[i] for i in inserted if i in stolen and len(cells[i])],
-                                     facecolors="#fff2a8", edgecolors="none"))
+    ax.add_collection(
+        PolyCollection(
+            [cells[i] for i in inserted if i in stolen and len(cells[i])], facecolors="#fff2a8", edgecolors="none"
+        )
+    )
     if step.site >= 0 and len(cells.get(step.site, [])):
         ax.add_collection(PolyCollection([cells[step.site]], facecolors="#cfe3ff", edgecolors="none"))
-    ax.add_collection(PolyCollection([c for c in cells.values() if len(c)], facecolors="none",
-                                     edgecolors="grey", linewidths=0.9))
+    ax.add_collection(
+        PolyCollection([c for c in cells.values() if len(c)], facecolors="none", edgecolors="grey", linewidths=0.9)
+    )
     tri = d.delaunay_triangles()
     if len(tri):
-        ax.add_collection(PolyCollection(pts[tri], facecolors="none", edgecolors="#bbbbbb",
-                                         linewidths=0.5, linestyles=":"))
+        ax.add_collection(
+            PolyCollection(pts[tri], facecolors="none", edgecolors="#bbbbbb", linewidths=0.5, linestyles=":")
+        )
     if len(step.conflict):
         corners = pts[step.conflict]
-        ax.add_collection(PolyCollection(corners, facecolors="none", edgecolors="tab:red", hatch="////",
-                                         linewidths=1.3))
+        ax.add_collection(
+            PolyCollection(corners, facecolors="none", edgecolors="tab:red", hatch="////", linewidths=1.3)
+        )
         centres = circumcentres(corners[:, 0], corners[:, 1], corners[:, 2])
         for (cx, cy), p in zip(centres, corners[:, 0]):
-            ax.add_patch(Circle((cx, cy), float(np.hypot(*(p - (cx, cy)))), fill=False, ls="--", lw=0.7,
-                                color="tab:red"))
+            ax.add_patch(
+                Circle((cx, cy), float(np.hypot(*(p - (cx, cy)))), fill=False, ls="--", lw=0.7, color="tab:red")
+            )
     if len(step.new_triangles):
         edges = pts[step.new_triangles][:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2, 2)
         ax.add_collection(LineCollection(edges, colors="tab:blue", linewidths=1.2))
@@ -173,8 +180,11 @@ def make_figures(out: Path, n: int = N_SITES, seed: int = SEED) -> list[Path]:
     plt, fig, axes = _figure(2, PANELS // 2)
     for ax, k in zip(axes, pick_fortune_steps(trace, PANELS)):
         fortune_panel(ax, pts, trace.step(k), box)
-    fig.suptitle(f"Fortune's sweepline on {n} sites: sweep line (red), beach line (blue), circle events "
-                 f"(purple), finished edges (black), growing edges (orange)", fontsize=10)
+    fig.suptitle(
+        f"Fortune's sweepline on {n} sites: sweep line (red), beach line (blue), circle events "
+        f"(purple), finished edges (black), growing edges (orange)",
+        fontsize=10,
+    )
     paths.append(out / "fortune_steps.png")
     _save(plt, fig, paths[-1])
 
@@ -183,8 +193,11 @@ def make_figures(out: Path, n: int = N_SITES, seed: int = SEED) -> list[Path]:
     ks = np.linspace(5, n, PANELS).round().astype(int)
     for ax, k in zip(axes, ks.tolist()):
         incremental_panel(ax, pts, trace.step(k), box)
-    fig.suptitle(f"Randomized incremental insertion on {n} sites: new site (star), conflict region (hatched red, with "
-                 f"circumcircles), new triangles (blue), cells it took area from (yellow)", fontsize=10)
+    fig.suptitle(
+        f"Randomized incremental insertion on {n} sites: new site (star), conflict region (hatched red, with "
+        f"circumcircles), new triangles (blue), cells it took area from (yellow)",
+        fontsize=10,
+    )
     paths.append(out / "incremental_steps.png")
     _save(plt, fig, paths[-1])
     return paths

@@ -55,29 +55,42 @@ def main(argv=None) -> None:
         t = time.perf_counter()
         cell_centroids(dynamic.diagram().to_diagram())
         convert = time.perf_counter() - t
-        row = {"n": n, "rebuild_and_centroids_s": round(rebuild, 4), "move_us": round(per_move * 1e6, 1),
-               "move_all_s": round(per_move * n, 3), "dynamic_cells_and_centroids_s": round(convert, 4),
-               "break_even_fraction": round(rebuild / (per_move * n), 4),
-               "step_median_cells": round(float(np.median(steps)), 4),
-               "step_p10_cells": round(float(np.quantile(steps, 0.1)), 4)}
+        row = {
+            "n": n,
+            "rebuild_and_centroids_s": round(rebuild, 4),
+            "move_us": round(per_move * 1e6, 1),
+            "move_all_s": round(per_move * n, 3),
+            "dynamic_cells_and_centroids_s": round(convert, 4),
+            "break_even_fraction": round(rebuild / (per_move * n), 4),
+            "step_median_cells": round(float(np.median(steps)), 4),
+            "step_p10_cells": round(float(np.quantile(steps, 0.1)), 4),
+        }
         rows.append(row)
         print(row, flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "lloyd.csv", rows, columns=list(rows[0]))
-    lines = ["# Lloyd steps: rebuild or move", "", f"Machine: {describe_machine(info)}", "",
-             f"Uniform sites in the unit square after {WARM_STEPS} Lloyd steps; moves of {SAMPLE_MOVES} sites "
-             "through DynamicVoronoi.move; one run, in one process. A dynamic step would also need the cells "
-             "of the moved sites' neighbours for their centroids: reading the whole diagram costs more than "
-             "a rebuild, so moves pay off only below the break-even fraction, and then only if the centroids "
-             "were read cell by cell.", "",
-             "| sites | rebuild + centroids s | one move us | moving all s | dynamic cells + centroids s | "
-             "break-even fraction of sites moved | median step (cell sizes) | 10% step |",
-             "|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        "# Lloyd steps: rebuild or move",
+        "",
+        f"Machine: {describe_machine(info)}",
+        "",
+        f"Uniform sites in the unit square after {WARM_STEPS} Lloyd steps; moves of {SAMPLE_MOVES} sites "
+        "through DynamicVoronoi.move; one run, in one process. A dynamic step would also need the cells "
+        "of the moved sites' neighbours for their centroids: reading the whole diagram costs more than "
+        "a rebuild, so moves pay off only below the break-even fraction, and then only if the centroids "
+        "were read cell by cell.",
+        "",
+        "| sites | rebuild + centroids s | one move us | moving all s | dynamic cells + centroids s | "
+        "break-even fraction of sites moved | median step (cell sizes) | 10% step |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in rows:
-        lines.append(f"| {r['n']:,} | {r['rebuild_and_centroids_s']:.3f} | {r['move_us']:.0f} | {r['move_all_s']:.2f} "
-                     f"| {r['dynamic_cells_and_centroids_s']:.3f} | {r['break_even_fraction']:.1%} | "
-                     f"{r['step_median_cells']:.3f} | {r['step_p10_cells']:.3f} |")
+        lines.append(
+            f"| {r['n']:,} | {r['rebuild_and_centroids_s']:.3f} | {r['move_us']:.0f} | {r['move_all_s']:.2f} "
+            f"| {r['dynamic_cells_and_centroids_s']:.3f} | {r['break_even_fraction']:.1%} | "
+            f"{r['step_median_cells']:.3f} | {r['step_p10_cells']:.3f} |"
+        )
     atomic_write(out / "lloyd.md", "\n".join(lines) + "\n")
     print(f"# wrote {out / 'lloyd.md'}")
 

@@ -46,7 +46,7 @@ DISTS = ("uniform", "gaussian", "clustered", "cluster_1e-9", "grid")
 def points(dist: str, n: int) -> np.ndarray:
     """The benchmark's points: seeded, the same for every tool."""
     if dist == "grid":
-        side = int(round(n ** 0.5))
+        side = int(round(n**0.5))
         g = np.arange(float(side))
         x, y = np.meshgrid(g, g)
         return np.c_[x.ravel(), y.ravel()]
@@ -108,8 +108,7 @@ def others(pts: np.ndarray, geos_max: int) -> dict:
         import shapely
 
         t0 = time.perf_counter()
-        shapely.voronoi_polygons(shapely.multipoints(pts), extend_to=shapely.box(*default_bbox(pts)),
-                                 ordered=True)
+        shapely.voronoi_polygons(shapely.multipoints(pts), extend_to=shapely.box(*default_bbox(pts)), ordered=True)
         out["GEOS voronoi_polygons"] = time.perf_counter() - t0
     gc.collect()
     return out
@@ -137,10 +136,8 @@ print((hwm() - before) / 1024)
 
 def build_peak(dist: str, n: int, engine: str, threads: int) -> float:
     """MiB a whole build adds to a fresh process's peak."""
-    code = PEAK.format(repo=str(Path(__file__).resolve().parent.parent), dist=dist, n=n, engine=engine,
-                       threads=threads)
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=subprocess_env(),
-                         check=True)
+    code = PEAK.format(repo=str(Path(__file__).resolve().parent.parent), dist=dist, n=n, engine=engine, threads=threads)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=subprocess_env(), check=True)
     return float(res.stdout.strip())
 
 
@@ -167,9 +164,9 @@ def main(argv=None) -> None:
             pts = points(dist, n)
             n_pts = len(pts)
             runs = {}
-            for engine in ("incremental", "fortune"):   # warm-up, not timed: the process's memory, the caches
+            for engine in ("incremental", "fortune"):  # warm-up, not timed: the process's memory, the caches
                 time_phases(pts, engine, 1)
-            for _ in range(args.repeats):            # interleaved: every configuration once per round
+            for _ in range(args.repeats):  # interleaved: every configuration once per round
                 for engine in ("incremental", "fortune"):
                     for threads in thread_counts:
                         gc.collect()
@@ -177,11 +174,21 @@ def main(argv=None) -> None:
             for (engine, threads), reps in runs.items():
                 med = {p: statistics.median(r[p] for r in reps) for p in PHASES}
                 med["total"] = statistics.median(sum(r[p] for p in PHASES) for r in reps)
-                rows.append({"n": n_pts, "dist": dist, "tool": f"tvoronoi {engine}", "threads": threads,
-                             **{p: med[p] for p in (*PHASES, "total")},
-                             "peak_mib": build_peak(dist, n, engine, threads)})
-                print(f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
-                      + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total")), flush=True)
+                rows.append(
+                    {
+                        "n": n_pts,
+                        "dist": dist,
+                        "tool": f"tvoronoi {engine}",
+                        "threads": threads,
+                        **{p: med[p] for p in (*PHASES, "total")},
+                        "peak_mib": build_peak(dist, n, engine, threads),
+                    }
+                )
+                print(
+                    f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
+                    + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total")),
+                    flush=True,
+                )
             for tool, seconds in others(pts, args.geos_max).items():
                 rows.append({"n": n_pts, "dist": dist, "tool": tool, "threads": 1, "total": seconds})
                 print(f"{dist:>13} n={n_pts:>9,} {tool}: {seconds * 1e3:.0f}ms", flush=True)
@@ -191,24 +198,34 @@ def main(argv=None) -> None:
 
 
 def report(rows: list[dict], info: dict) -> str:
-    lines = ["# Where a build's time goes", "",
-             f"Machine: {describe_machine(info)}", "",
-             "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
-             "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells. The other tools are "
-             "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
-             "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
-             "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process.", ""]
+    lines = [
+        "# Where a build's time goes",
+        "",
+        f"Machine: {describe_machine(info)}",
+        "",
+        "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
+        "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells. The other tools are "
+        "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
+        "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
+        "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process.",
+        "",
+    ]
     for n in sorted({r["n"] for r in rows}):
         for dist in dict.fromkeys(r["dist"] for r in rows if r["n"] == n):
             sub = [r for r in rows if r["n"] == n and r["dist"] == dist]
-            lines += [f"## {dist}, n = {n:,}", "",
-                      "| build | threads | order | tri | dual | cells | total | peak MiB |",
-                      "|---|---:|---:|---:|---:|---:|---:|---:|"]
+            lines += [
+                f"## {dist}, n = {n:,}",
+                "",
+                "| build | threads | order | tri | dual | cells | total | peak MiB |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|",
+            ]
             for r in sub:
                 if "order" in r:
-                    lines.append(f"| {r['tool']} | {r['threads']} | "
-                                 + " | ".join(fmt_ns(r[p], n) for p in PHASES)
-                                 + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | {r['peak_mib']:.0f} |")
+                    lines.append(
+                        f"| {r['tool']} | {r['threads']} | "
+                        + " | ".join(fmt_ns(r[p], n) for p in PHASES)
+                        + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | {r['peak_mib']:.0f} |"
+                    )
             for r in sub:
                 if "order" not in r:
                     lines.append(f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | |")

@@ -27,18 +27,29 @@ KIND_TITLES = {"full": "time to the full diagram", "bounded": "time to bounded c
 DIST_ORDER = ("uniform", "gaussian", "clustered")
 # A fixed colour per engine, the same in every plot.
 COLOURS = {
-    "tvoronoi-fortune": "tab:blue", "tvoronoi-incremental": "tab:orange", "tvoronoi-textbook": "tab:brown",
-    "qhull-voronoi": "black", "qhull-delaunay": "tab:grey", "geos": "tab:green", "triangle": "tab:purple",
+    "tvoronoi-fortune": "tab:blue",
+    "tvoronoi-incremental": "tab:orange",
+    "tvoronoi-textbook": "tab:brown",
+    "qhull-voronoi": "black",
+    "qhull-delaunay": "tab:grey",
+    "geos": "tab:green",
+    "triangle": "tab:purple",
 }
 # Memory readings below this (MiB) are drawn at it on the log axis.
 MEMORY_FLOOR = 0.1
 HEATMAP_COLUMNS = 4
-UPDATE_ENGINES = {"tvoronoi-dynamic": "tvoronoi incremental", "tvoronoi-dynamic-fortune": "tvoronoi Fortune",
-                  "qhull-incremental": "Qhull"}
+UPDATE_ENGINES = {
+    "tvoronoi-dynamic": "tvoronoi incremental",
+    "tvoronoi-dynamic-fortune": "tvoronoi Fortune",
+    "qhull-incremental": "Qhull",
+}
 UPDATE_KINDS = {"insert": "insert", "move": "small move", "remove": "remove", "add_points": "add_points (1 point)"}
 # Line colour per engine and marker per operation in the update plot.
-UPDATE_COLOURS = {"tvoronoi-dynamic": "tab:orange", "tvoronoi-dynamic-fortune": "tab:blue",
-                  "qhull-incremental": "black"}
+UPDATE_COLOURS = {
+    "tvoronoi-dynamic": "tab:orange",
+    "tvoronoi-dynamic-fortune": "tab:blue",
+    "qhull-incremental": "black",
+}
 UPDATE_MARKERS = {"insert": "o", "move": "s", "remove": "v", "add_points": "o"}
 
 
@@ -50,9 +61,18 @@ def summarise(rows: list[dict]) -> dict:
         key = (r["engine"], r["kind"], r["distribution"], int(r["n"]))
         groups[key].append(float(r["seconds"]))
         peaks[key] = float(r["peak_mib"])
-    return {k: {"median": statistics.median(v), "lo": min(v), "hi": max(v), "count": len(v), "peak": peaks[k],
-                "q1": float(np.percentile(v, 25)), "q3": float(np.percentile(v, 75))}
-            for k, v in groups.items()}
+    return {
+        k: {
+            "median": statistics.median(v),
+            "lo": min(v),
+            "hi": max(v),
+            "count": len(v),
+            "peak": peaks[k],
+            "q1": float(np.percentile(v, 25)),
+            "q3": float(np.percentile(v, 75)),
+        }
+        for k, v in groups.items()
+    }
 
 
 def fmt_time(s: float) -> str:
@@ -146,12 +166,16 @@ def update_section(updates: list[dict], status: dict, stats: dict) -> list[str]:
     sizes = sorted({key[2] for key in med})
     rebuild = {n: stats.get(("qhull-delaunay", "full", "uniform", n)) for n in sizes}
     head = [f"{UPDATE_ENGINES[e]}: {UPDATE_KINDS[k]}" for e, k in series] + ["Qhull: Delaunay rebuild"]
-    lines += ["Median time of one operation on uniform points. tvoronoi's include reading the changed cell "
-              "back (`diagram().cell_polygon(i)`: the new or moved site's, or after a removal the cell of "
-              "the nearest remaining site); Qhull's `add_points` is timed alone, without reading anything "
-              "back, which favours it. Qhull cannot move or remove a point: that is a rebuild (the build "
-              "benchmark's `scipy.spatial.Delaunay` median).", "",
-              "| n | " + " | ".join(head) + " |", "|---:|" + "---:|" * len(head)]
+    lines += [
+        "Median time of one operation on uniform points. tvoronoi's include reading the changed cell "
+        "back (`diagram().cell_polygon(i)`: the new or moved site's, or after a removal the cell of "
+        "the nearest remaining site); Qhull's `add_points` is timed alone, without reading anything "
+        "back, which favours it. Qhull cannot move or remove a point: that is a rebuild (the build "
+        "benchmark's `scipy.spatial.Delaunay` median).",
+        "",
+        "| n | " + " | ".join(head) + " |",
+        "|---:|" + "---:|" * len(head),
+    ]
     for n in sizes:
         cells = [fmt_time(med[(e, k, n)]) if (e, k, n) in med else "—" for e, k in series]
         cells.append(fmt_time(rebuild[n]["median"]) if rebuild[n] else "—")
@@ -165,8 +189,11 @@ def check_section(checks: list[dict]) -> list[str]:
     ok = sum(1 for c in checks if c["status"] == "ok")
     bad = [c for c in checks if c["status"] in ("failed", "error")]
     other = [c for c in checks if c["status"] in ("skipped", "unavailable")]
-    lines = ["## Correctness checks", "",
-             f"{ok} results checked before timing, {len(bad)} failed (a failed result is not timed)."]
+    lines = [
+        "## Correctness checks",
+        "",
+        f"{ok} results checked before timing, {len(bad)} failed (a failed result is not timed).",
+    ]
     for c in bad:
         lines.append(f"- **{c['engine']}** {c['kind']}, {c['distribution']} n={c['n']}: {c['detail']}")
     seen = set()
@@ -178,20 +205,27 @@ def check_section(checks: list[dict]) -> list[str]:
     return lines + [""]
 
 
-def markdown(stats: dict, checks: list[dict], info: dict, updates: list[dict], status: dict,
-             figures: list[str]) -> str:
+def markdown(stats: dict, checks: list[dict], info: dict, updates: list[dict], status: dict, figures: list[str]) -> str:
     plan = info.get("plan", {})
-    lines = ["# tvoronoi build benchmarks", "",
-             f"Machine: {describe_machine(info)}", "",
-             "Each (tool, distribution, n) runs in its own process: imports, a warm-up build (which gives the "
-             "peak memory) and a correctness check come first and are never timed; then the tools of a case "
-             "are timed in interleaved rounds. Times are medians, with [min–max] over the repeats; "
-             "**×r** is Qhull's median divided by the tool's (×8: eight times faster than Qhull, "
-             "×0.5: twice as slow). Points come from `tvoronoi.generators` with fixed seeds; every tool "
-             "gets the same points and the same box (the sites' bounding box grown by 10%).", ""]
+    lines = [
+        "# tvoronoi build benchmarks",
+        "",
+        f"Machine: {describe_machine(info)}",
+        "",
+        "Each (tool, distribution, n) runs in its own process: imports, a warm-up build (which gives the "
+        "peak memory) and a correctness check come first and are never timed; then the tools of a case "
+        "are timed in interleaved rounds. Times are medians, with [min–max] over the repeats; "
+        "**×r** is Qhull's median divided by the tool's (×8: eight times faster than Qhull, "
+        "×0.5: twice as slow). Points come from `tvoronoi.generators` with fixed seeds; every tool "
+        "gets the same points and the same box (the sites' bounding box grown by 10%).",
+        "",
+    ]
     if plan:
-        lines += [f"Sizes {', '.join(f'{n:,}' for n in plan.get('sizes', []))}; distributions "
-                  f"{', '.join(plan.get('distributions', []))}.", ""]
+        lines += [
+            f"Sizes {', '.join(f'{n:,}' for n in plan.get('sizes', []))}; distributions "
+            f"{', '.join(plan.get('distributions', []))}.",
+            "",
+        ]
     for kind in KINDS:
         _, dists, _ = present(stats, kind)
         if not dists:
@@ -199,21 +233,25 @@ def markdown(stats: dict, checks: list[dict], info: dict, updates: list[dict], s
         head = "uniform" if "uniform" in dists else dists[0]
         lines += [f"## Headline: {KIND_TITLES[kind]}, {head} points", ""]
         lines += time_table(stats, kind, head, spread=False) + [""]
-    lines += ["## What is timed", "",
-              "- **Full diagram**: tvoronoi -- the engine and its half-edge structure (Voronoi vertices, "
-              "edges, faces), before cells are clipped; Qhull -- `scipy.spatial.Voronoi(points)` (its "
-              "defaults, `Qbb Qc Qz`) and, as a lower bound, `scipy.spatial.Delaunay(points)` (the "
-              "triangulation alone); GEOS -- `shapely.voronoi_polygons(MultiPoint(points), "
-              "extend_to=box, ordered=True)`, polygons in input order; Triangle -- `triangle.voronoi(points)` "
-              "(vertices, edges and rays, no cells).",
-              "- **Bounded cells** (one polygon per site, clipped to the box): tvoronoi -- "
-              "`tvoronoi.voronoi(points, bbox=box)`, which returns clipped cells (CSR arrays); Qhull -- "
-              "`Voronoi`, the widely used finite-regions recipe (far points on the unbounded ridges), "
-              "then `shapely.intersection` with the box; GEOS -- `voronoi_polygons` then "
-              "`shapely.intersection` with the box. Qhull and GEOS return shapely polygons, tvoronoi numpy "
-              "arrays. Triangle has no cells and is not in this table.",
-              "- The textbook incremental order (fully random, conflict lists) is slow by design and runs "
-              "up to 200,000 points only.", ""]
+    lines += [
+        "## What is timed",
+        "",
+        "- **Full diagram**: tvoronoi -- the engine and its half-edge structure (Voronoi vertices, "
+        "edges, faces), before cells are clipped; Qhull -- `scipy.spatial.Voronoi(points)` (its "
+        "defaults, `Qbb Qc Qz`) and, as a lower bound, `scipy.spatial.Delaunay(points)` (the "
+        "triangulation alone); GEOS -- `shapely.voronoi_polygons(MultiPoint(points), "
+        "extend_to=box, ordered=True)`, polygons in input order; Triangle -- `triangle.voronoi(points)` "
+        "(vertices, edges and rays, no cells).",
+        "- **Bounded cells** (one polygon per site, clipped to the box): tvoronoi -- "
+        "`tvoronoi.voronoi(points, bbox=box)`, which returns clipped cells (CSR arrays); Qhull -- "
+        "`Voronoi`, the widely used finite-regions recipe (far points on the unbounded ridges), "
+        "then `shapely.intersection` with the box; GEOS -- `voronoi_polygons` then "
+        "`shapely.intersection` with the box. Qhull and GEOS return shapely polygons, tvoronoi numpy "
+        "arrays. Triangle has no cells and is not in this table.",
+        "- The textbook incremental order (fully random, conflict lists) is slow by design and runs "
+        "up to 200,000 points only.",
+        "",
+    ]
     for kind in KINDS:
         engines, dists, _ = present(stats, kind)
         if not dists:
@@ -225,9 +263,13 @@ def markdown(stats: dict, checks: list[dict], info: dict, updates: list[dict], s
         engines, dists, _ = present(stats, kind)
         if not dists:
             continue
-        lines += [f"## Peak memory (MiB), {KIND_TITLES[kind]}", "",
-                  f"Measured as the {info.get('peak_memory', 'peak resident set of the warm-up build')} "
-                  "(the points and a k-d tree for the checks are already in place).", ""]
+        lines += [
+            f"## Peak memory (MiB), {KIND_TITLES[kind]}",
+            "",
+            f"Measured as the {info.get('peak_memory', 'peak resident set of the warm-up build')} "
+            "(the points and a k-d tree for the checks are already in place).",
+            "",
+        ]
         for dist in dists:
             lines += [f"### {dist}", ""] + memory_table(stats, kind, dist) + [""]
     lines += update_section(updates, status, stats)
@@ -263,8 +305,14 @@ def plot_lines(stats: dict, value: str, path: Path, ylabel: str, title: str) -> 
     dists = [d for d in DIST_ORDER if any(key[2] == d for key in stats)]
     if not kinds or not dists:
         return False
-    fig, axes = plt.subplots(len(kinds), len(dists), figsize=(4.6 * len(dists), 3.9 * len(kinds)),
-                             squeeze=False, sharex=True, constrained_layout=True)
+    fig, axes = plt.subplots(
+        len(kinds),
+        len(dists),
+        figsize=(4.6 * len(dists), 3.9 * len(kinds)),
+        squeeze=False,
+        sharex=True,
+        constrained_layout=True,
+    )
     for row, kind in enumerate(kinds):
         engines, _, _ = present(stats, kind)
         for col, dist in enumerate(dists):
@@ -276,12 +324,20 @@ def plot_lines(stats: dict, value: str, path: Path, ylabel: str, title: str) -> 
                 xs = [n for n, _ in pts]
                 if value == "median":
                     ys = [s["median"] for _, s in pts]
-                    ax.fill_between(xs, [s["q1"] for _, s in pts], [s["q3"] for _, s in pts],
-                                    color=COLOURS.get(e), alpha=0.15, lw=0)
+                    ax.fill_between(
+                        xs, [s["q1"] for _, s in pts], [s["q3"] for _, s in pts], color=COLOURS.get(e), alpha=0.15, lw=0
+                    )
                 else:
                     ys = [max(s["peak"], MEMORY_FLOOR) for _, s in pts]
-                ax.plot(xs, ys, "o-", ms=3.5, color=COLOURS.get(e), label=label(e),
-                        lw=2.2 if e.startswith("tvoronoi") else 1.3)
+                ax.plot(
+                    xs,
+                    ys,
+                    "o-",
+                    ms=3.5,
+                    color=COLOURS.get(e),
+                    label=label(e),
+                    lw=2.2 if e.startswith("tvoronoi") else 1.3,
+                )
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.grid(True, which="major", alpha=0.3)
@@ -332,14 +388,15 @@ def plot_relative(stats: dict, path: Path) -> bool:
         for (i, j), v in np.ndenumerate(grid):
             if np.isfinite(v):
                 strong = abs(np.log(v)) > 0.6 * np.log(span)
-                ax.text(j, i, f"×{v:.2g}", ha="center", va="center", fontsize=7.5,
-                        color="white" if strong else "black")
+                ax.text(j, i, f"×{v:.2g}", ha="center", va="center", fontsize=7.5, color="white" if strong else "black")
         ax.set_xticks(range(len(sizes)), [short_n(n) for n in sizes], fontsize=7)
         ax.set_yticks(range(len(dists)), dists, fontsize=7.5)
         ax.set_title(f"{label(e)}\n{KIND_TITLES[k]}", fontsize=8.5)
     fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.8, label="speed-up over Qhull Voronoi (log)")
-    fig.suptitle("Each engine against Qhull (scipy.spatial.Voronoi; bounded: plus clipping): "
-                 "blue is faster, red slower", fontsize=10)
+    fig.suptitle(
+        "Each engine against Qhull (scipy.spatial.Voronoi; bounded: plus clipping): blue is faster, red slower",
+        fontsize=10,
+    )
     _save(fig, path)
     return True
 
@@ -352,14 +409,21 @@ def plot_updates(updates: list[dict], stats: dict, path: Path) -> bool:
     fig, ax = plt.subplots(figsize=(7.4, 5.0), constrained_layout=True)
     for e, k in update_series(med):
         pts = sorted((n, s) for (en, kind, n), s in med.items() if en == e and kind == k)
-        ax.plot(*zip(*pts), "-", marker=UPDATE_MARKERS[k], color=UPDATE_COLOURS[e],
-                label=f"{UPDATE_ENGINES[e]}: {UPDATE_KINDS[k]}")
+        ax.plot(
+            *zip(*pts),
+            "-",
+            marker=UPDATE_MARKERS[k],
+            color=UPDATE_COLOURS[e],
+            label=f"{UPDATE_ENGINES[e]}: {UPDATE_KINDS[k]}",
+        )
     sizes = sorted({key[2] for key in med})
-    for engine, kind, name, colour in (("qhull-delaunay", "full", "Qhull: Delaunay rebuild", "tab:grey"),
-                                       ("tvoronoi-incremental", "bounded", "tvoronoi: voronoi() rebuild",
-                                        "tab:orange")):
-        pts = [(n, stats[(engine, kind, "uniform", n)]["median"]) for n in sizes
-               if (engine, kind, "uniform", n) in stats]
+    for engine, kind, name, colour in (
+        ("qhull-delaunay", "full", "Qhull: Delaunay rebuild", "tab:grey"),
+        ("tvoronoi-incremental", "bounded", "tvoronoi: voronoi() rebuild", "tab:orange"),
+    ):
+        pts = [
+            (n, stats[(engine, kind, "uniform", n)]["median"]) for n in sizes if (engine, kind, "uniform", n) in stats
+        ]
         if pts:
             ax.plot(*zip(*pts), "--", color=colour, alpha=0.7, label=name)
     ax.set_xscale("log")
@@ -382,13 +446,17 @@ def write_report(out: Path = RESULTS) -> Path:
     info = json.loads((out / "machine.json").read_text()) if (out / "machine.json").exists() else {}
     status = json.loads((out / "updates.json").read_text()) if (out / "updates.json").exists() else {}
     made = []
-    if plot_lines(stats, "median", out / "time_vs_n.png", "seconds (median; band: quartiles)",
-                  "Build time against n"):
+    if plot_lines(stats, "median", out / "time_vs_n.png", "seconds (median; band: quartiles)", "Build time against n"):
         made.append("time_vs_n.png")
     if plot_relative(stats, out / "relative_to_qhull.png"):
         made.append("relative_to_qhull.png")
-    if plot_lines(stats, "peak", out / "memory_vs_n.png", "peak MiB above the baseline",
-                  f"Peak memory of one build against n (readings under {MEMORY_FLOOR} MiB drawn at it)"):
+    if plot_lines(
+        stats,
+        "peak",
+        out / "memory_vs_n.png",
+        "peak MiB above the baseline",
+        f"Peak memory of one build against n (readings under {MEMORY_FLOOR} MiB drawn at it)",
+    ):
         made.append("memory_vs_n.png")
     if plot_updates(updates, stats, out / "update_cost.png"):
         made.append("update_cost.png")

@@ -91,7 +91,7 @@ def repeats_for(n: int, quick: bool) -> int:
 def serve(tool_name: str, dist: str, n: int, seed: int) -> None:
     """Warm up, measure and check each kind, report, then time builds on request."""
     out = os.fdopen(os.dup(1), "w", buffering=1)
-    os.dup2(2, 1)                 # anything a library prints goes to stderr, not into the protocol
+    os.dup2(2, 1)  # anything a library prints goes to stderr, not into the protocol
     import numpy as np
     import scipy.spatial
 
@@ -139,8 +139,9 @@ class Worker:
         self.tool, self.dist, self.n = tool, dist, n
         self.err = tempfile.TemporaryFile(mode="w+")
         cmd = [sys.executable, __file__, "--worker", json.dumps([tool, dist, n, seed])]
-        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.err,
-                                     text=True, env=subprocess_env())
+        self.proc = subprocess.Popen(
+            cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.err, text=True, env=subprocess_env()
+        )
         self.error = None
         self.ready = {}
 
@@ -186,7 +187,7 @@ def started(dist: str, n: int, names: list[str], jobs: int):
     Nothing is timed while workers start: their warm-ups and checks may overlap.
     """
     for k in range(0, len(names), jobs):
-        batch = [Worker(name, dist, n, SEEDS.get(dist, 0)) for name in names[k:k + jobs]]
+        batch = [Worker(name, dist, n, SEEDS.get(dist, 0)) for name in names[k : k + jobs]]
         for w in batch:
             w.wait_ready()
             yield w
@@ -198,8 +199,17 @@ def run_case(dist: str, n: int, tools: list[str], repeats: int, rows: list, chec
     for name in tools:
         tool = TOOLS[name]
         if tool.max_n is not None and n > tool.max_n:
-            checks.extend({"engine": name, "distribution": dist, "n": n, "kind": k, "status": "skipped",
-                           "detail": f"not run above n = {tool.max_n:,}"} for k in tool.kinds())
+            checks.extend(
+                {
+                    "engine": name,
+                    "distribution": dist,
+                    "n": n,
+                    "kind": k,
+                    "status": "skipped",
+                    "detail": f"not run above n = {tool.max_n:,}",
+                }
+                for k in tool.kinds()
+            )
         else:
             names.append(name)
     workers = []
@@ -207,16 +217,26 @@ def run_case(dist: str, n: int, tools: list[str], repeats: int, rows: list, chec
         name = w.tool
         tool = TOOLS[name]
         if w.error:
-            checks.extend({"engine": name, "distribution": dist, "n": n, "kind": k, "status": "error",
-                           "detail": w.error} for k in tool.kinds())
+            checks.extend(
+                {"engine": name, "distribution": dist, "n": n, "kind": k, "status": "error", "detail": w.error}
+                for k in tool.kinds()
+            )
             print(f"  {name}: {w.error}", file=sys.stderr)
             w.close()
             continue
         for kind, r in w.ready.items():
             PEAK_RESET.add(r.get("fresh_peak", False))
             ok = r["check"] == "ok"
-            checks.append({"engine": name, "distribution": dist, "n": n, "kind": kind,
-                           "status": "ok" if ok else "failed", "detail": "" if ok else r["check"]})
+            checks.append(
+                {
+                    "engine": name,
+                    "distribution": dist,
+                    "n": n,
+                    "kind": kind,
+                    "status": "ok" if ok else "failed",
+                    "detail": "" if ok else r["check"],
+                }
+            )
             if not ok:
                 print(f"  {name} {kind}: {r['check']}", file=sys.stderr)
         workers.append(w)
@@ -229,25 +249,41 @@ def run_case(dist: str, n: int, tools: list[str], repeats: int, rows: list, chec
             if s is None:
                 continue
             times[(w.tool, kind)].append(s)
-            rows.append({"engine": w.tool, "distribution": dist, "n": n, "repeat": len(times[(w.tool, kind)]),
-                         "seconds": f"{s:.6g}", "peak_mib": w.ready[kind]["peak_mib"], "kind": kind})
+            rows.append(
+                {
+                    "engine": w.tool,
+                    "distribution": dist,
+                    "n": n,
+                    "repeat": len(times[(w.tool, kind)]),
+                    "seconds": f"{s:.6g}",
+                    "peak_mib": w.ready[kind]["peak_mib"],
+                    "kind": kind,
+                }
+            )
     for w in workers:
         if w.error:
-            checks.append({"engine": w.tool, "distribution": dist, "n": n, "kind": "timing", "status": "error",
-                           "detail": w.error})
+            checks.append(
+                {"engine": w.tool, "distribution": dist, "n": n, "kind": "timing", "status": "error", "detail": w.error}
+            )
             print(f"  {w.tool}: {w.error}", file=sys.stderr)
         w.close()
     peaks = {(w.tool, kind): r["peak_mib"] for w in workers for kind, r in w.ready.items()}
     for (tool, kind), ts in times.items():
         if ts:
-            print(f"  {tool:22s} {kind:8s} median {statistics.median(ts):9.4f} s  "
-                  f"[{min(ts):.4f} .. {max(ts):.4f}] x{len(ts)}  peak {peaks[(tool, kind)]:8.1f} MiB", flush=True)
+            print(
+                f"  {tool:22s} {kind:8s} median {statistics.median(ts):9.4f} s  "
+                f"[{min(ts):.4f} .. {max(ts):.4f}] x{len(ts)}  peak {peaks[(tool, kind)]:8.1f} MiB",
+                flush=True,
+            )
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true",
-                    help="sizes up to 100k, uniform and clustered, fewer repeats; results in results/quick/")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="sizes up to 100k, uniform and clustered, fewer repeats; results in results/quick/",
+    )
     ap.add_argument("--sizes", help="comma-separated sizes, e.g. 100,1k,10k")
     ap.add_argument("--dists", help="comma-separated distributions: uniform,gaussian,clustered")
     ap.add_argument("--tools", default=",".join(TOOLS), help="comma-separated tools (default: all)")
@@ -255,8 +291,12 @@ def main(argv=None) -> int:
     ap.add_argument("--update-sizes", help="sizes of the update-cost runs ('' to skip them)")
     ap.add_argument("--out", type=Path, help="results directory")
     ap.add_argument("--no-figures", action="store_true", help="skip the step-by-step figures")
-    ap.add_argument("--jobs", type=int, default=2,
-                    help=f"workers warming up at once (never while timing; 1 above n = {SERIAL_ABOVE:,})")
+    ap.add_argument(
+        "--jobs",
+        type=int,
+        default=2,
+        help=f"workers warming up at once (never while timing; 1 above n = {SERIAL_ABOVE:,})",
+    )
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
@@ -281,15 +321,16 @@ def main(argv=None) -> int:
         why = TOOLS[name].missing()
         if why:
             print(f"# {name} left out: {why}")
-            checks.append({"engine": name, "distribution": "*", "n": "*", "kind": "*", "status": "unavailable",
-                           "detail": why})
+            checks.append(
+                {"engine": name, "distribution": "*", "n": "*", "kind": "*", "status": "unavailable", "detail": why}
+            )
             tools.remove(name)
     atomic_write(out / "machine.json", json.dumps(info, indent=2) + "\n")
     print(f"# {info['cpu']}, {info['cores']} cores, Python {info['python']}; results in {out}", flush=True)
 
     rows: list = []
     t_start = time.perf_counter()
-    for n in sizes:                   # small cases first: a long run leaves usable results early
+    for n in sizes:  # small cases first: a long run leaves usable results early
         for dist in dists:
             print(f"{dist} n={n:,}", flush=True)
             jobs = args.jobs if n <= SERIAL_ABOVE else 1
@@ -299,13 +340,18 @@ def main(argv=None) -> int:
     print(f"# builds: {time.perf_counter() - t_start:.0f} s", flush=True)
     info["peak_memory"] = (
         "peak resident set of each warm-up build alone (reset through /proc/self/clear_refs), less the "
-        "resident set before it" if PEAK_RESET == {True} else
-        "process high-water mark less the resident set before the build (the peak could not be reset: "
-        "small builds read as the import-time peak)")
+        "resident set before it"
+        if PEAK_RESET == {True}
+        else "process high-water mark less the resident set before the build (the peak could not be reset: "
+        "small builds read as the import-time peak)"
+    )
     atomic_write(out / "machine.json", json.dumps(info, indent=2) + "\n")
 
-    update_sizes = plan["update_sizes"] if args.update_sizes is None else (
-        parse_sizes(args.update_sizes) if args.update_sizes.strip() else [])
+    update_sizes = (
+        plan["update_sizes"]
+        if args.update_sizes is None
+        else (parse_sizes(args.update_sizes) if args.update_sizes.strip() else [])
+    )
     if update_sizes:
         import updates
 

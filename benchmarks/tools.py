@@ -57,7 +57,7 @@ class Tool:
     check_full: Callable | None
     check_bounded: Callable | None
     max_n: int | None = None
-    requires: str | None = None      # an optional module the tool needs
+    requires: str | None = None  # an optional module the tool needs
 
     def kinds(self) -> tuple[str, ...]:
         return tuple(k for k in KINDS if getattr(self, k) is not None)
@@ -152,14 +152,14 @@ def finite_regions(vor, radius: float):
     for p1, region in enumerate(vor.point_region.tolist()):
         vertices = vor.regions[region]
         if all(v >= 0 for v in vertices):
-            new_regions.append(vertices)        # a bounded region: as Qhull gave it
+            new_regions.append(vertices)  # a bounded region: as Qhull gave it
             continue
         new_region = [v for v in vertices if v >= 0]
         for p2, v1, v2 in all_ridges[p1]:
             if v2 < 0:
                 v1, v2 = v2, v1
             if v1 >= 0:
-                continue                        # a finite ridge: already in the region
+                continue  # a finite ridge: already in the region
             t = vor.points[p2] - vor.points[p1]
             t /= np.linalg.norm(t)
             normal = np.array([-t[1], t[0]])
@@ -231,12 +231,13 @@ def check_vertices(vertices: np.ndarray, tree, box, what: str) -> None:
     tol = DIST_TOL * (_scale(box) + d[:, 0])
     bad = np.flatnonzero(gap > tol)
     if len(bad):
-        raise CheckFailed(f"{what}: vertex {finite[pick[bad[0]]]} is not equidistant from its three nearest "
-                          f"sites (gap {gap[bad[0]]:.3g})")
+        raise CheckFailed(
+            f"{what}: vertex {finite[pick[bad[0]]]} is not equidistant from its three nearest "
+            f"sites (gap {gap[bad[0]]:.3g})"
+        )
 
 
-def check_cells(n_cells: int, cell, areas: float, pts: np.ndarray, box, tree, what: str,
-                *, area: bool = True) -> None:
+def check_cells(n_cells: int, cell, areas: float, pts: np.ndarray, box, tree, what: str, *, area: bool = True) -> None:
     """One cell per site; sampled cells hold their site and lie in its Voronoi cell; areas tile the box.
 
     ``cell(i)`` gives the corners of cell i as a (k, 2) array (closed or not),
@@ -248,8 +249,10 @@ def check_cells(n_cells: int, cell, areas: float, pts: np.ndarray, box, tree, wh
     _fail(n_cells == n, f"{what}: {n_cells} cells for {n} sites")
     if area:
         box_area = (box[2] - box[0]) * (box[3] - box[1])
-        _fail(abs(areas - box_area) <= AREA_TOL * box_area,
-              f"{what}: cell areas add up to {areas!r}, the box has {box_area!r}")
+        _fail(
+            abs(areas - box_area) <= AREA_TOL * box_area,
+            f"{what}: cell areas add up to {areas!r}, the box has {box_area!r}",
+        )
     tol = DIST_TOL * _scale(box)
     for i in _rng().choice(n, size=min(SAMPLE, n), replace=False).tolist():
         ring = np.asarray(cell(i), float).reshape(-1, 2)
@@ -271,10 +274,10 @@ def csr_area(points: np.ndarray, offsets: np.ndarray, ring: np.ndarray) -> float
             continue
         xy = points[ring[a:b]]
         nxt = np.arange(a, b) + 1
-        ends = offsets[lo + 1:hi + 1]
+        ends = offsets[lo + 1 : hi + 1]
         starts = offsets[lo:hi]
         nonempty = ends > starts
-        nxt[ends[nonempty] - 1 - a] = starts[nonempty]   # last corner of a ring wraps to its first
+        nxt[ends[nonempty] - 1 - a] = starts[nonempty]  # last corner of a ring wraps to its first
         nxy = points[ring[nxt]]
         total += 0.5 * float(np.sum(xy[:, 0] * nxy[:, 1] - nxy[:, 0] * xy[:, 1]))
     return total
@@ -295,8 +298,16 @@ def check_tv_bounded(d, pts, box, tree) -> None:
 def check_shapely_cells(cells, pts, box, tree, what: str, *, area: bool = True) -> None:
     import shapely
 
-    check_cells(len(cells), lambda i: shapely.get_coordinates(cells[i]),
-                float(shapely.area(cells).sum()), pts, box, tree, what, area=area)
+    check_cells(
+        len(cells),
+        lambda i: shapely.get_coordinates(cells[i]),
+        float(shapely.area(cells).sum()),
+        pts,
+        box,
+        tree,
+        what,
+        area=area,
+    )
 
 
 def check_qhull_voronoi(vor, pts, box, tree) -> None:
@@ -306,15 +317,19 @@ def check_qhull_voronoi(vor, pts, box, tree) -> None:
 
 def check_qhull_delaunay(tri, pts, box, tree) -> None:
     n, h = len(pts), hull_size(pts)
-    _fail(len(tri.simplices) == 2 * n - 2 - h,
-          f"Qhull Delaunay: {len(tri.simplices)} triangles, expected 2n - 2 - h = {2 * n - 2 - h}")
+    _fail(
+        len(tri.simplices) == 2 * n - 2 - h,
+        f"Qhull Delaunay: {len(tri.simplices)} triangles, expected 2n - 2 - h = {2 * n - 2 - h}",
+    )
     pick = _rng().choice(len(tri.simplices), size=min(SAMPLE, len(tri.simplices)), replace=False)
     p, q, r = (pts[tri.simplices[pick, k]] for k in range(3))
     centre = circumcentres(p, q, r)
     radius = np.hypot(*(centre - p).T)
     nearest, _ = tree.query(centre)
-    _fail(bool(np.all(nearest >= radius - DIST_TOL * (_scale(box) + radius))),
-          "Qhull Delaunay: a site lies inside a triangle's circumcircle")
+    _fail(
+        bool(np.all(nearest >= radius - DIST_TOL * (_scale(box) + radius))),
+        "Qhull Delaunay: a site lies inside a triangle's circumcircle",
+    )
 
 
 def check_geos_full(cells, pts, box, tree) -> None:
@@ -329,29 +344,60 @@ def check_bounded_cells(what: str):
 def check_triangle(result, pts, box, tree) -> None:
     vertices, edges, ray_origin, _ = result
     n, h = len(pts), hull_size(pts)
-    _fail(len(vertices) == 2 * n - 2 - h,
-          f"Triangle: {len(vertices)} Voronoi vertices, expected 2n - 2 - h = {2 * n - 2 - h}")
-    _fail(len(edges) + len(ray_origin) == 3 * n - 3 - h,
-          f"Triangle: {len(edges) + len(ray_origin)} edges and rays, expected 3n - 3 - h = {3 * n - 3 - h}")
+    _fail(
+        len(vertices) == 2 * n - 2 - h,
+        f"Triangle: {len(vertices)} Voronoi vertices, expected 2n - 2 - h = {2 * n - 2 - h}",
+    )
+    _fail(
+        len(edges) + len(ray_origin) == 3 * n - 3 - h,
+        f"Triangle: {len(edges) + len(ray_origin)} edges and rays, expected 3n - 3 - h = {3 * n - 3 - h}",
+    )
     check_vertices(vertices, tree, box, "Triangle")
 
 
 # Textbook insertion (fully random order, conflict lists) is the slow reference; not run above this.
 TEXTBOOK_MAX_N = 200_000
 
-TOOLS: dict[str, Tool] = {t.name: t for t in (
-    Tool("tvoronoi-fortune", "tvoronoi Fortune",
-         _tv_full("fortune"), _tv_bounded("fortune"), check_tv_full, check_tv_bounded),
-    Tool("tvoronoi-incremental", "tvoronoi incremental (BRIO)",
-         _tv_full("incremental"), _tv_bounded("incremental"), check_tv_full, check_tv_bounded),
-    Tool("tvoronoi-textbook", "tvoronoi incremental (textbook)",
-         _tv_full("incremental", "random"), _tv_bounded("incremental", "random"),
-         check_tv_full, check_tv_bounded, max_n=TEXTBOOK_MAX_N),
-    Tool("qhull-voronoi", "Qhull Voronoi (scipy)",
-         qhull_voronoi, qhull_bounded, check_qhull_voronoi, check_bounded_cells("Qhull cells")),
-    Tool("qhull-delaunay", "Qhull Delaunay (scipy)", qhull_delaunay, None, check_qhull_delaunay, None),
-    Tool("geos", "GEOS (shapely)", geos_full, geos_bounded, check_geos_full, check_bounded_cells("GEOS cells")),
-    Tool("triangle", "Triangle", triangle_full, None, check_triangle, None, requires="triangle"),
-)}
+TOOLS: dict[str, Tool] = {
+    t.name: t
+    for t in (
+        Tool(
+            "tvoronoi-fortune",
+            "tvoronoi Fortune",
+            _tv_full("fortune"),
+            _tv_bounded("fortune"),
+            check_tv_full,
+            check_tv_bounded,
+        ),
+        Tool(
+            "tvoronoi-incremental",
+            "tvoronoi incremental (BRIO)",
+            _tv_full("incremental"),
+            _tv_bounded("incremental"),
+            check_tv_full,
+            check_tv_bounded,
+        ),
+        Tool(
+            "tvoronoi-textbook",
+            "tvoronoi incremental (textbook)",
+            _tv_full("incremental", "random"),
+            _tv_bounded("incremental", "random"),
+            check_tv_full,
+            check_tv_bounded,
+            max_n=TEXTBOOK_MAX_N,
+        ),
+        Tool(
+            "qhull-voronoi",
+            "Qhull Voronoi (scipy)",
+            qhull_voronoi,
+            qhull_bounded,
+            check_qhull_voronoi,
+            check_bounded_cells("Qhull cells"),
+        ),
+        Tool("qhull-delaunay", "Qhull Delaunay (scipy)", qhull_delaunay, None, check_qhull_delaunay, None),
+        Tool("geos", "GEOS (shapely)", geos_full, geos_bounded, check_geos_full, check_bounded_cells("GEOS cells")),
+        Tool("triangle", "Triangle", triangle_full, None, check_triangle, None, requires="triangle"),
+    )
+}
 # The reference every ratio is taken against, per kind.
 REFERENCE = {"full": "qhull-voronoi", "bounded": "qhull-voronoi"}

@@ -150,9 +150,13 @@ def main() -> None:
         parser.error("--start-only needs --start")
     cols, rows = (int(v) for v in args.size.lower().split("x"))
     (n,) = parse_sizes(args.sites)
-    report = {"sites": n, "terminal": f"{cols}x{rows}", "repeats": args.repeats,
-              "load_average": os.getloadavg()[0],
-              "keys_ms": {} if args.start_only else asyncio.run(keys(n, cols, rows, args.repeats))}
+    report = {
+        "sites": n,
+        "terminal": f"{cols}x{rows}",
+        "repeats": args.repeats,
+        "load_average": os.getloadavg()[0],
+        "keys_ms": {} if args.start_only else asyncio.run(keys(n, cols, rows, args.repeats)),
+    }
     if args.start:
         (big,) = parse_sizes(args.start)
         wall, cpu = asyncio.run(start(big, cols, rows))
@@ -162,8 +166,10 @@ def main() -> None:
     for label, ms in report["keys_ms"].items():
         print(f"{label:<32} {ms['cpu_ms']:8.1f} {ms['wall_ms']:8.1f}")
     for big, ms in report.get("start_ms", {}).items():
-        print(f"{int(big):,} sites shown in {ms / 1000:.2f} s ({report['start_cpu_ms'][big] / 1000:.2f} s CPU, "
-              f"all threads)")
+        print(
+            f"{int(big):,} sites shown in {ms / 1000:.2f} s ({report['start_cpu_ms'][big] / 1000:.2f} s CPU, "
+            f"all threads)"
+        )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(report, indent=2) + "\n")
 

@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common import RESULTS, maxrss_mib, parse_sizes, reset_peak, rss_mib, subprocess_env, write_csv  # noqa: E402
 
-SEED = 1                      # the uniform points of the build benchmark
+SEED = 1  # the uniform points of the build benchmark
 WARM_UP_OPS = 3
 # The dynamic structure of each tvoronoi engine.
 DYNAMIC_ENGINES = {"tvoronoi-dynamic": "incremental", "tvoronoi-dynamic-fortune": "fortune"}
@@ -89,15 +89,18 @@ def measure_dynamic(pts, box, ops: int, rng, engine: str) -> tuple[list, list]:
         alive[i] = False
         d = np.hypot(*(xy - xy[i]).T)
         d[~alive] = np.inf
-        j = ids[int(np.argmin(d))]              # the nearest survivor now owns the removed site's place
+        j = ids[int(np.argmin(d))]  # the nearest survivor now owns the removed site's place
         t0 = time.perf_counter()
         dv.remove(i)
         ring = cell(j)
         rows.append(("remove", time.perf_counter() - t0))
         cells["remove"].append((ring, xy[i]))
-    failures = [f"{op} {k}: the cell read back misses {tuple(p)}"
-                for op, found in cells.items() for k, (ring, p) in enumerate(found)
-                if not shapely.Polygon(np.asarray(ring)).covers(shapely.Point(p))]
+    failures = [
+        f"{op} {k}: the cell read back misses {tuple(p)}"
+        for op, found in cells.items()
+        for k, (ring, p) in enumerate(found)
+        if not shapely.Polygon(np.asarray(ring)).covers(shapely.Point(p))
+    ]
     # drop the warm-up operations of each kind
     timed = [r for op in ("insert", "move", "remove") for r in [x for x in rows if x[0] == op][WARM_UP_OPS:]]
     return timed, failures
@@ -115,16 +118,19 @@ def measure_qhull(pts, ops: int, rng) -> tuple[list, list]:
     spent = 0.0
     for k in range(total):
         t0 = time.perf_counter()
-        tri.add_points(new[k:k + 1])
+        tri.add_points(new[k : k + 1])
         rows.append(("add_points", time.perf_counter() - t0))
         spent += rows[-1][1]
         if spent > QHULL_BUDGET and len(rows) >= WARM_UP_OPS + QHULL_MIN_OPS:
-            break                                   # each call is O(n): enough for a median
+            break  # each call is O(n): enough for a median
     # every added point is a vertex of the triangulation, and no point was dropped
     used = np.zeros(len(tri.points), bool)
     used[tri.simplices.ravel()] = True
-    failures = [] if len(tri.points) == len(pts) + len(rows) and used[len(pts):].all() else [
-        "Qhull: an added point is not a vertex of the triangulation"]
+    failures = (
+        []
+        if len(tri.points) == len(pts) + len(rows) and used[len(pts) :].all()
+        else ["Qhull: an added point is not a vertex of the triangulation"]
+    )
     tri.close()
     return rows[WARM_UP_OPS:], failures
 
@@ -167,8 +173,17 @@ def run_all(sizes: list[int], ops: int, out: Path) -> list[dict]:
             by_kind: dict = {}
             for kind, s in res["rows"]:
                 by_kind.setdefault(kind, []).append(s)
-                rows.append({"engine": tool, "distribution": "uniform", "n": n, "repeat": len(by_kind[kind]),
-                             "seconds": f"{s:.6g}", "peak_mib": res["peak_mib"], "kind": kind})
+                rows.append(
+                    {
+                        "engine": tool,
+                        "distribution": "uniform",
+                        "n": n,
+                        "repeat": len(by_kind[kind]),
+                        "seconds": f"{s:.6g}",
+                        "peak_mib": res["peak_mib"],
+                        "kind": kind,
+                    }
+                )
             for kind, ts in by_kind.items():
                 print(f"  {tool:26s} {kind:10s} n={n:>9,}  median {statistics.median(ts) * 1e3:9.3f} ms", flush=True)
     write_csv(out / "updates.csv", rows)

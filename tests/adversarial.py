@@ -123,8 +123,7 @@ def hexagonal_rotated(side: int = 30, *, degrees: float = 17.0, noise: float = 0
     rng = np.random.default_rng(seed)
     g = np.array([(i + 0.5 * (j % 2), j * math.sqrt(3) / 2) for i in range(side) for j in range(side)], float)
     t = math.radians(degrees)
-    g = np.column_stack([math.cos(t) * g[:, 0] - math.sin(t) * g[:, 1],
-                         math.sin(t) * g[:, 0] + math.cos(t) * g[:, 1]])
+    g = np.column_stack([math.cos(t) * g[:, 0] - math.sin(t) * g[:, 1], math.sin(t) * g[:, 0] + math.cos(t) * g[:, 1]])
     if noise:
         g = g + rng.normal(0.0, noise, g.shape)
     return Case(_pts(g[rng.permutation(len(g))]), note=f"hexagonal lattice rotated {degrees} deg, noise {noise:g}")
@@ -223,8 +222,9 @@ def rounded_gaussian(n: int = 2000, *, decimals: int = 1, seed: int = SEED) -> C
 # circles
 
 
-def circle_rounded(n: int = 500, *, radius: float = 1.0, centre=(0.0, 0.0), with_centre: bool = False,
-                   seed: int = SEED) -> Case:
+def circle_rounded(
+    n: int = 500, *, radius: float = 1.0, centre=(0.0, 0.0), with_centre: bool = False, seed: int = SEED
+) -> Case:
     """n points on a circle at random angles, rounded to doubles: every quadruple near-cocircular."""
     rng = np.random.default_rng(seed)
     t = rng.uniform(0.0, 2.0 * math.pi, n)
@@ -392,8 +392,9 @@ def box_far_away(n: int = 300, *, seed: int = SEED) -> Case:
 def box_one_ulp_thin(n: int = 300, *, seed: int = SEED) -> Case:
     """A box one ulp high across the sites."""
     y0 = 0.5
-    return Case(_pts(_unit_sites(n, seed)), bbox=(0.0, y0, 1.0, float(np.nextafter(y0, 1.0))),
-                note="a box one ulp thin")
+    return Case(
+        _pts(_unit_sites(n, seed)), bbox=(0.0, y0, 1.0, float(np.nextafter(y0, 1.0))), note="a box one ulp thin"
+    )
 
 
 def box_huge(n: int = 300, *, seed: int = SEED) -> Case:
@@ -482,8 +483,10 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "heavy_duplicates": partial(heavy_duplicates, 50, 20),
     "duplicates_of_triangle": partial(duplicates_of_three, 30),
     "duplicates_of_collinear": partial(duplicates_of_three, 30, collinear=True),
-    **{f"sites_{kind}": partial(few_sites, kind)
-       for kind in ("zero", "one", "two", "two_equal", "three_collinear", "three")},
+    **{
+        f"sites_{kind}": partial(few_sites, kind)
+        for kind in ("zero", "one", "two", "two_equal", "three_collinear", "three")
+    },
     # user boxes
     "box_excludes_most": box_excludes_most,
     "box_far_away": box_far_away,

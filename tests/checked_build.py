@@ -24,17 +24,32 @@ def built() -> bool:
     """The checked kernels exist and are newer than every kernel source and setup.py."""
     sos = list((CHECKED_DIR / "tvoronoi" / "kernels").glob("*.so"))
     sources = list(KERNELS.glob("*.pyx")) + list(KERNELS.glob("*.pxd")) + [ROOT / "setup.py"]
-    return len(sos) >= len(list(KERNELS.glob("*.pyx"))) and \
-        min(p.stat().st_mtime for p in sos) >= max(p.stat().st_mtime for p in sources)
+    return len(sos) >= len(list(KERNELS.glob("*.pyx"))) and min(p.stat().st_mtime for p in sos) >= max(
+        p.stat().st_mtime for p in sources
+    )
 
 
 def ensure_built() -> None:
     if built():
         return
     env = dict(os.environ, TVORONOI_CHECKED=os.environ.get("CHECKED_MODE", "asan"))
-    subprocess.run([sys.executable, "setup.py", "-q", "build_ext", "--force", "--build-lib", str(CHECKED_DIR),
-                    "--build-temp", str(ROOT / "build" / "checked-tmp")],
-                   cwd=ROOT, env=env, check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "setup.py",
+            "-q",
+            "build_ext",
+            "--force",
+            "--build-lib",
+            str(CHECKED_DIR),
+            "--build-temp",
+            str(ROOT / "build" / "checked-tmp"),
+        ],
+        cwd=ROOT,
+        env=env,
+        check=True,
+        capture_output=True,
+    )
 
 
 @contextlib.contextmanager

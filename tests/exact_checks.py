@@ -52,8 +52,7 @@ class ExactPoints:
         alift = adx * adx + ady * ady
         blift = bdx * bdx + bdy * bdy
         clift = cdx * cdx + cdy * cdy
-        return (alift * (bdx * cdy - bdy * cdx) + blift * (cdx * ady - cdy * adx)
-                + clift * (adx * bdy - ady * bdx))
+        return alift * (bdx * cdy - bdy * cdx) + blift * (cdx * ady - cdy * adx) + clift * (adx * bdy - ady * bdx)
 
 
 def orient_fraction(p, q, r) -> Fraction:
@@ -66,8 +65,11 @@ def incircle_fraction(a, b, c, d) -> Fraction:
     """The in-circle determinant in Fractions (reference for ExactPoints.incircle)."""
     (ax, ay), (bx, by), (cx, cy), (dx, dy) = [(Fraction(float(u)), Fraction(float(v))) for u, v in (a, b, c, d)]
     adx, ady, bdx, bdy, cdx, cdy = ax - dx, ay - dy, bx - dx, by - dy, cx - dx, cy - dy
-    return ((adx * adx + ady * ady) * (bdx * cdy - bdy * cdx) + (bdx * bdx + bdy * bdy) * (cdx * ady - cdy * adx)
-            + (cdx * cdx + cdy * cdy) * (adx * bdy - ady * bdx))
+    return (
+        (adx * adx + ady * ady) * (bdx * cdy - bdy * cdx)
+        + (bdx * bdx + bdy * bdy) * (cdx * ady - cdy * adx)
+        + (cdx * cdx + cdy * cdy) * (adx * bdy - ady * bdx)
+    )
 
 
 def hull_boundary(ex: ExactPoints, idx) -> list[int]:
@@ -148,12 +150,15 @@ def check_delaunay_exact(d) -> None:
         if dd is None:
             continue
         s = ex.incircle(a, b, c, dd)
-        assert s <= 0, (f"edge {a, b}: site {dd} is strictly inside the circumcircle of {a, b, c} "
-                        f"(exact in-circle), not Delaunay")
+        assert s <= 0, (
+            f"edge {a, b}: site {dd} is strictly inside the circumcircle of {a, b, c} (exact in-circle), not Delaunay"
+        )
     boundary = {e for e in third if (e[1], e[0]) not in third}
     want = {(hull[k], hull[(k + 1) % h]) for k in range(h)}
-    assert boundary == want, (f"the unpaired edges are not the hull's: {sorted(boundary - want)[:3]} extra, "
-                              f"{sorted(want - boundary)[:3]} missing")
+    assert boundary == want, (
+        f"the unpaired edges are not the hull's: {sorted(boundary - want)[:3]} extra, "
+        f"{sorted(want - boundary)[:3]} missing"
+    )
     hull_area2 = ring_area2([ex.x[i] for i in hull], [ex.y[i] for i in hull])
     assert area2 == hull_area2, f"triangles cover {area2}, hull {hull_area2} (twice the area, exact units)"
 
@@ -163,7 +168,7 @@ def check_delaunay_exact(d) -> None:
 
 # Below this magnitude GEOS's products of coordinate differences underflow (a subnormal diagram looks flat
 # to it); such diagrams are handed to shapely scaled up by a power of two, which is exact (no rounding).
-GEOS_TINY = 2.0 ** -500
+GEOS_TINY = 2.0**-500
 
 
 # GEOS decides on doubles (with double-double filters): a diagram whose nonzero coordinates span more
@@ -181,14 +186,21 @@ def magnitude_span(d) -> int:
 
 def _segments_meet(ex: ExactPoints, p: int, q: int, r: int, s: int) -> bool:
     """Closed segments pq and rs share a point (exact)."""
+
     def on(a, b, c):
-        return (min(ex.x[a], ex.x[b]) <= ex.x[c] <= max(ex.x[a], ex.x[b])
-                and min(ex.y[a], ex.y[b]) <= ex.y[c] <= max(ex.y[a], ex.y[b]))
+        return min(ex.x[a], ex.x[b]) <= ex.x[c] <= max(ex.x[a], ex.x[b]) and min(ex.y[a], ex.y[b]) <= ex.y[c] <= max(
+            ex.y[a], ex.y[b]
+        )
+
     sg = [(o > 0) - (o < 0) for o in (ex.orient(p, q, r), ex.orient(p, q, s), ex.orient(r, s, p), ex.orient(r, s, q))]
     if sg[0] * sg[1] < 0 and sg[2] * sg[3] < 0:
         return True
-    return ((sg[0] == 0 and on(p, q, r)) or (sg[1] == 0 and on(p, q, s))
-            or (sg[2] == 0 and on(r, s, p)) or (sg[3] == 0 and on(r, s, q)))
+    return (
+        (sg[0] == 0 and on(p, q, r))
+        or (sg[1] == 0 and on(p, q, s))
+        or (sg[2] == 0 and on(r, s, p))
+        or (sg[3] == 0 and on(r, s, q))
+    )
 
 
 def ring_is_simple_exact(ex: ExactPoints, k: int) -> bool:
@@ -210,8 +222,10 @@ def covers_exact(ring: np.ndarray, point) -> bool:
     for a in range(k):
         b = (a + 1) % k
         o = ex.orient(a, b, t)
-        if o == 0 and (min(ex.x[a], ex.x[b]) <= ex.x[t] <= max(ex.x[a], ex.x[b])
-                       and min(ex.y[a], ex.y[b]) <= ex.y[t] <= max(ex.y[a], ex.y[b])):
+        if o == 0 and (
+            min(ex.x[a], ex.x[b]) <= ex.x[t] <= max(ex.x[a], ex.x[b])
+            and min(ex.y[a], ex.y[b]) <= ex.y[t] <= max(ex.y[a], ex.y[b])
+        ):
             return True
         if (ex.y[a] > ex.y[t]) != (ex.y[b] > ex.y[t]):
             # the edge crosses the horizontal through t: on t's right when the turn says so
@@ -222,8 +236,11 @@ def covers_exact(ring: np.ndarray, point) -> bool:
 
 def geos_exponent(d) -> int:
     """k such that coordinates * 2**k are what shapely sees: 0 (raw) unless every coordinate is tiny."""
-    top = max(float(np.abs(d.cell_points).max()) if len(d.cell_points) else 0.0,
-              float(np.abs(d.sites).max()) if d.n_sites else 0.0, *(abs(v) for v in d.bbox))
+    top = max(
+        float(np.abs(d.cell_points).max()) if len(d.cell_points) else 0.0,
+        float(np.abs(d.sites).max()) if d.n_sites else 0.0,
+        *(abs(v) for v in d.bbox),
+    )
     if top == 0.0 or top >= GEOS_TINY:
         return 0
     return -int(np.frexp(top)[1])
@@ -272,8 +289,9 @@ def check_cells_valid(d) -> None:
             assert len(ring) == 0, f"repeated point {i} (a copy of {int(d.site_of[i])}) has a cell of its own"
             continue
         if len(ring) == 0:
-            assert not inside[i] or has_ulp_neighbour(d, i), \
+            assert not inside[i] or has_ulp_neighbour(d, i), (
                 f"site {i} {tuple(d.sites[i].tolist())} is in the box but has no cell"
+            )
             continue
         assert len(ring) >= 3, f"cell {i} has {len(ring)} points"
         assert np.all(np.isfinite(ring)), f"cell {i} has a non-finite point"
@@ -290,8 +308,9 @@ def check_cells_valid(d) -> None:
         poly = shapely.Polygon(for_geos(ring, k))
         assert poly.is_valid, f"cell {i} invalid: {shapely.is_valid_reason(poly)}"
         if inside[i]:
-            assert poly.covers(shapely.Point(for_geos(d.sites[i], k))), \
+            assert poly.covers(shapely.Point(for_geos(d.sites[i], k))), (
                 f"site {i} {tuple(d.sites[i].tolist())} is outside its cell"
+            )
 
 
 def check_points_distinct(d) -> None:
@@ -338,8 +357,9 @@ def check_tiling(d) -> None:
         return
     k = geos_exponent(d)
     polys = shapely.polygons([shapely.linearrings(for_geos(r, k)) for r in rings])
-    assert shapely.coverage_is_valid(shapely.GeometryCollection(list(polys))), \
+    assert shapely.coverage_is_valid(shapely.GeometryCollection(list(polys))), (
         "shapely: the cells do not form a valid coverage (overlap or slivers)"
+    )
 
 
 def _collinear(a, b, p) -> bool:

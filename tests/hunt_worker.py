@@ -89,8 +89,8 @@ def _serve(kernels: str | None) -> None:
     import faulthandler
 
     faulthandler.enable()
-    proto = os.fdopen(os.dup(1), "w")         # answers go to the real stdout ...
-    os.dup2(2, 1)                             # ... and anything printed to stderr
+    proto = os.fdopen(os.dup(1), "w")  # answers go to the real stdout ...
+    os.dup2(2, 1)  # ... and anything printed to stderr
     sys.path.insert(0, str(HERE))
     if kernels:
         _use_kernels(kernels)
@@ -100,7 +100,7 @@ def _serve(kernels: str | None) -> None:
 
     unraisable: list[str] = []
 
-    def hook(u):                               # an error inside a noexcept kernel function
+    def hook(u):  # an error inside a noexcept kernel function
         unraisable.append(f"{type(u.exc_value).__name__}: {u.exc_value} (in {u.object!r})")
 
     sys.unraisablehook = hook
@@ -108,7 +108,7 @@ def _serve(kernels: str | None) -> None:
     proto.flush()
     for line in sys.stdin:
         req = json.loads(line)
-        if req.get("selftest") == "asan":          # overflow a numpy buffer: ASan must stop the child here
+        if req.get("selftest") == "asan":  # overflow a numpy buffer: ASan must stop the child here
             import ctypes
 
             src, dst = np.zeros(64), np.zeros(128)
@@ -150,8 +150,7 @@ def _serve(kernels: str | None) -> None:
         if d is not None and req.get("save"):
             cells = exact_checks.cells_of(d)
             lengths = np.array([len(r) for r in cells], np.int64)
-            np.savez(req["save"], lengths=lengths,
-                     points=np.concatenate(cells) if cells else np.empty((0, 2)))
+            np.savez(req["save"], lengths=lengths, points=np.concatenate(cells) if cells else np.empty((0, 2)))
             out["saved"] = req["save"]
         proto.write(json.dumps(out) + "\n")
         proto.flush()
@@ -171,8 +170,14 @@ def load_cells(path) -> list[np.ndarray]:
 class Worker:
     """A child process that runs cases; restarted after a crash or a timeout."""
 
-    def __init__(self, *, kernels: str | None = None, env: dict | None = None, python: str = sys.executable,
-                 start_timeout: float = 120.0):
+    def __init__(
+        self,
+        *,
+        kernels: str | None = None,
+        env: dict | None = None,
+        python: str = sys.executable,
+        start_timeout: float = 120.0,
+    ):
         self.kernels, self.env, self.python = kernels, env, python
         self.start_timeout = start_timeout
         self.proc: subprocess.Popen | None = None
@@ -186,8 +191,16 @@ class Worker:
         env = dict(os.environ, **(self.env or {}))
         self.stderr = open(Path(self.tmp.name, f"stderr{self._n}.txt"), "w+b")
         self._n += 1
-        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.stderr,
-                                     cwd=str(ROOT), env=env, text=True, bufsize=1)
+        self.proc = subprocess.Popen(
+            cmd,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.stderr,
+            cwd=str(ROOT),
+            env=env,
+            text=True,
+            bufsize=1,
+        )
         ready = self._read(self.start_timeout)
         if ready is None or "ready" not in ready:
             raise RuntimeError(f"the worker did not start: {self._stderr_tail()}")
@@ -280,9 +293,9 @@ POISONS = (0x00, 0xFF, 0x01)
 
 
 def uninit_result(worker: Worker, request: dict, reference: dict, *, timeout: float) -> str:
-    """"ok" if the build gives the same output (digest or error) whatever np.empty's arrays held."""
+    """ "ok" if the build gives the same output (digest or error) whatever np.empty's arrays held."""
     if "digest" not in reference and not reference["build"].startswith(("crash", "timeout")):
-        want = reference["build"]                 # an error the engine reports: must stay the same
+        want = reference["build"]  # an error the engine reports: must stay the same
     elif "digest" in reference:
         want = reference["digest"]
     else:

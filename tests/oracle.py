@@ -38,8 +38,7 @@ def oracle_cells(points, bbox):
             if t[0] == s[0] and t[1] == s[1]:
                 continue
             # |x - s|^2 <= |x - t|^2  <=>  2 (t - s) . x <= |t|^2 - |s|^2
-            poly = clip_half_plane(poly, 2 * (t[0] - s[0]), 2 * (t[1] - s[1]),
-                                   t @ t - s @ s)
+            poly = clip_half_plane(poly, 2 * (t[0] - s[0]), 2 * (t[1] - s[1]), t @ t - s @ s)
         cells.append(shapely.Polygon(poly) if len(poly) >= 3 else shapely.Polygon())
     return cells
 
@@ -60,6 +59,7 @@ def assert_matches_oracle(d, *, rtol=1e-7):
         got = shapely.Polygon(ring - origin)
         # areas and vertex distances, not an overlay: GEOS can mis-node two rings that
         # differ only in the last bits of their vertices
-        assert abs(got.area - want.area) <= rtol * size * (got.length + want.length), \
+        assert abs(got.area - want.area) <= rtol * size * (got.length + want.length), (
             f"cell {i}: area {got.area}, the oracle's {want.area}"
+        )
         assert got.hausdorff_distance(want) <= rtol * size, f"cell {i}: a vertex is off"

@@ -84,8 +84,14 @@ def main(argv=None) -> int:
             for engine in ENGINES:
                 base = {k: v for k, v in req.items() if k not in ("engine", "save")} | {"engine": engine}
                 u = uninit_result(worker, base, answers[engine], timeout=min(args.timeout, 20.0))
-                row = {"family": name, "engine": engine, **{c: answers[engine][c] for c in CHECK_NAMES},
-                       "agree": a, "uninit": u, "seconds": answers[engine]["seconds"]}
+                row = {
+                    "family": name,
+                    "engine": engine,
+                    **{c: answers[engine][c] for c in CHECK_NAMES},
+                    "agree": a,
+                    "uninit": u,
+                    "seconds": answers[engine]["seconds"],
+                }
                 if cw:
                     row["checked"] = build_only(cw, base)
                 rows.append(row)

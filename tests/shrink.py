@@ -27,16 +27,25 @@ from hunt_worker import Worker, load_cells  # noqa: E402
 
 
 def kind(msg: str) -> str:
-    return "ok" if msg == "ok" else "crash" if msg.startswith("crash") else \
-        "timeout" if msg.startswith("timeout") else "fail"
+    return (
+        "ok"
+        if msg == "ok"
+        else "crash"
+        if msg.startswith("crash")
+        else "timeout"
+        if msg.startswith("timeout")
+        else "fail"
+    )
 
 
 def outcome(worker: Worker, pts, bbox, engine: str, check: str, timeout: float, poison=None) -> str:
     req = {"points": np.asarray(pts).tolist(), "bbox": bbox, "poison": poison}
     if check != "agree":
         return worker.run(req | {"engine": engine}, timeout=timeout)[check]
-    answers = [worker.run(req | {"engine": e, "save": worker.cells_path(f"shrink-{e}")}, timeout=timeout)
-               for e in ("fortune", "incremental")]
+    answers = [
+        worker.run(req | {"engine": e, "save": worker.cells_path(f"shrink-{e}")}, timeout=timeout)
+        for e in ("fortune", "incremental")
+    ]
     if not all("saved" in a for a in answers):
         return "crash or error: " + " / ".join(a["build"] for a in answers)
     try:
@@ -78,8 +87,11 @@ def main(argv=None) -> int:
     ap.add_argument("--poison", type=int, help="fill np.empty's arrays with this byte (deterministic garbage)")
     args = ap.parse_args(argv)
 
-    case = (load_fixture(args.family[8:]) if args.family.startswith("fixture:")
-            else adversarial.make(args.family, args.seed))
+    case = (
+        load_fixture(args.family[8:])
+        if args.family.startswith("fixture:")
+        else adversarial.make(args.family, args.seed)
+    )
     worker = Worker()
     try:
         first = outcome(worker, case.points, case.bbox, args.engine, args.check, args.timeout, args.poison)
@@ -95,8 +107,10 @@ def main(argv=None) -> int:
             got = outcome(worker, pts, case.bbox, args.engine, args.check, args.timeout, args.poison)
             if kind(got) != want or args.match not in got:
                 return False
-            return not args.other_ok or outcome(worker, pts, case.bbox, other, args.check, args.timeout,
-                                                args.poison) == "ok"
+            return (
+                not args.other_ok
+                or outcome(worker, pts, case.bbox, other, args.check, args.timeout, args.poison) == "ok"
+            )
 
         small = ddmin(case.points, fails)
         last = outcome(worker, small, case.bbox, args.engine, args.check, args.timeout, args.poison)

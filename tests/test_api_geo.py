@@ -38,8 +38,20 @@ XY = np.array([[0.0, 0.0], [2.0, 1.0], [1.0, 3.0], [-1.0, 2.5]])
         lambda xy: pd.DataFrame({"a": xy[:, 0], "b": xy[:, 1]}),
         lambda xy: shapely.points(np.c_[xy, np.arange(4.0)]),  # z dropped
     ],
-    ids=["multipoint", "list", "tuple", "object_array", "geoseries", "geodataframe", "series", "frame_xy",
-         "frame_lonlat", "frame_easting", "frame_two_columns", "points_z"],
+    ids=[
+        "multipoint",
+        "list",
+        "tuple",
+        "object_array",
+        "geoseries",
+        "geodataframe",
+        "series",
+        "frame_xy",
+        "frame_lonlat",
+        "frame_easting",
+        "frame_two_columns",
+        "points_z",
+    ],
 )
 def test_voronoi_takes_geospatial_points(make):
     got = tvoronoi.voronoi(make(XY))
@@ -60,8 +72,12 @@ def test_shapely_points_round_trip_hypothesis():
     @settings(max_examples=100, deadline=None)
     @given(arrays(np.float64, st.tuples(st.integers(1, 30), st.just(2)), elements=finite))
     def check(xy):
-        for given_points in (shapely.MultiPoint(xy), list(shapely.points(xy)), gpd.GeoSeries(shapely.points(xy)),
-                             pd.DataFrame({"lon": xy[:, 0], "lat": xy[:, 1]})):
+        for given_points in (
+            shapely.MultiPoint(xy),
+            list(shapely.points(xy)),
+            gpd.GeoSeries(shapely.points(xy)),
+            pd.DataFrame({"lon": xy[:, 0], "lat": xy[:, 1]}),
+        ):
             got = as_points(given_points)
             assert got.flags.c_contiguous and got.dtype == np.float64
             np.testing.assert_array_equal(got, xy)
@@ -100,9 +116,11 @@ def test_bad_geospatial_points_name_the_row(bad, words):
 
 
 def test_arrays_do_not_import_pandas_or_geopandas():
-    code = ("import sys, numpy as np, shapely, tvoronoi; tvoronoi.voronoi(np.random.rand(20, 2)); "
-            "tvoronoi.voronoi(shapely.MultiPoint(np.random.rand(20, 2))).to_shapely(); "
-            "print('pandas' in sys.modules or 'geopandas' in sys.modules)")
+    code = (
+        "import sys, numpy as np, shapely, tvoronoi; tvoronoi.voronoi(np.random.rand(20, 2)); "
+        "tvoronoi.voronoi(shapely.MultiPoint(np.random.rand(20, 2))).to_shapely(); "
+        "print('pandas' in sys.modules or 'geopandas' in sys.modules)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
@@ -141,8 +159,9 @@ def test_to_geopandas():
     rng = np.random.default_rng(SEED)
     xy = rng.random((300, 2))
     xy[7] = xy[3]
-    props = pd.DataFrame({"name": [f"p{i}" for i in range(300)], "v": np.arange(300) * 0.5},
-                         index=np.arange(300) + 1000)
+    props = pd.DataFrame(
+        {"name": [f"p{i}" for i in range(300)], "v": np.arange(300) * 0.5}, index=np.arange(300) + 1000
+    )
     d = tvoronoi.voronoi(xy)
     g = d.to_geopandas(props, crs="EPSG:3857")
     assert isinstance(g, gpd.GeoDataFrame)
@@ -264,8 +283,10 @@ def test_locate_hypothesis():
     coords = st.integers(-6, 6)
 
     @settings(max_examples=200, deadline=None)
-    @given(st.lists(st.tuples(coords, coords), min_size=1, max_size=25),
-           st.lists(st.tuples(coords, coords), min_size=1, max_size=20))
+    @given(
+        st.lists(st.tuples(coords, coords), min_size=1, max_size=25),
+        st.lists(st.tuples(coords, coords), min_size=1, max_size=20),
+    )
     def check(sites, queries):
         sites = np.asarray(sites, float)
         q = np.asarray(queries, float) / 2.0
@@ -322,11 +343,14 @@ def test_dataframe_named_coordinates_come_before_a_points_column():
     assert np.array_equal(as_points(frame), xy)
 
 
-@pytest.mark.parametrize("bad, words", [
-    (shapely.LineString([(0, 0), (1, 1)]), ["column 'geometry'", "point 3", "LineString"]),
-    (None, ["column 'geometry'", "point 3", "None"]),
-    (shapely.Point(), ["column 'geometry'", "point 3", "empty"]),
-])
+@pytest.mark.parametrize(
+    "bad, words",
+    [
+        (shapely.LineString([(0, 0), (1, 1)]), ["column 'geometry'", "point 3", "LineString"]),
+        (None, ["column 'geometry'", "point 3", "None"]),
+        (shapely.Point(), ["column 'geometry'", "point 3", "empty"]),
+    ],
+)
 def test_dataframe_points_column_errors_name_column_and_row(bad, words):
     frame = _frame_with_points(np.random.default_rng(SEED).random((6, 2)))
     values = frame["geometry"].to_numpy().copy()

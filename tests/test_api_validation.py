@@ -17,12 +17,15 @@ from tvoronoi.engines import BOX_SCALED_MAX
 # -- points ---------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("bad, message", [
-    ([[0, 0], [np.nan, 1]], "point 1"),
-    ([[0, 0], [1, np.inf]], "finite"),
-    ([[0, 0, 0]], "shape"),
-    ([["a", "b"]], "numbers"),
-])
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        ([[0, 0], [np.nan, 1]], "point 1"),
+        ([[0, 0], [1, np.inf]], "finite"),
+        ([[0, 0, 0]], "shape"),
+        ([["a", "b"]], "numbers"),
+    ],
+)
 def test_bad_points_are_named(bad, message):
     with pytest.raises(tvoronoi.TvoronoiError, match=message):
         tvoronoi.voronoi(bad)
@@ -36,25 +39,30 @@ def test_dynamic_range_beyond_exact_arithmetic_is_refused():
 # -- the box ----------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("bbox, message", [
-    ((0, 0, 0, 1), "bbox (0, 0, 0, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
-    ((0, 2, 1, 1), "bbox (0, 2, 1, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
-    ((0, 0, 1), "bbox (0, 0, 1): expected four numbers xmin, ymin, xmax, ymax, got 3"),
-    (5, "bbox 5: expected four numbers xmin, ymin, xmax, ymax"),
-    ((0, 0, np.nan, 1), "bbox (0, 0, nan, 1): nan is not a finite number"),
-    ((0, 0, "inf", 1), "bbox (0, 0, 'inf', 1): 'inf' is not a finite number"),
-    ("abcd", "bbox 'abcd': 'a' is not a number; expected xmin, ymin, xmax, ymax"),
-    ((0, None, 1, 1), "bbox (0, None, 1, 1): None is not a number; expected xmin, ymin, xmax, ymax"),
-])
+@pytest.mark.parametrize(
+    "bbox, message",
+    [
+        ((0, 0, 0, 1), "bbox (0, 0, 0, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
+        ((0, 2, 1, 1), "bbox (0, 2, 1, 1): the box is empty; it needs xmin < xmax and ymin < ymax"),
+        ((0, 0, 1), "bbox (0, 0, 1): expected four numbers xmin, ymin, xmax, ymax, got 3"),
+        (5, "bbox 5: expected four numbers xmin, ymin, xmax, ymax"),
+        ((0, 0, np.nan, 1), "bbox (0, 0, nan, 1): nan is not a finite number"),
+        ((0, 0, "inf", 1), "bbox (0, 0, 'inf', 1): 'inf' is not a finite number"),
+        ("abcd", "bbox 'abcd': 'a' is not a number; expected xmin, ymin, xmax, ymax"),
+        ((0, None, 1, 1), "bbox (0, None, 1, 1): None is not a number; expected xmin, ymin, xmax, ymax"),
+    ],
+)
 def test_bad_boxes_name_the_value(bbox, message):
     with pytest.raises(tvoronoi.TvoronoiError) as caught:
         tvoronoi.voronoi([[0.5, 0.5]], bbox=bbox)
     assert str(caught.value) == message
     # the same check, the same words, everywhere a box is taken
-    for call in (lambda: tvoronoi.DynamicVoronoi([[0.5, 0.5]], bbox=bbox),
-                 lambda: tvoronoi.lloyd([[0.5, 0.5]], 1, bbox=bbox),
-                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="fortune", bbox=bbox),
-                 lambda: tvoronoi.steps([[0.5, 0.5]], engine="incremental", bbox=bbox)):
+    for call in (
+        lambda: tvoronoi.DynamicVoronoi([[0.5, 0.5]], bbox=bbox),
+        lambda: tvoronoi.lloyd([[0.5, 0.5]], 1, bbox=bbox),
+        lambda: tvoronoi.steps([[0.5, 0.5]], engine="fortune", bbox=bbox),
+        lambda: tvoronoi.steps([[0.5, 0.5]], engine="incremental", bbox=bbox),
+    ):
         with pytest.raises(tvoronoi.TvoronoiError) as again:
             call()
         assert str(again.value) == message
@@ -70,7 +78,7 @@ def test_the_box_check_speaks_the_callers_names():
 
 
 @pytest.mark.parametrize("engine", ["incremental", "fortune"])
-@pytest.mark.parametrize("side", [1.5e300, 2.0 ** 1000, 2.0 ** -701, 1e-250])
+@pytest.mark.parametrize("side", [1.5e300, 2.0**1000, 2.0**-701, 1e-250])
 def test_a_box_beyond_the_range_rule_is_refused(engine, side):
     """Unit-square sites: box sides past about 1.3e300 (2^997: the exact products split a coordinate by
     multiplying it with 2^27 + 1) or, when nonzero, under 2^-700 are refused with the side and value named."""
@@ -88,11 +96,11 @@ def test_the_largest_and_smallest_boxes_of_the_range_rule_build(engine):
     pts = np.random.default_rng(0).random((30, 2))
     big = BOX_SCALED_MAX
     d = tvoronoi.voronoi(pts, bbox=(-big, -big, big, big), engine=engine)
-    exact_checks.check_cells_valid(d)     # exact at any span (validate's box frame and GEOS are not)
+    exact_checks.check_cells_valid(d)  # exact at any span (validate's box frame and GEOS are not)
     exact_checks.check_tiling(d)
-    small = 2.0 ** -700
+    small = 2.0**-700
     d = tvoronoi.voronoi(np.vstack([pts, [[0.0, 0.0]]]), bbox=(-small, -small, small, small), engine=engine)
-    assert len(d.cell_polygon(30)) == 4         # the box around the site at the origin is its cell
+    assert len(d.cell_polygon(30)) == 4  # the box around the site at the origin is its cell
 
 
 def test_a_tiny_box_around_tiny_sites_is_in_range():
@@ -111,8 +119,10 @@ def test_unknown_engine_and_order():
         tvoronoi.voronoi([[0, 0]], engine="qhull")
     with pytest.raises(tvoronoi.TvoronoiError, match="unknown insertion order 'sorted': choose one of brio, random"):
         tvoronoi.voronoi([[0, 0]], insertion="sorted")
-    for call in (lambda: tvoronoi.DynamicVoronoi([[0, 0]], engine="qhull"),
-                 lambda: tvoronoi.steps([[0, 0]], engine="qhull"),
-                 lambda: check_engine("qhull")):
+    for call in (
+        lambda: tvoronoi.DynamicVoronoi([[0, 0]], engine="qhull"),
+        lambda: tvoronoi.steps([[0, 0]], engine="qhull"),
+        lambda: check_engine("qhull"),
+    ):
         with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull'"):
             call()

@@ -155,7 +155,7 @@ def test_bom_crlf_zip_codes_and_nulls(tmp_path):
 
 
 def test_text_column_reads_like_its_list():
-    values = ["a", None, "é, \"q\"", "", "line\nbreak", "z"]
+    values = ["a", None, 'é, "q"', "", "line\nbreak", "z"]
     column = TextColumn.from_strings(values)
     expected = [v if v else None for v in values]
     expected[3] = ""  # from_strings keeps an empty string as it is
@@ -174,7 +174,7 @@ def test_text_column_reads_like_its_list():
 
 def test_text_column_to_arrow_matches_pyarrow():
     pa = pytest.importorskip("pyarrow")
-    values = ["a", None, "é, \"q\"", "", "line\nbreak", "z", None]
+    values = ["a", None, 'é, "q"', "", "line\nbreak", "z", None]
     assert TextColumn.from_strings(values).to_arrow().equals(pa.array(values, pa.string()))
 
 
@@ -242,15 +242,22 @@ def test_output_made_in_two_processes_is_the_same(monkeypatch, tmp_path, layout,
     if case == "clip":
         options["clip"] = shapely.Polygon([(0, 0), (100, 0), (50, 80)]).buffer(-5)
     diagram = voronoi(xy, **options)
-    points = PointSet(xy, "t", {"name": TextColumn.from_strings([f"n{i}" for i in range(n)]),
-                                "k": [i % 7 for i in range(n)]})
+    points = PointSet(
+        xy, "t", {"name": TextColumn.from_strings([f"n{i}" for i in range(n)]), "k": [i % 7 for i in range(n)]}
+    )
     outs = []
     for minimum in (10**12, 1):
         monkeypatch.setattr(forked, "MIN_FEATURES", minimum)
         path = tmp_path / f"{minimum}.geojson"
         seen: list = []
-        count = write_cells(diagram, points, str(path), layout=layout, precision=6 if case == "clip" else None,
-                            progress=lambda done, total, seen=seen: seen.append((done, total)))
+        count = write_cells(
+            diagram,
+            points,
+            str(path),
+            layout=layout,
+            precision=6 if case == "clip" else None,
+            progress=lambda done, total, seen=seen: seen.append((done, total)),
+        )
         stream = io.BytesIO()
         assert write_cells(diagram, points, stream, layout=layout) == count
         outs.append((path.read_bytes(), count, stream.getvalue()))

@@ -171,7 +171,9 @@ def test_version_and_help(capsys):
 
 def test_without_a_command_the_tui_starts(capsys, monkeypatch):
     calls = []
-    monkeypatch.setitem(sys.modules, "tvoronoi.tui.app", types.SimpleNamespace(main=lambda path=None: calls.append(path)))
+    monkeypatch.setitem(
+        sys.modules, "tvoronoi.tui.app", types.SimpleNamespace(main=lambda path=None: calls.append(path))
+    )
     assert run(capsys) == (0, "", "")
     assert calls == [None]
 
@@ -224,13 +226,15 @@ def test_nan_coordinate(capsys, tmp_path):
 
 @pytest.mark.parametrize(
     "value, why",
-    [("1,2,3", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 3"),
-     ("0,0,a,1", "'a' is not a number; expected XMIN,YMIN,XMAX,YMAX"),
-     ("0,0,inf,1", "'inf' is not a finite number"),
-     ("0, 0,nan ,1", "'nan' is not a finite number"),
-     ("1,0,0,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
-     ("0,1,1,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
-     ("", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 1")],
+    [
+        ("1,2,3", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 3"),
+        ("0,0,a,1", "'a' is not a number; expected XMIN,YMIN,XMAX,YMAX"),
+        ("0,0,inf,1", "'inf' is not a finite number"),
+        ("0, 0,nan ,1", "'nan' is not a finite number"),
+        ("1,0,0,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
+        ("0,1,1,1", "the box is empty; it needs XMIN < XMAX and YMIN < YMAX"),
+        ("", "expected four numbers XMIN,YMIN,XMAX,YMAX, got 1"),
+    ],
 )
 def test_bad_bbox_names_the_value(capsys, tmp_path, points_csv, value, why):
     """The API's box check (tvoronoi.api.as_bbox) in the CLI's words: the option, the text given, upper-case names."""
@@ -252,7 +256,9 @@ def test_a_tiny_bbox_around_tiny_sites_is_accepted(capsys, tmp_path):
 
 
 def test_a_bbox_out_of_range_for_the_sites_is_refused(capsys, tmp_path, points_csv):
-    assert_error(capsys, tmp_path, points_csv, "--bbox=0,0,1e-250,1", contains=["xmax = 1e-250 is beyond the exact range"])
+    assert_error(
+        capsys, tmp_path, points_csv, "--bbox=0,0,1e-250,1", contains=["xmax = 1e-250 is beyond the exact range"]
+    )
 
 
 def test_engine_fortune_writes_the_same_valid_cells(capsys, tmp_path, points_csv):
@@ -354,7 +360,11 @@ def test_subprocess_exit_status_and_no_traceback(tmp_path, existing):
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.run(
         [sys.executable, "-m", "tvoronoi.cli", "batch", str(bad), "-o", str(existing), "--force"],
-        capture_output=True, text=True, env=env, cwd=tmp_path, timeout=120,
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
     )
     assert proc.returncode == 2
     assert proc.stdout == ""
@@ -399,8 +409,13 @@ def test_semicolon_file_with_delimiter_option(capsys, tmp_path):
 def test_range_error_names_file_line_and_value_without_numpy_warnings(tmp_path):
     path = tmp_path / "p.csv"
     path.write_text("x,y\n1,1\n2,3\n1e60,2\n3,3\n")
-    proc = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
-                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=120,
+    )
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"tvoronoi: error: {path}, line 2: coordinate 1.0 is over 1e51 times smaller")
     assert "1e+60 (line 4)" in proc.stderr and "np.float64" not in proc.stderr
@@ -410,8 +425,13 @@ def test_range_error_names_file_line_and_value_without_numpy_warnings(tmp_path):
 def test_values_at_the_edge_of_the_double_range_leak_no_warning(tmp_path):
     path = tmp_path / "p.csv"
     path.write_text("x,y\n1e308,1e308\n-1.7e308,-1e308\n1e308,-1.5e308\n")
-    proc = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
-                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "tvoronoi", "batch", str(path), "-o", str(tmp_path / "o.geojson")],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=120,
+    )
     assert "Warning" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
     assert proc.stderr.count("\n") <= 1
 

@@ -52,8 +52,9 @@ def check_tiles(d, region) -> None:
     assert shapely.is_ccw(shapely.get_exterior_ring(polygons)).all()
 
 
-@pytest.mark.parametrize("region", [L_SHAPE, WITH_HOLES, TWO_PARTS, star(per_edge=5)],
-                         ids=["concave-L", "holes", "multi-part", "star"])
+@pytest.mark.parametrize(
+    "region", [L_SHAPE, WITH_HOLES, TWO_PARTS, star(per_edge=5)], ids=["concave-L", "holes", "multi-part", "star"]
+)
 @pytest.mark.parametrize("engine", ["incremental", "fortune"])
 def test_cells_tile_the_region(rng, region, engine):
     xmin, ymin, xmax, ymax = region.bounds
@@ -70,7 +71,8 @@ def test_cells_tile_the_region(rng, region, engine):
 
 # a coastline family: detailed, spiky outlines with lakes and islands (tvoronoi.generators.coastline)
 COASTS = [coastline(600, spikes=80, lakes=3, islands=4, seed=seed) for seed in (1, 2)] + [
-    coastline(1500, spikes=200, seed=3)]
+    coastline(1500, spikes=200, seed=3)
+]
 
 
 @pytest.mark.parametrize("region", COASTS, ids=["coast600-1", "coast600-2", "coast1500"])
@@ -107,7 +109,9 @@ def test_local_pieces_give_the_whole_intersection(rng, spikes):
     local = local_intersection(cells, region)
     split, _ = region_module._short_edged(region)
     assert len(cells) > 100
-    assert shapely.equals_exact(shapely.normalize(local), shapely.normalize(shapely.intersection(cells, split)), 0).all()
+    assert shapely.equals_exact(
+        shapely.normalize(local), shapely.normalize(shapely.intersection(cells, split)), 0
+    ).all()
     whole = shapely.intersection(cells, region)
     if spikes:
         same = shapely.equals_exact(shapely.normalize(local), shapely.normalize(whole), 0)
@@ -126,11 +130,14 @@ def test_grid_places_sites_as_the_region_does(monkeypatch):
     vertices = shapely.get_coordinates(region)
     midpoints = (vertices[:-1] + vertices[1:]) / 2
     rng = np.random.default_rng(8)
-    pts = np.concatenate([
-        rng.uniform([xmin - 0.1, ymin - 0.1], [xmax + 0.1, ymax + 0.1], (20000, 2)),
-        vertices, midpoints,
-        np.c_[np.repeat(edges_x, 50), rng.uniform(ymin, ymax, 9 * 50)],
-    ])
+    pts = np.concatenate(
+        [
+            rng.uniform([xmin - 0.1, ymin - 0.1], [xmax + 0.1, ymax + 0.1], (20000, 2)),
+            vertices,
+            midpoints,
+            np.c_[np.repeat(edges_x, 50), rng.uniform(ymin, ymax, 9 * 50)],
+        ]
+    )
     monkeypatch.setattr(region_module, "GRID_MIN_SITES", 0)
     got = region_module.sites_inside(pts, region, grid)
     assert np.array_equal(got, shapely.intersects_xy(region, pts[:, 0], pts[:, 1]))
@@ -144,8 +151,10 @@ def test_inner_diagram_is_that_of_the_inside_sites(rng):
     alone = tvoronoi.voronoi(pts[inside], bbox=d.bbox)
     for k, i in enumerate(inside.tolist()):
         assert np.array_equal(d.cell_polygon(i), alone.cell_polygon(k))
-    assert np.array_equal(np.sort(d.triangles, axis=1)[np.lexsort(np.sort(d.triangles, axis=1).T)],
-                          np.sort(inside[alone.triangles], axis=1)[np.lexsort(np.sort(inside[alone.triangles], axis=1).T)])
+    assert np.array_equal(
+        np.sort(d.triangles, axis=1)[np.lexsort(np.sort(d.triangles, axis=1).T)],
+        np.sort(inside[alone.triangles], axis=1)[np.lexsort(np.sort(inside[alone.triangles], axis=1).T)],
+    )
     # nearest-site queries answer among the inside sites only
     q = rng.uniform(-1, 3, (200, 2))
     got = d.locate(q[:, 0], q[:, 1])
@@ -173,11 +182,14 @@ def test_region_missing_every_site_is_an_error():
         tvoronoi.voronoi([[5, 5], [6, 6]], clip=L_SHAPE)
 
 
-@pytest.mark.parametrize("clip, message", [
-    (shapely.Point(0, 0), "must be a shapely Polygon or MultiPolygon, got Point"),
-    (shapely.Polygon(), "empty"),
-    (shapely.Polygon([(0, 0), (1, 1), (1, 0), (0, 1)]), "not a valid Polygon .*Self-intersection"),
-])
+@pytest.mark.parametrize(
+    "clip, message",
+    [
+        (shapely.Point(0, 0), "must be a shapely Polygon or MultiPolygon, got Point"),
+        (shapely.Polygon(), "empty"),
+        (shapely.Polygon([(0, 0), (1, 1), (1, 0), (0, 1)]), "not a valid Polygon .*Self-intersection"),
+    ],
+)
 def test_bad_regions(clip, message):
     with pytest.raises(tvoronoi.TvoronoiError, match=message):
         tvoronoi.voronoi([[0.5, 0.5]], clip=clip)
@@ -256,9 +268,16 @@ def test_region_beyond_the_exact_range_is_refused():
 
 
 def write_region(path, geometry) -> str:
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": [
-        {"type": "Feature", "properties": {}, "geometry": shapely.geometry.mapping(g)} for g in geometry
-    ]}))
+    path.write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "features": [
+                    {"type": "Feature", "properties": {}, "geometry": shapely.geometry.mapping(g)} for g in geometry
+                ],
+            }
+        )
+    )
     return str(path)
 
 
@@ -279,16 +298,21 @@ def test_batch_clip(tmp_path, capsys):
     assert capsys.readouterr().err == ""
 
 
-@pytest.mark.parametrize("text, message", [
-    ('{"type": "Point", "coordinates": [0, 0]}', "expected a GeoJSON FeatureCollection, Feature, Polygon"),
-    ('{"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, '
-     '"geometry": {"type": "LineString", "coordinates": [[0, 0], [1, 1]]}}]}',
-     "feature 0 is a LineString; --clip takes Polygons and MultiPolygons only"),
-    ('{"type": "Feature", "geometry": null, "properties": {}}', "feature 0 has a null geometry"),
-    ('{"type": "Polygon", "coordinates": [[[0, 0], [1, 1], [1, 0], [0, 1], [0, 0]]]}', "not a valid Polygon"),
-    ("not json", "not JSON"),
-    ('{"type": "FeatureCollection", "features": []}', "holds no Polygon"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ('{"type": "Point", "coordinates": [0, 0]}', "expected a GeoJSON FeatureCollection, Feature, Polygon"),
+        (
+            '{"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, '
+            '"geometry": {"type": "LineString", "coordinates": [[0, 0], [1, 1]]}}]}',
+            "feature 0 is a LineString; --clip takes Polygons and MultiPolygons only",
+        ),
+        ('{"type": "Feature", "geometry": null, "properties": {}}', "feature 0 has a null geometry"),
+        ('{"type": "Polygon", "coordinates": [[[0, 0], [1, 1], [1, 0], [0, 1], [0, 0]]]}', "not a valid Polygon"),
+        ("not json", "not JSON"),
+        ('{"type": "FeatureCollection", "features": []}', "holds no Polygon"),
+    ],
+)
 def test_batch_clip_errors_name_the_file(tmp_path, capsys, text, message):
     src = tmp_path / "pts.csv"
     src.write_text("x,y\n0.5,0.5\n1.5,0.5\n")
@@ -322,7 +346,11 @@ def test_a_cells_cut_depends_on_it_and_the_region_alone(rng, spikes):
     whole, reshaped = cut_polygons(cells, region)
     assert reshaped.sum() > 100
     areas = shapely.area(cells)
-    for part in (np.flatnonzero(rng.random(len(cells)) < 0.3), np.arange(len(cells) // 2),
-                 np.flatnonzero(reshaped)[:9], np.flatnonzero(areas < np.nanmedian(areas))):
+    for part in (
+        np.flatnonzero(rng.random(len(cells)) < 0.3),
+        np.arange(len(cells) // 2),
+        np.flatnonzero(reshaped)[:9],
+        np.flatnonzero(areas < np.nanmedian(areas)),
+    ):
         sub, _ = cut_polygons(cells[part], region)
         assert (shapely.to_wkb(sub) == shapely.to_wkb(whole[part])).all()

@@ -75,11 +75,11 @@ def test_near_ties_of_noisy_lattices():
     rng = np.random.default_rng(11)
     for noise in (1e-12, 1e-15, 1e-17):
         k = 30
-        g = np.stack(np.meshgrid(np.arange(k), np.arange(k)), -1).reshape(-1, 2) * 2.0 ** -6
+        g = np.stack(np.meshgrid(np.arange(k), np.arange(k)), -1).reshape(-1, 2) * 2.0**-6
         g = g + noise * rng.standard_normal(g.shape)
         i = rng.integers(0, k - 1, 600)
         j = rng.integers(0, k - 1, 600)
-        at = lambda di, dj: g[(i + di) * k + j + dj]        # noqa: E731, B023 (used in this iteration)
+        at = lambda di, dj: g[(i + di) * k + j + dj]  # noqa: E731, B023 (used in this iteration)
         check_triangles(np.stack([at(0, 0), at(1, 0), at(0, 1)], 1))
         check_triangles(np.stack([at(1, 1), at(0, 1), at(1, 0)], 1))
 
@@ -118,7 +118,7 @@ def test_hypothesis_circumcentres(values):
 def exact_bisector_at(a, b, t, along_y):
     ax, ay, bx, by, t = (Fraction(v) for v in (*a, *b, t))
     num = bx * bx + by * by - ax * ax - ay * ay
-    if along_y:          # y = t: returns x
+    if along_y:  # y = t: returns x
         return (num - 2 * t * (by - ay)) / (2 * (bx - ax))
     return (num - 2 * t * (bx - ax)) / (2 * (by - ay))
 
@@ -137,12 +137,12 @@ def test_bisector_crossings_are_correctly_rounded(along_y):
 
 def test_ties_round_to_even():
     # circumcentres exactly halfway between two doubles (x = 2^52 + k + 1/2, where the ulp is 1)
-    big = 2.0 ** 52
+    big = 2.0**52
     tris = [((big + k, 0.0), (big + k + 1, 0.0), (big + k, 2.0)) for k in range(0, 12, 2)]
     tris += [((big + k, 1.0), (big + k + 1, 1.0), (big + k + 1, -3.0)) for k in range(1, 12, 2)]
     check_triangles(tris)
     got = kernel_circumcentres(tris[:1])
-    assert got[0, 0] == big        # 2^52 + 1/2 -> the even neighbour, 2^52
+    assert got[0, 0] == big  # 2^52 + 1/2 -> the even neighbour, 2^52
 
 
 def exact_orientation(a, b, c) -> int:
@@ -155,7 +155,7 @@ def exact_orientation(a, b, c) -> int:
 wide = st.one_of(
     st.floats(min_value=-1.3e300, max_value=1.3e300, allow_nan=False, allow_infinity=False),
     st.floats(min_value=-1.0, max_value=1.0, allow_nan=False, allow_infinity=False, allow_subnormal=False),
-    st.sampled_from([0.0, 1.0, -1.0, 1e300, -1e300, 2.0 ** -900, 1.0 + 2.0 ** -52, 1e-300]),
+    st.sampled_from([0.0, 1.0, -1.0, 1e300, -1e300, 2.0**-900, 1.0 + 2.0**-52, 1e-300]),
 )
 
 
@@ -167,7 +167,7 @@ def test_ring_turns_are_exact_at_any_span(a, b, c):
     assert clip.ring_turn(*a, *b, *c) == exact_orientation(a, b, c)
 
 
-@pytest.mark.parametrize("scale", [2.0 ** -1000, 2.0 ** -300, 1.0, 2.0 ** 300, 2.0 ** 996])
+@pytest.mark.parametrize("scale", [2.0**-1000, 2.0**-300, 1.0, 2.0**300, 2.0**996])
 def test_ring_turns_see_one_ulp_beside_a_huge_segment(scale):
     """A point one ulp off the line through the origin and a far point: the spans of the largest ring."""
     far = (1e300, 1e300)

@@ -52,7 +52,7 @@ def assert_same_triangles(result, full) -> None:
     each row's geometry the triangle of its three sites."""
     frame = result.triangles.compute()
     tri = frame[["a", "b", "c"]].to_numpy()
-    assert (tri[:, 0] < tri[:, 1]).all() and (tri[:, 0] < tri[:, 2]).all()      # lowest first
+    assert (tri[:, 0] < tri[:, 1]).all() and (tri[:, 0] < tri[:, 2]).all()  # lowest first
     tri = tri[np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))]
     want, _ = canonical_triangles(np.asarray(full.sites), full.triangles, len(full.vertices))
     assert tri.shape == want.shape and np.array_equal(tri, want)
@@ -144,7 +144,7 @@ def test_geoparquet_directory_reads_as_one_table(client, tmp_path):
     import pyarrow.parquet as pq
 
     pts = generate("clustered", N_SMALL - 500, seed=9)
-    pts = np.concatenate([pts, pts[:500]])          # repeated points: rows without a cell (null)
+    pts = np.concatenate([pts, pts[:500]])  # repeated points: rows without a cell (null)
     names = np.array([f"p{i}" for i in range(N_SMALL)], object)
     out = tmp_path / "cells"
     result = voronoi(frame_of(pts, name=names), client=client, tiles=4, to=out)
@@ -171,15 +171,20 @@ def test_geojsonseq_parts(client, tmp_path):
     result = voronoi(frame_of(pts, 3), client=client, tiles=3, to=out, format="geojsonseq", delaunay=triangles)
     assert result.triangles is None and any(result.triangle_parts)
     # the triangles' parts: features with "sites", as one process's GeoJSON --delaunay writes them
-    rows = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(triangles.iterdir())
-            for line in part.read_bytes().splitlines()]
+    rows = [
+        orjson.loads(line.lstrip(b"\x1e"))
+        for part in sorted(triangles.iterdir())
+        for line in part.read_bytes().splitlines()
+    ]
     sites = np.array([f["properties"]["sites"] for f in rows])
     full_triangles = tvoronoi.voronoi(pts, threads=1).triangles
     assert len(sites) == len(full_triangles)
     assert {tuple(sorted(t)) for t in sites.tolist()} == {tuple(sorted(t)) for t in full_triangles.tolist()}
     ring = np.array([f["geometry"]["coordinates"][0] for f in rows])
     assert np.array_equal(ring[:, :3], pts[sites]) and np.array_equal(ring[:, 3], ring[:, 0])
-    features = [orjson.loads(line.lstrip(b"\x1e")) for part in sorted(out.iterdir()) for line in part.read_bytes().splitlines()]
+    features = [
+        orjson.loads(line.lstrip(b"\x1e")) for part in sorted(out.iterdir()) for line in part.read_bytes().splitlines()
+    ]
     features.sort(key=lambda f: f["properties"]["site"])
     assert [f["properties"]["site"] for f in features] == list(range(5_000))
     full = tvoronoi.voronoi(pts, threads=1)
@@ -207,7 +212,7 @@ def test_bad_input_is_named(client, tmp_path):
         voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "full")
     with pytest.raises(TvoronoiError, match="not empty"):
         voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "new", delaunay=tmp_path / "full")
-    assert not (tmp_path / "new").exists()          # the cells' directory made first is removed again
+    assert not (tmp_path / "new").exists()  # the cells' directory made first is removed again
     with pytest.raises(TvoronoiError, match="would go to one directory"):
         voronoi(frame_of(pts[:10], 1), client=client, to=tmp_path / "same", delaunay=tmp_path / "same")
 
@@ -230,7 +235,8 @@ def test_the_core_package_works_without_dask():
 def write_csv_parts(directory, pts: np.ndarray, parts: int) -> None:
     for k, chunk in enumerate(np.array_split(np.arange(len(pts)), parts)):
         pd.DataFrame({"label": [f"r{i}" for i in chunk], "x": pts[chunk, 0], "y": pts[chunk, 1]}).to_csv(
-            directory / f"points-{k}.csv", index=False)
+            directory / f"points-{k}.csv", index=False
+        )
 
 
 def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, capsys):
@@ -241,8 +247,20 @@ def test_cli_reads_a_glob_of_csv_files_on_a_running_scheduler(client, tmp_path, 
     pts = generate("gaussian", 20_000, seed=4)
     write_csv_parts(tmp_path, pts, 3)
     out, triangles = tmp_path / "cells.parquet", tmp_path / "triangles"
-    status = main(["batch", str(tmp_path / "points-*.csv"), "-o", str(out), "--dask", client.scheduler.address,
-                   "--tiles", "5", "--delaunay", str(triangles)])
+    status = main(
+        [
+            "batch",
+            str(tmp_path / "points-*.csv"),
+            "-o",
+            str(out),
+            "--dask",
+            client.scheduler.address,
+            "--tiles",
+            "5",
+            "--delaunay",
+            str(triangles),
+        ]
+    )
     err = capsys.readouterr().err
     assert status == 0, err
     assert "3 file(s)" in err and f"Delaunay triangles -> {triangles}" in err
@@ -268,7 +286,8 @@ def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path)
     source.mkdir()
     for k, chunk in enumerate(np.array_split(np.arange(len(pts)), 2)):
         geopandas.GeoDataFrame({"w": chunk * 2.0}, geometry=geopandas.points_from_xy(*pts[chunk].T)).to_parquet(
-            source / f"part{k}.parquet")
+            source / f"part{k}.parquet"
+        )
     out = tmp_path / "cells"
     assert main(["batch", str(source), "-o", str(out), "--dask", "local:2", "--to", "geojsonseq", "-q"]) == 0
     import orjson
@@ -282,15 +301,18 @@ def test_cli_reads_a_directory_of_geoparquet_points_on_a_local_cluster(tmp_path)
         assert np.array_equal(np.array(f["geometry"]["coordinates"][0][:-1]), full.cell_polygon(i))
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--dask", "loc"], "--dask 'loc': give local"),
-    (["--dask", "local:0"], "needs at least one worker"),
-    (["--dask", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
-    (["--tiles", "3"], "--tiles goes with --dask"),
-    (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
-    (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
-    (["--dask", "local", "--delaunay", "-"], "--delaunay names a new directory of parts"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--dask", "loc"], "--dask 'loc': give local"),
+        (["--dask", "local:0"], "needs at least one worker"),
+        (["--dask", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+        (["--tiles", "3"], "--tiles goes with --dask"),
+        (["--dask", "local", "--lloyd", "2"], "--lloyd is not available with --dask"),
+        (["--dask", "local", "--to", "geojson"], "OUTPUT is a directory of parts"),
+        (["--dask", "local", "--delaunay", "-"], "--delaunay names a new directory of parts"),
+    ],
+)
 def test_cli_errors_are_named(tmp_path, capsys, argv, message):
     from tvoronoi.cli import main
 
@@ -319,7 +341,7 @@ def test_cli_names_the_file_and_line_of_a_bad_value_in_a_later_block(tmp_path, c
     write_csv_parts(tmp_path, generate("uniform", 6_000, seed=3), 3)
     path = tmp_path / "points-1.csv"
     lines = path.read_text().splitlines()
-    lines.insert(1500, "")                          # a blank line, skipped by the reader, counted as a line
+    lines.insert(1500, "")  # a blank line, skipped by the reader, counted as a line
     lines[1700] = "r9999,0.5,not-a-number"
     path.write_text("\n".join(lines) + "\n")
     out = tmp_path / "cells"
@@ -349,7 +371,7 @@ def test_cli_names_a_csv_file_that_cannot_be_parsed(tmp_path, capsys):
     write_csv_parts(tmp_path, generate("uniform", 40_000, seed=2), 2)
     path = tmp_path / "points-1.csv"
     lines = path.read_text().splitlines()
-    lines[15_000] += ",1,2"                         # a row with extra fields, past the sample dask reads first
+    lines[15_000] += ",1,2"  # a row with extra fields, past the sample dask reads first
     path.write_text("\n".join(lines) + "\n")
     assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
     err = capsys.readouterr().err

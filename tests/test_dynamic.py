@@ -129,14 +129,14 @@ def test_down_to_nothing_and_back(engine):
 def test_special_places(engine):
     """On an existing site, on a bisector, outside the hull, collinear with the hull."""
     dv = tvoronoi.DynamicVoronoi([[0, 0], [2, 0], [0, 2], [2, 2]], engine=engine, bbox=BOX)
-    a = dv.insert(0, 0)                      # on a site: shares its cell
+    a = dv.insert(0, 0)  # on a site: shares its cell
     assert len(dv.diagram().cell_polygon(a)) == 0 and dv.changed.tolist() == [a]
-    dv.insert(1, 0)                          # on a hull edge and a bisector
-    dv.insert(1, 1)                          # the common vertex of four cells
-    dv.insert(5, 5)                          # outside the hull
-    dv.insert(3, 0)                          # collinear with a hull edge
+    dv.insert(1, 0)  # on a hull edge and a bisector
+    dv.insert(1, 1)  # the common vertex of four cells
+    dv.insert(5, 5)  # outside the hull
+    dv.insert(3, 0)  # collinear with a hull edge
     assert_equals_fresh_build(dv)
-    dv.remove(0)                             # the repeat at (0, 0) takes over
+    dv.remove(0)  # the repeat at (0, 0) takes over
     assert len(dv.diagram().cell_polygon(a)) > 0
     assert_equals_fresh_build(dv)
 

@@ -46,7 +46,7 @@ def lattice_circle():
         zs = [mul(z, mul(power((a, b), j), power((a, -b), 2 * e - j))) for z in zs for j in range(2 * e + 1)]
     pts = sorted(set(zs))
     assert len(pts) == 14_580 and all(x * x + y * y == r * r for x, y in pts)
-    assert r < 2**53                                        # exact as doubles
+    assert r < 2**53  # exact as doubles
     keep = np.sort(np.random.default_rng(0).choice(len(pts), N, replace=False))
     return np.array(pts, float)[keep], float(r)
 
@@ -82,7 +82,7 @@ def assert_rings_match(got, want, ids, tol):
     for rings, other in ((got, shapely.boundary(w)), (want, shapely.boundary(g))):
         shapely.prepare(other)
         which = np.repeat(np.arange(len(rings)), [len(ring) for ring in rings])
-        near = shapely.dwithin(other[which], shapely.points(np.concatenate(rings)), tol)   # prepared first
+        near = shapely.dwithin(other[which], shapely.points(np.concatenate(rings)), tol)  # prepared first
         ok &= np.bincount(which[~near], minlength=len(rings)) == 0
     bad = [int(ids[full[k]]) for k in np.flatnonzero(~ok)]
     assert not bad, f"{len(bad)} cells differ from a fresh build, e.g. site {bad[0]}"
@@ -102,8 +102,7 @@ def assert_cells_match(dv, ids, box):
     full = view.to_diagram()
     assert_rings_match([full.cell_polygon(i) for i in ids], want, ids, tol)
     sample = np.random.default_rng(1).permutation(len(ids))[:VIEW_SAMPLE]
-    assert_rings_match([view.cell_polygon(ids[k]) for k in sample], [want[k] for k in sample],
-                       ids[sample], tol)
+    assert_rings_match([view.cell_polygon(ids[k]) for k in sample], [want[k] for k in sample], ids[sample], tol)
 
 
 @pytest.mark.parametrize("circle", sorted(CIRCLES))
@@ -186,7 +185,7 @@ def test_down_to_a_few_sites_and_back(engine):
     assert dv._mesh is mesh, "a removal rebuilt the mesh"
     back = order[:-5]
     coords = np.vstack([pts, [[0.0, 0.0]]])[back]
-    back = back[np.argsort(np.arctan2(coords[:, 1], coords[:, 0]))]     # around the circle: short walks
+    back = back[np.argsort(np.arctan2(coords[:, 1], coords[:, 0]))]  # around the circle: short walks
     for count, i in enumerate(back.tolist(), start=1):
         dv.insert(*(pts[i] if i < N else (0.0, 0.0)))
         if count in checks:
@@ -213,8 +212,8 @@ def test_out_of_memory_changes_nothing(engine):
     assert np.array_equal(after.cell_offsets, before.cell_offsets)
     assert np.array_equal(after.cell_points, before.cell_points)
     assert len(dv.diagram().neighbours(N)) == N
-    dv.remove(5)                                    # a small hole fits in the scratch
-    dv.insert(0.0, 0.5 * r)                         # beside the centre: the cavity fan, no scratch
+    dv.remove(5)  # a small hole fits in the scratch
+    dv.insert(0.0, 0.5 * r)  # beside the centre: the cavity fan, no scratch
     if engine == "fortune":
         assert not dv._mesh.swept_ok
     dv._mesh._limit_scratch(-1)

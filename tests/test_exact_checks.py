@@ -21,8 +21,13 @@ def with_cells(d, rings):
     offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
     points = np.vstack([r for r in rings if len(r)]) if any(len(r) for r in rings) else np.zeros((0, 2))
     return types.SimpleNamespace(
-        sites=d.sites, site_of=d.site_of, n_sites=d.n_sites, bbox=d.bbox, cell_points=points,
-        cell_polygon=lambda i: points[offsets[i]:offsets[i + 1]])
+        sites=d.sites,
+        site_of=d.site_of,
+        n_sites=d.n_sites,
+        bbox=d.bbox,
+        cell_points=points,
+        cell_polygon=lambda i: points[offsets[i] : offsets[i + 1]],
+    )
 
 
 def test_the_huge_box_diagram_passes():
@@ -46,6 +51,6 @@ def test_a_self_intersecting_cell_is_caught():
     rings = [d.cell_polygon(i).copy() for i in range(d.n_sites)]
     i = next(i for i, r in enumerate(rings) if len(r) >= 5 and np.abs(r).max() > 1e299)
     r = rings[i]
-    r[[1, 2]] = r[[2, 1]]                 # a bow tie
+    r[[1, 2]] = r[[2, 1]]  # a bow tie
     with pytest.raises(AssertionError, match="(not simple|clockwise|flat)"):
         ec.check_cells_valid(with_cells(d, rings))

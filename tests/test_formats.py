@@ -60,7 +60,9 @@ def test_geoparquet_cells_read_back_valid_typed_and_tiling_the_box(tmp_path, poi
 
 
 def test_geoparquet_delaunay_and_crs_option(tmp_path, points_csv):
-    assert run(points_csv, "-o", tmp_path / "c.geojson", "--delaunay", tmp_path / "t.parquet", "--crs", "EPSG:3857") == 0
+    assert (
+        run(points_csv, "-o", tmp_path / "c.geojson", "--delaunay", tmp_path / "t.parquet", "--crs", "EPSG:3857") == 0
+    )
     table = pq.read_table(tmp_path / "t.parquet")
     triangles = shapely.from_wkb(table.column("geometry").to_numpy(zero_copy_only=False))
     assert shapely.is_valid(triangles).all() and len(triangles) > 50
@@ -81,7 +83,10 @@ def test_geojson_sequences(tmp_path, points_csv):
     features = [json.loads(r) for r in records[1:]]
     assert all(r.endswith(b"\n") for r in records[1:]) and features[3]["properties"]["duplicates"] == [50]
     lines = (tmp_path / "t.geojsonl").read_text().splitlines()
-    assert all(json.loads(line)["type"] == "Feature" for line in lines) and b"\x1e" not in (tmp_path / "t.geojsonl").read_bytes()
+    assert (
+        all(json.loads(line)["type"] == "Feature" for line in lines)
+        and b"\x1e" not in (tmp_path / "t.geojsonl").read_bytes()
+    )
 
 
 def test_precision_rounds_coordinates(tmp_path, points_csv):
@@ -94,8 +99,17 @@ def test_precision_rounds_coordinates(tmp_path, points_csv):
 
 def test_parquet_inputs_plain_and_geo(tmp_path):
     plain = tmp_path / "plain.parquet"
-    pq.write_table(pa.table({"id": [1, 2, 3, 4], "Easting": [0.0, 10, 0, 7], "Northing": [0.0, 0, 10, 7],
-                             "zip": ["01000", "02000", None, "04000"]}), plain)
+    pq.write_table(
+        pa.table(
+            {
+                "id": [1, 2, 3, 4],
+                "Easting": [0.0, 10, 0, 7],
+                "Northing": [0.0, 0, 10, 7],
+                "zip": ["01000", "02000", None, "04000"],
+            }
+        ),
+        plain,
+    )
     assert run(plain, "-o", tmp_path / "a.parquet", "--crs", "EPSG:27700") == 0
     table = pq.read_table(tmp_path / "a.parquet")
     assert table.column("zip").to_pylist() == ["01000", "02000", None, "04000"]
@@ -103,8 +117,11 @@ def test_parquet_inputs_plain_and_geo(tmp_path):
     points = shapely.points([[5e5, 0], [5e5 + 10, 0], [5e5, 10], [5e5 + 7, 7]])
     geo = pa.table({"name": list("abcd"), "geometry": pa.array(shapely.to_wkb(points), pa.binary())})
     crs = {"id": {"authority": "EPSG", "code": 32631}}
-    meta = {"version": "1.1.0", "primary_column": "geometry",
-            "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Point"], "crs": crs}}}
+    meta = {
+        "version": "1.1.0",
+        "primary_column": "geometry",
+        "columns": {"geometry": {"encoding": "WKB", "geometry_types": ["Point"], "crs": crs}},
+    }
     pq.write_table(geo.replace_schema_metadata({b"geo": json.dumps(meta)}), tmp_path / "geo.parquet")
     assert run(tmp_path / "geo.parquet", "-o", tmp_path / "b.parquet") == 0
     out = pq.read_table(tmp_path / "b.parquet")
@@ -124,9 +141,14 @@ def test_lonlat_default_box_stays_on_the_globe(tmp_path):
 
 
 def test_non_wgs84_geojson_input_warns_for_geojson_output(tmp_path, capsys):
-    doc = {"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3857"}},
-           "features": [{"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": c}}
-                        for c in ([0, 0], [10, 0], [0, 10])]}
+    doc = {
+        "type": "FeatureCollection",
+        "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3857"}},
+        "features": [
+            {"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": c}}
+            for c in ([0, 0], [10, 0], [0, 10])
+        ],
+    }
     path = tmp_path / "p.geojson"
     path.write_text(json.dumps(doc))
     assert cli.main(["batch", str(path), "-o", str(tmp_path / "c.geojson")]) == 0
@@ -161,7 +183,9 @@ def test_crs_code_without_pyproj_names_the_extra(tmp_path, points_csv, capsys, m
 def test_geopandas_reads_cells_with_crs_types_and_covering(tmp_path):
     gpd = pytest.importorskip("geopandas")
     path = tmp_path / "p.csv"
-    path.write_text("name,Easting,Northing,zip\na,500000,100,01000\nb,500100,120,02000\nc,500050,190,\nd,500020,40,04000\n")
+    path.write_text(
+        "name,Easting,Northing,zip\na,500000,100,01000\nb,500100,120,02000\nc,500050,190,\nd,500020,40,04000\n"
+    )
     assert run(path, "-o", tmp_path / "c.parquet", "--crs", "EPSG:27700") == 0
     frame = gpd.read_parquet(tmp_path / "c.parquet")
     assert frame.crs.to_epsg() == 27700
@@ -193,21 +217,31 @@ def test_bulk_wkb_is_shapely_wkb(ring_sizes, seed):
     offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
     xy = np.vstack(rings)
     ours = _wkb_polygons(pa, xy, offsets).to_pylist()
-    polygons = shapely.from_ragged_array(shapely.GeometryType.POLYGON, xy,
-                                         (offsets, np.arange(len(rings) + 1, dtype=np.int64)))
+    polygons = shapely.from_ragged_array(
+        shapely.GeometryType.POLYGON, xy, (offsets, np.arange(len(rings) + 1, dtype=np.int64))
+    )
     assert ours == list(shapely.to_wkb(polygons, byte_order=1))
 
 
 def test_parquet_input_binary_and_decimal_columns(tmp_path):
     import decimal
 
-    table = pa.table({"x": [0.0, 1, 0], "y": [0.0, 0, 1], "raw": [b"\x00", b"\x01", b"\x02"],
-                      "price": pa.array([decimal.Decimal("1.25"), None, decimal.Decimal("3")], pa.decimal128(5, 2))})
+    table = pa.table(
+        {
+            "x": [0.0, 1, 0],
+            "y": [0.0, 0, 1],
+            "raw": [b"\x00", b"\x01", b"\x02"],
+            "price": pa.array([decimal.Decimal("1.25"), None, decimal.Decimal("3")], pa.decimal128(5, 2)),
+        }
+    )
     pq.write_table(table, tmp_path / "p.parquet")
     assert run(tmp_path / "p.parquet", "-o", tmp_path / "c.geojson") == 0
     doc = json.loads((tmp_path / "c.geojson").read_text())
     assert [f["properties"] for f in doc["features"]] == [
-        {"site": 0, "price": 1.25}, {"site": 1, "price": None}, {"site": 2, "price": 3.0}]
+        {"site": 0, "price": 1.25},
+        {"site": 1, "price": None},
+        {"site": 2, "price": 3.0},
+    ]
 
 
 def test_geoparquet_row_groups_hold_the_same_rows(tmp_path, monkeypatch):

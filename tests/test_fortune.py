@@ -77,10 +77,10 @@ def test_legalize_restores_delaunay(rng):
     for e in rng.permutation(len(tv)):
         o = opp[e]
         t, u = e // 3, o // 3
-        if n in tv[3 * t:3 * t + 3] or n in tv[3 * u:3 * u + 3]:
+        if n in tv[3 * t : 3 * t + 3] or n in tv[3 * u : 3 * u + 3]:
             continue
-        nxt = lambda h: h - 2 if h % 3 == 2 else h + 1          # noqa: E731
-        prv = lambda h: h + 2 if h % 3 == 0 else h - 1          # noqa: E731
+        nxt = lambda h: h - 2 if h % 3 == 2 else h + 1  # noqa: E731
+        prv = lambda h: h + 2 if h % 3 == 0 else h - 1  # noqa: E731
         a, b, c, d = tv[e], tv[nxt(e)], tv[prv(e)], tv[prv(o)]
         # flip only where the quadrilateral a, d, b, c is convex
         cross = lambda p, q, r: (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])  # noqa: E731
@@ -114,8 +114,11 @@ def test_property_engines_agree_on_degenerate_sets(points):
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1)), min_size=3, max_size=60)
-       .filter(lambda pts: all(v == 0 or v > 1e-40 for p in pts for v in p)))
+@given(
+    st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1)), min_size=3, max_size=60).filter(
+        lambda pts: all(v == 0 or v > 1e-40 for p in pts for v in p)
+    )
+)
 def test_property_engines_agree_on_floats(points):
     pts = np.array(points, float)
     f = tvoronoi.voronoi(pts, engine="fortune")

@@ -24,6 +24,7 @@ SEED = 20261123
 # ---------------------------------------------------------------------------------------------------------
 # exact checks (fractions.Fraction on the input doubles)
 
+
 def _orient(p, q, r):
     return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
 
@@ -32,8 +33,11 @@ def _incircle(a, b, c, d):
     """> 0: d strictly inside the circle through a, b, c (counter-clockwise)."""
     rows = [(p[0] - d[0], p[1] - d[1]) for p in (a, b, c)]
     (ax, ay), (bx, by), (cx, cy) = rows
-    return ((ax * ax + ay * ay) * (bx * cy - by * cx) - (bx * bx + by * by) * (ax * cy - ay * cx)
-            + (cx * cx + cy * cy) * (ax * by - ay * bx))
+    return (
+        (ax * ax + ay * ay) * (bx * cy - by * cx)
+        - (bx * bx + by * by) * (ax * cy - ay * cx)
+        + (cx * cx + cy * cy) * (ax * by - ay * bx)
+    )
 
 
 def exact_hull_count(points):
@@ -79,7 +83,7 @@ def check_sweep(pts, *, against_all=None):
     n = len(xs)
     h = exact_hull_count(list(distinct))
     if len(distinct) < 3 or h == len(distinct) and all(_orient(*sorted(distinct)[:2], p) == 0 for p in distinct):
-        assert "tv" not in out            # collinear: no triangle
+        assert "tv" not in out  # collinear: no triangle
         return xs, ys, out, False
     tv, opp = out["tv"], out["opp"]
     n_he = len(tv)
@@ -130,7 +134,7 @@ def assert_same_cells(a, b):
     """The two diagrams give every site the same cell, up to rounding of the vertices."""
     assert np.array_equal(a.site_of, b.site_of)
     scale = max(a.bbox[2] - a.bbox[0], a.bbox[3] - a.bbox[1])
-    atol = max(1e-9 * scale, 16 * np.spacing(max(abs(v) for v in a.bbox)))   # far from 0: a few ulps
+    atol = max(1e-9 * scale, 16 * np.spacing(max(abs(v) for v in a.bbox)))  # far from 0: a few ulps
     for i in range(a.n_sites):
         ra, rb = _ring(a.cell_polygon(i), atol), _ring(b.cell_polygon(i), atol)
         assert len(ra) == len(rb), f"cell {i}: {len(ra)} vs {len(rb)} vertices"
@@ -161,6 +165,7 @@ def check_against_incremental(pts):
 
 # ---------------------------------------------------------------------------------------------------------
 # generators of hard families
+
 
 def near_line(n, slope, offset, seed, spread=1.0):
     """Points (t, slope * t + offset) rounded to doubles, t random."""
@@ -225,6 +230,7 @@ def offset_cloud(n, offset, spread, seed):
 # ---------------------------------------------------------------------------------------------------------
 # regression inputs, one file per bug
 
+
 def test_fixture_near_line_4_sites():
     """Four sites within 1e-16 of y = 0: one inside the triangle of the others. The rounded top of a
     circle event (centre ~1e17 below) put a site out of order: one triangle instead of three."""
@@ -249,9 +255,11 @@ def test_fixture_voronoi_diagrams():
 # ---------------------------------------------------------------------------------------------------------
 # the filter and the exact event order
 
+
 def _exact_top(tri):
     """Top of the circle through a, b, c, to 60 digits (decimal)."""
     from decimal import Decimal, getcontext
+
     getcontext().prec = 80
     ax, ay, bx, by, cx, cy = (Fraction(v) for v in tri)
     bx, by, cx, cy = bx - ax, by - ay, cx - ax, cy - ay
@@ -284,6 +292,7 @@ def _ccw_triples(rng, count, scale_y):
 def test_filter_interval_holds_the_exact_top(scale_y):
     rng = np.random.default_rng(SEED)
     from decimal import Decimal
+
     for tri in _ccw_triples(rng, 200, scale_y):
         top, lo, hi, base, rise, rise_err, _, _ = fortune.circle_event_top(*tri)
         exact = _exact_top(tri)
@@ -297,10 +306,17 @@ def test_filter_interval_holds_the_exact_top(scale_y):
 def _family_triples():
     """Counter-clockwise triples of neighbouring sites from the hard families."""
     rng = np.random.default_rng(SEED + 2)
-    sets = [parallel_lines(200, 1.0, 1e-16, SEED), parallel_lines(200, 1.0, 1e-12, SEED),
-            near_line(200, 1 / 3, 0.7, SEED), near_line(200, 2.0, 0.0, SEED), near_line(200, 1e6, 3.0, SEED),
-            near_line(200, 0.0, 1e-18, SEED), lattice(12, "square", 0.1, 1e-12, SEED),
-            offset_cloud(200, 1e12, 1.0, SEED), lattice(12, "triangular", 0.0, 0.0, SEED)]
+    sets = [
+        parallel_lines(200, 1.0, 1e-16, SEED),
+        parallel_lines(200, 1.0, 1e-12, SEED),
+        near_line(200, 1 / 3, 0.7, SEED),
+        near_line(200, 2.0, 0.0, SEED),
+        near_line(200, 1e6, 3.0, SEED),
+        near_line(200, 0.0, 1e-18, SEED),
+        lattice(12, "square", 0.1, 1e-12, SEED),
+        offset_cloud(200, 1e12, 1.0, SEED),
+        lattice(12, "triangular", 0.0, 0.0, SEED),
+    ]
     out = []
     for pts in sets:
         pts = np.unique(pts, axis=0)
@@ -317,6 +333,7 @@ def _family_triples():
 
 def test_filters_hold_the_exact_top_on_hard_families():
     from decimal import Decimal
+
     decided = 0
     for tri in _family_triples():
         exact = _exact_top(tri)
@@ -336,6 +353,7 @@ def test_filters_hold_the_exact_top_on_hard_families():
 @pytest.mark.parametrize("scale_y", [1.0, 1e-9, 1e-18])
 def test_exact_orders_agree_with_high_precision(scale_y):
     from decimal import Decimal
+
     rng = np.random.default_rng(SEED + 1)
     tris = _ccw_triples(rng, 60, scale_y)
     tops = [_exact_top(t) for t in tris]
@@ -345,20 +363,20 @@ def test_exact_orders_agree_with_high_precision(scale_y):
         assert fortune.event_top_order(a, b) == want
         assert fortune.event_top_order(b, a) == -want
         assert fortune.event_top_order(a, a) == 0
-        y = float(tops[k])            # the rounded top: just above or just below the exact one
+        y = float(tops[k])  # the rounded top: just above or just below the exact one
         assert fortune.site_before_event(y, *a) == (Decimal(y) <= tops[k])
         assert fortune.site_before_event(float(a[1]), *a)
 
 
 def test_exact_order_of_equal_tops():
     """Translated copies of one circle have equal tops; a site exactly at a top comes first."""
-    a = (0.0, 0.0, 1.0, 0.0, 0.0, 1.0)              # circle centre (0.5, 0.5)
+    a = (0.0, 0.0, 1.0, 0.0, 0.0, 1.0)  # circle centre (0.5, 0.5)
     b = (5.0, 0.0, 6.0, 0.0, 5.0, 1.0)
-    c = (0.0, 0.0, 2.0, 0.0, 1.0, 1.0)              # centre (1, 0), radius 1: top y = 1 exactly
+    c = (0.0, 0.0, 2.0, 0.0, 1.0, 1.0)  # centre (1, 0), radius 1: top y = 1 exactly
     assert fortune.event_top_order(a, b) == 0
     assert fortune.site_before_event(1.0, *c)
-    assert not fortune.site_before_event(1.0 + 2.0 ** -52, *c)
-    assert fortune.site_before_event(1.0 - 2.0 ** -53, *c)
+    assert not fortune.site_before_event(1.0 + 2.0**-52, *c)
+    assert fortune.site_before_event(1.0 - 2.0**-53, *c)
 
 
 def test_exact_order_of_far_apart_magnitudes():
@@ -372,11 +390,12 @@ def test_exact_order_of_far_apart_magnitudes():
 # ---------------------------------------------------------------------------------------------------------
 # the families
 
+
 @pytest.mark.parametrize("slope", [0.0, 1e-12, 1.0, 1 / 3, 2.0, 1e6])
 @pytest.mark.parametrize("offset", [0.0, 1e-18, 0.7])
 def test_near_collinear_on_slopes(slope, offset):
     pts = near_line(60, slope, offset, SEED)
-    pts[::7, 1] += 1e-9            # a few clearly off the line
+    pts[::7, 1] += 1e-9  # a few clearly off the line
     check_against_incremental(pts)
     check_against_incremental(near_line(30, slope, offset, SEED + 1))
 
@@ -437,9 +456,11 @@ def test_property_coarse_decimals(points):
 
 
 @settings(max_examples=150, deadline=None)
-@given(st.lists(st.floats(0, 1).filter(lambda v: v == 0 or v > 1e-40), min_size=3, max_size=12),
-       st.sampled_from([0.0, 1e-9, 1 / 3, 1.0, 3.0]),
-       st.lists(st.sampled_from([0.0, 1e-18, -1e-17, 1e-16, 2.5e-16]), min_size=12, max_size=12))
+@given(
+    st.lists(st.floats(0, 1).filter(lambda v: v == 0 or v > 1e-40), min_size=3, max_size=12),
+    st.sampled_from([0.0, 1e-9, 1 / 3, 1.0, 3.0]),
+    st.lists(st.sampled_from([0.0, 1e-18, -1e-17, 1e-16, 2.5e-16]), min_size=12, max_size=12),
+)
 def test_property_near_one_line(ts, slope, bumps):
     # (subnormal coordinates are left out, as in test_fortune: orient2d and incircle underflow there)
     pts = np.array([(t, slope * t + bumps[k]) for k, t in enumerate(ts)], float)
@@ -447,8 +468,9 @@ def test_property_near_one_line(ts, slope, bumps):
 
 
 @settings(max_examples=150, deadline=None)
-@given(st.lists(st.tuples(st.sampled_from([1.0, 2.0, 5.0]), st.integers(0, 23)), min_size=3, max_size=12),
-       st.booleans())
+@given(
+    st.lists(st.tuples(st.sampled_from([1.0, 2.0, 5.0]), st.integers(0, 23)), min_size=3, max_size=12), st.booleans()
+)
 def test_property_on_a_few_circles(polar, centre):
     pts = [(r * math.cos(math.pi * k / 12), r * math.sin(math.pi * k / 12)) for r, k in polar]
     if centre:
@@ -491,8 +513,7 @@ _FINISH = textwrap.dedent("""
 def test_hard_families_finish(kind, tmp_path):
     """2 x 20,000 sites within 1e-16 of two parallel lines; a 100 x 100 grid with 1e-12 noise."""
     saved = tmp_path / "points.npy"
-    run = subprocess.run([sys.executable, "-c", _FINISH, kind, str(saved)], capture_output=True, text=True,
-                         timeout=60)
+    run = subprocess.run([sys.executable, "-c", _FINISH, kind, str(saved)], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, run.stderr[-2000:]
     status, flips, twins, n_finite = map(int, run.stdout.split("\n")[0].split())
     assert status == fortune.STATUS_OK and flips == 0 and twins == 1
@@ -506,13 +527,18 @@ def test_hard_families_finish(kind, tmp_path):
 # ---------------------------------------------------------------------------------------------------------
 # the stages of the event order are all exercised, and trouble is an error, not a crash
 
+
 def two_circles_with_one_top():
     """The integer points of two circles whose tops are at one height but whose radii differ (5 about
     (0, 0), 10 about (40, -5)), the top points left out: equal tops that no shift along x relates."""
     pts = []
     for (cx, cy), r in (((0, 0), 5), ((40, -5), 10)):
-        pts += [(cx + x, cy + y) for x in range(-r, r + 1) for y in range(-r, r + 1)
-                if x * x + y * y == r * r and (x, y) != (0, r)]
+        pts += [
+            (cx + x, cy + y)
+            for x in range(-r, r + 1)
+            for y in range(-r, r + 1)
+            if x * x + y * y == r * r and (x, y) != (0, r)
+        ]
     return np.array(pts, float)
 
 
@@ -533,8 +559,8 @@ def test_lattice_rows_are_settled_without_the_integer_fallback(kind, scale):
     (a 1000 x 1000 grid took 54 s when each went to the integer fallback, 5 s now). The sweep stays exact."""
     pts = lattice(12, kind, 0.0, 0.0, SEED)
     if kind == "triangular":
-        pts = np.round(pts * 8) / 8            # rows at exact heights, coordinates exact in binary
-    pts = pts * scale + 1000.0                 # exact: a power of two or a small integer, and an offset
+        pts = np.round(pts * 8) / 8  # rows at exact heights, coordinates exact in binary
+    pts = pts * scale + 1000.0  # exact: a power of two or a small integer, and an offset
     _, _, out, _ = check_sweep(pts)
     assert out["near_ties"][0] > 0
     assert out["exact_tests"][1] == 0
@@ -555,7 +581,7 @@ def test_a_large_lattice_proves_each_tie_about_once(kind):
     order = sweep_order(pts[:, 0], pts[:, 1])
     out = fortune.sweep(np.ascontiguousarray(pts[order, 0]), np.ascontiguousarray(pts[order, 1]))
     assert out["status"] == fortune.STATUS_OK
-    assert out["near_ties"][0] < 8 * len(pts)        # 20 to 50 per site when each pair was proven anew
+    assert out["near_ties"][0] < 8 * len(pts)  # 20 to 50 per site when each pair was proven anew
     assert out["exact_tests"][1] == 0
 
 
@@ -575,17 +601,19 @@ def test_an_inconsistent_sweep_stops_a_dynamic_diagram_too(monkeypatch):
 
 
 @pytest.mark.parametrize("noise", [1e-17, 1e-13, 1e-9])
-@pytest.mark.parametrize("scale", [1.0, 2.0 ** -60, 2.0 ** -150])
+@pytest.mark.parametrize("scale", [1.0, 2.0**-60, 2.0**-150])
 def test_fine_filter_holds_and_decides_on_noisy_squares(noise, scale):
     """The double-double stage's bound holds on the triangles of noisy lattice squares (the near-cocircular
     pairs that reach it), at several scales, and it decides them: exact integers stay the exception."""
     from decimal import Decimal
+
     rng = np.random.default_rng(SEED + 3)
     decided = 0
     for _ in range(120):
         i, j = rng.integers(0, 50, 2)
-        sq = (np.array([(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)], float) / 64
-              + noise * rng.standard_normal((4, 2))) * scale
+        sq = (
+            np.array([(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)], float) / 64 + noise * rng.standard_normal((4, 2))
+        ) * scale
         for a, b, c in ((0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)):
             tri = tuple(float(v) for v in (*sq[a], *sq[b], *sq[c]))
             if _orient(*[(Fraction(tri[2 * k]), Fraction(tri[2 * k + 1])) for k in range(3)]) <= 0:

@@ -100,7 +100,10 @@ def test_clustered_points_come_in_random_order():
 @pytest.mark.parametrize(
     "call, message",
     [
-        (lambda: generate("poisson", 10), r"unknown distribution 'poisson'; choose one of: uniform, gaussian, clustered"),
+        (
+            lambda: generate("poisson", 10),
+            r"unknown distribution 'poisson'; choose one of: uniform, gaussian, clustered",
+        ),
         (lambda: generate(None, 10), r"unknown distribution None; choose one of"),
         (lambda: generate("uniform", -1), r"n must be >= 0, got -1"),
         (lambda: generate("uniform", 2.5), r"n must be an integer, got 2.5"),

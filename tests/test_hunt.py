@@ -60,8 +60,9 @@ def answer(worker: Worker, kind: str, name: str, engine: str) -> dict:
 
 
 def assert_reads_only_written_memory(worker: Worker, kind: str, name: str, engine: str) -> None:
-    result = uninit_result(worker, request(kind, name, engine), answer(worker, kind, name, engine),
-                           timeout=BUILD_TIMEOUT)
+    result = uninit_result(
+        worker, request(kind, name, engine), answer(worker, kind, name, engine), timeout=BUILD_TIMEOUT
+    )
     assert_ok(result, f"{name}, {engine}")
 
 
@@ -160,13 +161,16 @@ def test_checked_fortune_fixture(checked, fixture):
 
 def run_engines(worker: Worker, points) -> list[dict]:
     pts = np.asarray(points, np.float64).reshape(-1, 2)
-    return [worker.run({"points": pts.tolist(), "engine": e, "save": worker.cells_path(f"hyp-{e}")},
-                       timeout=SMALL_TIMEOUT) for e in ENGINES]
+    return [
+        worker.run({"points": pts.tolist(), "engine": e, "save": worker.cells_path(f"hyp-{e}")}, timeout=SMALL_TIMEOUT)
+        for e in ENGINES
+    ]
 
 
-decimal = st.integers(-20, 20).map(lambda k: k / 10)             # 0.1 steps, rounded to doubles
-HYPOTHESIS = settings(max_examples=40, deadline=None, phases=CI_PHASES,
-                      suppress_health_check=[HealthCheck.function_scoped_fixture])
+decimal = st.integers(-20, 20).map(lambda k: k / 10)  # 0.1 steps, rounded to doubles
+HYPOTHESIS = settings(
+    max_examples=40, deadline=None, phases=CI_PHASES, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 @st.composite

@@ -98,7 +98,7 @@ def test_tiny_inputs(n):
     assert d.n_sites == n
     validate(d)
     if n == 1:
-        assert len(d.cell_polygon(0)) == 4   # the whole box
+        assert len(d.cell_polygon(0)) == 4  # the whole box
 
 
 def test_default_box():
@@ -119,9 +119,9 @@ def test_user_box_leaving_sites_out():
 
 def test_extreme_scales_are_exact():
     base = np.array([(i, j) for i in range(5) for j in range(5)], float)
-    for scale in (2.0 ** -300, 2.0 ** 300):
+    for scale in (2.0**-300, 2.0**300):
         d = tvoronoi.voronoi(base * scale)
-        assert d.n_vertices == 16      # the grid's cocircular structure survives scaling
+        assert d.n_vertices == 16  # the grid's cocircular structure survives scaling
         validate(d)
 
 
@@ -129,8 +129,7 @@ small_ints = st.integers(min_value=-6, max_value=6)
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.tuples(small_ints, small_ints), min_size=0, max_size=30),
-       st.sampled_from(INSERTIONS))
+@given(st.lists(st.tuples(small_ints, small_ints), min_size=0, max_size=30), st.sampled_from(INSERTIONS))
 def test_property_degenerate_integer_sets(points, insertion):
     """Small integer sets are full of repeats, collinear runs and cocircular quads."""
     pts = np.array(points, float).reshape(-1, 2)

@@ -99,10 +99,21 @@ def test_dual_and_clip_answer_signals(points, alarm):
     s = t.sites
     first = (out["dup"] < 0).astype(np.int8)
     box = default_bbox(points)
-    assert stopped_in_kernel(alarm, lambda: clip.clip_cells(
-        s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"],
-        out["he_face"], out["face_edge"], first, box, s.exponent,
-    )).endswith("clip.pyx")
+    assert stopped_in_kernel(
+        alarm,
+        lambda: clip.clip_cells(
+            s.xs,
+            s.ys,
+            out["vertices"],
+            out["he_origin"],
+            out["he_twin"],
+            out["he_face"],
+            out["face_edge"],
+            first,
+            box,
+            s.exponent,
+        ),
+    ).endswith("clip.pyx")
 
 
 def test_a_build_after_an_interrupted_one_is_whole(points, alarm):
@@ -124,14 +135,18 @@ def test_batch_stops_on_signal_and_leaves_no_file(tmp_path, sig, code):
     out = tmp_path / "cells.geojson"
     # a child of a background job inherits SIGINT ignored, and Python then leaves it ignored: give the
     # child the default disposition, as a terminal would
-    proc = subprocess.Popen([sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    time.sleep(2.5)                          # start-up and reading done; the engine is running
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    time.sleep(2.5)  # start-up and reading done; the engine is running
     proc.send_signal(sig)
     try:
         _, err = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:       # a kernel that ignores signals would not end: fail, don't hang
+    except subprocess.TimeoutExpired:  # a kernel that ignores signals would not end: fail, don't hang
         proc.kill()
         proc.communicate()
         pytest.fail("the batch did not stop on the signal")

@@ -88,8 +88,13 @@ def test_clipped_steps_match_the_reference(rng):
     # each moved site is the centroid of a piece of the region, so it lies in the region's hull
     assert shapely.covers(L_SHAPE.convex_hull, shapely.points(moved[inside])).all()
     more = tvoronoi.lloyd(moved, 4, clip=L_SHAPE)
-    steps = [np.abs(b - a).sum() for a, b in zip([moved, *[tvoronoi.lloyd(moved, k, clip=L_SHAPE) for k in (1, 2, 3)]],
-                                                    [tvoronoi.lloyd(moved, k, clip=L_SHAPE) for k in (1, 2, 3, 4)])]
+    steps = [
+        np.abs(b - a).sum()
+        for a, b in zip(
+            [moved, *[tvoronoi.lloyd(moved, k, clip=L_SHAPE) for k in (1, 2, 3)]],
+            [tvoronoi.lloyd(moved, k, clip=L_SHAPE) for k in (1, 2, 3, 4)],
+        )
+    ]
     assert steps[-1] < steps[0]
     assert np.isfinite(more).all()
 

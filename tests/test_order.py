@@ -19,7 +19,7 @@ def test_same_seed_same_order(rng):
     xs, ys = rng.random(5000), rng.random(5000)
     assert np.array_equal(brio_order(xs, ys, 7), brio_order(xs, ys, 7))
     assert not np.array_equal(brio_order(xs, ys, 7), brio_order(xs, ys, 8))
-    assert np.array_equal(np.sort(brio_order(xs, ys, -1)), np.arange(5000))   # any int seeds
+    assert np.array_equal(np.sort(brio_order(xs, ys, -1)), np.arange(5000))  # any int seeds
 
 
 @pytest.mark.parametrize("kind", ["uniform", "clustered", "rows"])
@@ -41,15 +41,17 @@ def test_the_same_order_on_any_thread_count(rng, kind):
 
 def test_repeats_and_ties(rng):
     """All sites at one place, and sites on a few rows and columns (ties on both axes)."""
-    for xs, ys in [(np.full(1000, 0.25), np.full(1000, 0.25)),
-                   (np.floor(rng.random(20000) * 7), np.floor(rng.random(20000) * 5))]:
+    for xs, ys in [
+        (np.full(1000, 0.25), np.full(1000, 0.25)),
+        (np.floor(rng.random(20000) * 7), np.floor(rng.random(20000) * 5)),
+    ]:
         perm = brio_order(xs, ys, 0)
         assert np.array_equal(np.sort(perm), np.arange(len(xs)))
 
 
 def mean_step(xs, ys, perm, n):
     """Mean distance between consecutive sites of the last (largest) round, among the first n."""
-    last = perm[len(perm) // 2 + len(perm) // 8:]       # well inside the last round
+    last = perm[len(perm) // 2 + len(perm) // 8 :]  # well inside the last round
     last = last[last < n]
     return np.hypot(np.diff(xs[last]), np.diff(ys[last])).mean()
 
@@ -73,6 +75,6 @@ def test_two_lines_are_followed_along(rng):
     xs = rng.random(n)
     ys = np.where(np.arange(n) < n // 2, 0.5, 0.5 + 1e-9)
     perm = brio_order(xs, ys, 0)
-    last = perm[n // 2 + n // 8:]
+    last = perm[n // 2 + n // 8 :]
     rank = np.argsort(np.argsort(xs[last]))
     assert np.abs(np.diff(rank)).mean() < 4

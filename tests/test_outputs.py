@@ -21,8 +21,9 @@ CSV = "x,y,name\n0,0,a\n1,0,b\n0,1,c\n1,1,d\n0.5,0.4,e\n"
 
 def batch(*args) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-m", "tvoronoi", "batch", *map(str, args)],
-                          capture_output=True, env=env, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "tvoronoi", "batch", *map(str, args)], capture_output=True, env=env, timeout=120
+    )
 
 
 @pytest.fixture
@@ -71,8 +72,12 @@ def test_dev_stdout_redirected_to_a_file_is_written_through_the_descriptor(tmp_p
     out.write_bytes(b"HEAD\n")
     with open(out, "ab") as sink:
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        status = subprocess.run([sys.executable, "-m", "tvoronoi", "batch", str(points), "-o", "/dev/stdout"],
-                                stdout=sink, env=env, timeout=120).returncode
+        status = subprocess.run(
+            [sys.executable, "-m", "tvoronoi", "batch", str(points), "-o", "/dev/stdout"],
+            stdout=sink,
+            env=env,
+            timeout=120,
+        ).returncode
     assert status == 0
     data = out.read_bytes()
     assert data.startswith(b'HEAD\n{"type":"FeatureCollection"') and data.endswith(b"]}\n")
@@ -100,8 +105,12 @@ def test_a_reader_leaving_early_ends_the_run_quietly(tmp_path):
     big = tmp_path / "big.csv"
     np.savetxt(big, rng.random((60_000, 2)), delimiter=",", header="x,y", comments="")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.Popen([sys.executable, "-m", "tvoronoi", "batch", str(big), "-o", "-"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tvoronoi", "batch", str(big), "-o", "-"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+    )
     proc.stdout.read(100)
     proc.stdout.close()
     err = proc.stderr.read()

@@ -15,7 +15,7 @@ from tvoronoi.build import assemble, build_arrays
 from tvoronoi.generators import generate
 from tvoronoi.kernels import pages
 
-BIG = (1 << 20) // 8 + 1000          # doubles: just over the size that gets a mapping
+BIG = (1 << 20) // 8 + 1000  # doubles: just over the size that gets a mapping
 
 
 def test_arrays_made_inside_come_from_the_handler_and_the_old_one_returns():
@@ -24,7 +24,7 @@ def test_arrays_made_inside_come_from_the_handler_and_the_old_one_returns():
         small, big = np.empty(10), np.empty(BIG)
         assert get_handler_name(small) == get_handler_name(big) == "tvoronoi_pages"
     assert get_handler_name(np.empty(BIG)) == before
-    big[:] = 1.5                     # still usable, and freed by its own handler after the block
+    big[:] = 1.5  # still usable, and freed by its own handler after the block
     assert big.sum() == 1.5 * BIG
 
 
@@ -51,12 +51,12 @@ def test_zeros_grow_and_shrink_keep_the_data(n):
         z = np.zeros(n)
         assert not z.any()
         a = np.arange(n, dtype=np.float64)
-        a.resize(3 * n, refcheck=False)          # a mapping grows in place or moves, with its pages
+        a.resize(3 * n, refcheck=False)  # a mapping grows in place or moves, with its pages
         assert np.array_equal(a[:n], np.arange(n)) and not a[n:].any()
         a.resize(n // 2 + 1, refcheck=False)
         assert np.array_equal(a, np.arange(n // 2 + 1))
         b = np.arange(7, dtype=np.float64)
-        b.resize(n + 7, refcheck=False)          # from malloc to a mapping when it grows past 1 MiB
+        b.resize(n + 7, refcheck=False)  # from malloc to a mapping when it grows past 1 MiB
         assert np.array_equal(b[:7], np.arange(7)) and not b[7:].any()
 
 
@@ -73,8 +73,18 @@ def test_a_build_equals_one_made_with_the_default_allocator_and_no_room():
     assert get_handler_name(owner(plain.cell_points)) != "tvoronoi_pages"
     built = tvoronoi.voronoi(pts, threads=1)
     assert get_handler_name(owner(built.cell_points)) == "tvoronoi_pages"
-    for name in ("vertices", "he_origin", "he_twin", "he_face", "face_edge", "triangles", "cell_points",
-                 "cell_offsets", "cell_vertices", "site_of"):
+    for name in (
+        "vertices",
+        "he_origin",
+        "he_twin",
+        "he_face",
+        "face_edge",
+        "triangles",
+        "cell_points",
+        "cell_offsets",
+        "cell_vertices",
+        "site_of",
+    ):
         assert np.array_equal(getattr(plain, name), getattr(built, name)), name
 
 
@@ -93,9 +103,9 @@ def resident_mib() -> float:
 def test_a_freed_array_is_handed_back():
     """Unlike the C heap's blocks below its threshold, a freed array leaves the resident set at once."""
     with build_arrays():
-        scratch = np.empty(2 << 20)              # raise the heap's threshold as a build's temporaries do
+        scratch = np.empty(2 << 20)  # raise the heap's threshold as a build's temporaries do
         del scratch
-        a = np.ones(2 << 20)                     # 16 MiB
+        a = np.ones(2 << 20)  # 16 MiB
         held = resident_mib()
         del a
     assert held - resident_mib() > 14

@@ -1,4 +1,5 @@
 """Property tests of the exact predicates against rational arithmetic (fractions.Fraction)."""
+
 import itertools
 import math
 import random
@@ -39,9 +40,7 @@ def incircle_rational(ax, ay, bx, by, cx, cy, dx, dy):
     a_lift = adx * adx + ady * ady
     b_lift = bdx * bdx + bdy * bdy
     c_lift = cdx * cdx + cdy * cdy
-    return sign(
-        a_lift * (bdx * cdy - cdx * bdy) + b_lift * (cdx * ady - adx * cdy) + c_lift * (adx * bdy - bdx * ady)
-    )
+    return sign(a_lift * (bdx * cdy - cdx * bdy) + b_lift * (cdx * ady - adx * cdy) + c_lift * (adx * bdy - bdx * ady))
 
 
 def orient2d_float(ax, ay, bx, by, cx, cy):
@@ -54,9 +53,7 @@ def incircle_float(ax, ay, bx, by, cx, cy, dx, dy):
     a_lift = adx * adx + ady * ady
     b_lift = bdx * bdx + bdy * bdy
     c_lift = cdx * cdx + cdy * cdy
-    return sign(
-        a_lift * (bdx * cdy - cdx * bdy) + b_lift * (cdx * ady - adx * cdy) + c_lift * (adx * bdy - bdx * ady)
-    )
+    return sign(a_lift * (bdx * cdy - cdx * bdy) + b_lift * (cdx * ady - adx * cdy) + c_lift * (adx * bdy - bdx * ady))
 
 
 def orient2d_filter_decides(ax, ay, bx, by, cx, cy):
@@ -99,7 +96,9 @@ def differences_exact(points):
 
 def parity(permutation):
     """+1 for an even permutation of range(n), -1 for an odd one."""
-    inversions = sum(1 for i, j in itertools.combinations(range(len(permutation)), 2) if permutation[i] > permutation[j])
+    inversions = sum(
+        1 for i, j in itertools.combinations(range(len(permutation)), 2) if permutation[i] > permutation[j]
+    )
     return -1 if inversions % 2 else 1
 
 
@@ -237,9 +236,7 @@ def test_cocircular_radius_65(scale, shift_x, shift_y):
 def test_lattice_points_near_radius_65():
     """Points just inside (+1) and just outside (-1) the circle through three of its lattice points."""
     a, b, c = (65.0, 0.0), (0.0, 65.0), (-65.0, 0.0)  # counter-clockwise
-    near = [
-        (x, y) for x in range(-66, 67) for y in range(-66, 67) if 0 < abs(x * x + y * y - 65 * 65) <= 130
-    ]
+    near = [(x, y) for x in range(-66, 67) for y in range(-66, 67) if 0 < abs(x * x + y * y - 65 * 65) <= 130]
     assert len(near) > 100
     for x, y in near:
         expected = 1 if x * x + y * y < 65 * 65 else -1
@@ -270,7 +267,9 @@ def test_orient2d_exact_tiers():
             # on a line through integer points: differences are exact
             step = (rng.randint(-5, 5), rng.randint(1, 5))
             base = (rng.randint(-(2**40), 2**40), rng.randint(-(2**40), 2**40))
-            points = [(float(base[0] + k * step[0]), float(base[1] + k * step[1])) for k in rng.sample(range(-50, 50), 3)]
+            points = [
+                (float(base[0] + k * step[0]), float(base[1] + k * step[1])) for k in rng.sample(range(-50, 50), 3)
+            ]
         if rng.random() < 0.7:
             i, axis = rng.randrange(3), rng.randrange(2)
             moved = list(points[i])

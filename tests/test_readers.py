@@ -197,8 +197,13 @@ def test_csv_extra_columns_are_typed_per_column(tmp_path):
     points = read(tmp_path, "p.csv", content)
     # a column with a word is text throughout; a number column with a non-integer is float throughout
     assert points.properties(0) == {
-        "i": 1, "f": 1.5, "mixed": "1", "s": "abc", "e": None,
-        "big": "123456789012345678901234567890", "nan": None,
+        "i": 1,
+        "f": 1.5,
+        "mixed": "1",
+        "s": "abc",
+        "e": None,
+        "big": "123456789012345678901234567890",
+        "nan": None,
     }
     row1 = points.properties(1)
     assert row1["i"] == -2 and type(row1["i"]) is int
@@ -510,9 +515,7 @@ CELLS = st.one_of(
     data=st.data(),
 )
 def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
-    extras = [
-        [data.draw(CELLS) for _ in range(n_extra)] for _ in xy
-    ]
+    extras = [[data.draw(CELLS) for _ in range(n_extra)] for _ in xy]
     if kind == "text":
         # text fields cannot be empty or hold spaces
         extras = [[c.replace(" ", "_") or "-" for c in row] for row in extras]
@@ -527,7 +530,7 @@ def test_fast_and_slow_paths_agree(kind, header, xy, n_extra, data):
     layout = readers.table_layout(text, "t", kind, None, None)
     slow = readers.slow_table(text, "t", kind, layout)
     np.testing.assert_array_equal(slow.xy, np.array(xy, dtype=np.float64).reshape(-1, 2))
-    body = text[readers.line_offset(text, layout.header_lines):]
+    body = text[readers.line_offset(text, layout.header_lines) :]
     fast = readers.fast_table(body, kind, layout)
     assert fast is not None
     np.testing.assert_array_equal(fast[0], slow.xy)
@@ -565,7 +568,7 @@ def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line,
         lines.insert(2, "")
     text = "\n".join(lines) + "\n"
     layout = readers.table_layout(text, "t", "csv", None, None, delimiter)
-    body = text[readers.line_offset(text, layout.header_lines):]
+    body = text[readers.line_offset(text, layout.header_lines) :]
     plain = text.isascii() and "_" not in text
     arrow = tabular._arrow_columns(body, layout, len(layout.names), plain)
     if arrow is None:
@@ -652,9 +655,11 @@ def test_non_finite_in_text_npy_and_geojson(tmp_path):
     assert "p.txt, line 2: y is inf" in error(tmp_path, "p.txt", "# c\n1 inf\n")
     array = np.array([[1.0, 2.0], [3.0, 4.0], [np.nan, 5.0]])
     assert "p.npy, row 2 (0-based): x is nan" in error(tmp_path, "p.npy", npy_bytes(array))
-    nan_json = '{"type": "FeatureCollection", "features": [\n' + json.dumps(
-        feature({"type": "Point", "coordinates": [1, 2]})
-    ) + ',\n{"type": "Feature", "geometry": {"type": "Point", "coordinates": [NaN, 1]}}]}'
+    nan_json = (
+        '{"type": "FeatureCollection", "features": [\n'
+        + json.dumps(feature({"type": "Point", "coordinates": [1, 2]}))
+        + ',\n{"type": "Feature", "geometry": {"type": "Point", "coordinates": [NaN, 1]}}]}'
+    )
     message = error(tmp_path, "p.geojson", nan_json)
     # orjson refuses NaN while parsing, on line 3
     assert "p.geojson, line 3" in message
@@ -662,10 +667,13 @@ def test_non_finite_in_text_npy_and_geojson(tmp_path):
 
 def test_non_finite_geojson_coordinates_are_named(monkeypatch):
     """The reader's own finiteness check names the feature and the point."""
-    doc = {"type": "FeatureCollection", "features": [
-        feature({"type": "Point", "coordinates": [1, 2]}),
-        feature({"type": "MultiPoint", "coordinates": [[1, 2], [3, float("inf")]]}),
-    ]}
+    doc = {
+        "type": "FeatureCollection",
+        "features": [
+            feature({"type": "Point", "coordinates": [1, 2]}),
+            feature({"type": "MultiPoint", "coordinates": [[1, 2], [3, float("inf")]]}),
+        ],
+    }
     monkeypatch.setattr(readers, "_loads_json", lambda data, source: doc)
     monkeypatch.setattr(sys, "stdin", FakeStdin(b"{}"))
     with pytest.raises(InputFileError, match=r"<stdin>, features\[1\], point 1: y is inf; tvoronoi needs finite"):
@@ -689,10 +697,16 @@ def test_ragged_rows(tmp_path, name, content, expected):
 @pytest.mark.parametrize(
     "name, content, expected",
     [
-        ("points.csv", "x,y\n1,2\n3,4\n5,6\n7,8\n9,10\n11,abc\n",
-         'points.csv, line 7: "abc" in column "y" is not a number'),
-        ("points.csv", "id,lon,lat,name\n1,2,3,a\n2,,3,b\n",
-         'points.csv, line 3: "" in column "lon" (x) is not a number'),
+        (
+            "points.csv",
+            "x,y\n1,2\n3,4\n5,6\n7,8\n9,10\n11,abc\n",
+            'points.csv, line 7: "abc" in column "y" is not a number',
+        ),
+        (
+            "points.csv",
+            "id,lon,lat,name\n1,2,3,a\n2,,3,b\n",
+            'points.csv, line 3: "" in column "lon" (x) is not a number',
+        ),
         ("points.txt", "1 2\n3 4\n\n5 six\n", 'points.txt, line 4: "six" in column "col2" (y) is not a number'),
         ("points.csv", 'x,y\n"1,5",2\n', 'points.csv, line 2: "1,5" in column "x" is not a number'),
     ],
@@ -738,25 +752,41 @@ def test_broken_json_names_line_and_column(tmp_path):
 @pytest.mark.parametrize(
     "content, expected",
     [
-        (collection(feature({"type": "Point", "coordinates": [0, 0]}),
-                    feature({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [0, 1], [0, 0]]]})),
-         'p.geojson, features[1]: geometry type "Polygon" is not a point'),
+        (
+            collection(
+                feature({"type": "Point", "coordinates": [0, 0]}),
+                feature({"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [0, 1], [0, 0]]]}),
+            ),
+            'p.geojson, features[1]: geometry type "Polygon" is not a point',
+        ),
         (collection(feature(None)), "p.geojson, features[0]: the geometry is null"),
-        (collection(feature({"type": "Point", "coordinates": [1]})),
-         "p.geojson, features[0]: coordinates [1] are not a position"),
-        (collection(feature({"type": "Point", "coordinates": ["1", 2]})),
-         "p.geojson, features[0]: coordinates ['1', 2] are not a position"),
-        (collection(feature({"type": "MultiPoint", "coordinates": [[1, 2], [True, 3]]})),
-         "p.geojson, features[0], point 1: coordinates [True, 3] are not a position"),
-        (collection(feature({"type": "Point", "coordinates": [1, 2]}, [1])),
-         'p.geojson, features[0]: "properties" is a list'),
+        (
+            collection(feature({"type": "Point", "coordinates": [1]})),
+            "p.geojson, features[0]: coordinates [1] are not a position",
+        ),
+        (
+            collection(feature({"type": "Point", "coordinates": ["1", 2]})),
+            "p.geojson, features[0]: coordinates ['1', 2] are not a position",
+        ),
+        (
+            collection(feature({"type": "MultiPoint", "coordinates": [[1, 2], [True, 3]]})),
+            "p.geojson, features[0], point 1: coordinates [True, 3] are not a position",
+        ),
+        (
+            collection(feature({"type": "Point", "coordinates": [1, 2]}, [1])),
+            'p.geojson, features[0]: "properties" is a list',
+        ),
         (collection(5), "p.geojson, features[0]: not a Feature object but a number"),
         ('{"type": "FeatureCollection"}', 'p.geojson: the FeatureCollection has no "features" list'),
         ("[[1, 2]]", "p.geojson: not GeoJSON: expected a FeatureCollection"),
-        ('{"type": "LineString", "coordinates": [[0, 0], [1, 1]]}',
-         "p.geojson: the file is a single LineString geometry"),
-        (json.dumps(feature({"type": "GeometryCollection", "geometries": []})),
-         'p.geojson, the feature: geometry type "GeometryCollection" is not a point'),
+        (
+            '{"type": "LineString", "coordinates": [[0, 0], [1, 1]]}',
+            "p.geojson: the file is a single LineString geometry",
+        ),
+        (
+            json.dumps(feature({"type": "GeometryCollection", "geometries": []})),
+            'p.geojson, the feature: geometry type "GeometryCollection" is not a point',
+        ),
     ],
 )
 def test_geojson_errors(tmp_path, content, expected):
@@ -832,10 +862,19 @@ def test_a_column_is_integer_only_if_every_value_is(tmp_path):
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.one_of(st.integers(-10**20, 10**20).map(str), st.from_regex(r"0[0-9]{1,5}", fullmatch=True),
-                          st.floats(allow_nan=False, allow_infinity=False).map(repr), st.just(""),
-                          st.text("abc ", min_size=1, max_size=4)),
-                min_size=1, max_size=12))
+@given(
+    st.lists(
+        st.one_of(
+            st.integers(-(10**20), 10**20).map(str),
+            st.from_regex(r"0[0-9]{1,5}", fullmatch=True),
+            st.floats(allow_nan=False, allow_infinity=False).map(repr),
+            st.just(""),
+            st.text("abc ", min_size=1, max_size=4),
+        ),
+        min_size=1,
+        max_size=12,
+    )
+)
 def test_every_column_has_one_type(values):
     from tvoronoi.readers.pointset import convert_column
 
@@ -854,13 +893,16 @@ def test_every_column_has_one_type(values):
 # column choice: names, id-like columns, separators
 
 
-@pytest.mark.parametrize("header, expect", [
-    ("name,Easting,Northing", ("Easting", "Northing")),
-    ("name,E,N", ("E", "N")),
-    ("name,X,Y", ("X", "Y")),
-    ("name,Longitude,Latitude", ("Longitude", "Latitude")),
-    ("name,lng,lat", ("lng", "lat")),
-])
+@pytest.mark.parametrize(
+    "header, expect",
+    [
+        ("name,Easting,Northing", ("Easting", "Northing")),
+        ("name,E,N", ("E", "N")),
+        ("name,X,Y", ("X", "Y")),
+        ("name,Longitude,Latitude", ("Longitude", "Latitude")),
+        ("name,lng,lat", ("lng", "lat")),
+    ],
+)
 def test_coordinate_columns_recognised_by_name(tmp_path, header, expect):
     points = read(tmp_path, "p.csv", f"{header}\na,5,7\nb,6,8\n")
     np.testing.assert_array_equal(points.xy, [[5, 7], [6, 8]])
@@ -896,8 +938,7 @@ def test_readers_report_the_columns_taken_and_the_candidates_when_ambiguous(tmp_
     # a header-less table: the columns by their colN names, which the readers take back
     bare = read(tmp_path, "t.csv", "1,2,3\n4,5,6\n")
     assert bare.candidates == ("col1", "col2", "col3")
-    np.testing.assert_array_equal(read(tmp_path, "t.csv", "1,2,3\n4,5,6\n", x="col3", y="col2").xy,
-                                  [[3, 2], [6, 5]])
+    np.testing.assert_array_equal(read(tmp_path, "t.csv", "1,2,3\n4,5,6\n", x="col3", y="col2").xy, [[3, 2], [6, 5]])
     # a structured .npy array of three unnamed numeric fields
     array = np.array([(1.0, 2.0, 3.0)], dtype=[("p", "f8"), ("q", "f8"), ("r", "i4")])
     npy = read(tmp_path, "p.npy", npy_bytes(array))
@@ -928,16 +969,19 @@ def test_tsv_and_explicit_delimiter(tmp_path):
     np.testing.assert_array_equal(points.xy, [[1, 2], [3, 4]])
 
 
-@pytest.mark.parametrize("name, content, what", [
-    ("p.gpkg", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
-    ("p.dat", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
-    ("p.shp", b"\x00\x00\x27\x0a" + bytes(96), "shapefile"),
-    ("p.zip", b"PK\x03\x04" + bytes(40), "zip archive"),
-    ("p.csv", b"PK\x03\x04" + bytes(40), "zip archive"),
-    ("p.xlsx", b"PK\x03\x04" + bytes(40), "zip archive"),
-    ("p.kml", b"<?xml version='1.0'?><kml/>", "KML"),
-    ("p.csv.gz", b"\x1f\x8b\x08" + bytes(20), "gzip"),
-])
+@pytest.mark.parametrize(
+    "name, content, what",
+    [
+        ("p.gpkg", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+        ("p.dat", b"SQLite format 3\x00" + bytes(100), "GeoPackage"),
+        ("p.shp", b"\x00\x00\x27\x0a" + bytes(96), "shapefile"),
+        ("p.zip", b"PK\x03\x04" + bytes(40), "zip archive"),
+        ("p.csv", b"PK\x03\x04" + bytes(40), "zip archive"),
+        ("p.xlsx", b"PK\x03\x04" + bytes(40), "zip archive"),
+        ("p.kml", b"<?xml version='1.0'?><kml/>", "KML"),
+        ("p.csv.gz", b"\x1f\x8b\x08" + bytes(20), "gzip"),
+    ],
+)
 def test_unsupported_formats_are_named_with_a_conversion(tmp_path, name, content, what):
     message = error(tmp_path, name, content)
     assert what in message and "does not read" in message
@@ -951,9 +995,14 @@ def test_a_binary_file_is_named_as_such(tmp_path):
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.sampled_from([",", ";", "\t", "|"]),
-       st.lists(st.tuples(st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
-                          st.text("ab ,;|", max_size=5)), min_size=1, max_size=20))
+@given(
+    st.sampled_from([",", ";", "\t", "|"]),
+    st.lists(
+        st.tuples(st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6), st.text("ab ,;|", max_size=5)),
+        min_size=1,
+        max_size=20,
+    ),
+)
 def test_any_separator_is_found_from_the_rows(tmp_path_factory, delimiter, rows):
     out = io.StringIO()
     writer = csv.writer(out, delimiter=delimiter, lineterminator="\n")
@@ -967,12 +1016,15 @@ def test_any_separator_is_found_from_the_rows(tmp_path_factory, delimiter, rows)
     ]
 
 
-@pytest.mark.parametrize("content, rows_lines", [
-    ("x,y\n1,2\n3,4\n5,6\n", [(0, 2), (2, 4)]),  # fast path, one line per row
-    ("\nx,y\n\n1,2\n\n3,4\n5,6", [(0, 4), (1, 6), (2, 7)]),  # blank lines
-    ('x,y,n\n1,2,"a\nb"\n3,4,c\n', [(0, 2), (1, 4)]),  # a field over two lines
-    ("x,y\n1,2\n3,abc\n", None),  # the slow path names the line itself
-])
+@pytest.mark.parametrize(
+    "content, rows_lines",
+    [
+        ("x,y\n1,2\n3,4\n5,6\n", [(0, 2), (2, 4)]),  # fast path, one line per row
+        ("\nx,y\n\n1,2\n\n3,4\n5,6", [(0, 4), (1, 6), (2, 7)]),  # blank lines
+        ('x,y,n\n1,2,"a\nb"\n3,4,c\n', [(0, 2), (1, 4)]),  # a field over two lines
+        ("x,y\n1,2\n3,abc\n", None),  # the slow path names the line itself
+    ],
+)
 def test_each_site_knows_its_line(tmp_path, content, rows_lines):
     if rows_lines is None:
         assert "line 3" in error(tmp_path, "p.csv", content)

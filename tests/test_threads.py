@@ -16,8 +16,21 @@ from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import generate
 from tvoronoi.kernels import clip, dual
 
-FIELDS = ("sites", "site_of", "vertices", "he_origin", "he_twin", "he_next", "he_prev", "he_face",
-          "face_edge", "triangles", "cell_points", "cell_offsets", "cell_vertices")
+FIELDS = (
+    "sites",
+    "site_of",
+    "vertices",
+    "he_origin",
+    "he_twin",
+    "he_next",
+    "he_prev",
+    "he_face",
+    "face_edge",
+    "triangles",
+    "cell_points",
+    "cell_offsets",
+    "cell_vertices",
+)
 
 
 def assert_same(a, b):
@@ -39,7 +52,7 @@ LARGE = {
     "clustered": lambda: generate("clustered", 40_000, seed=4),
     # every square cocircular: the merged vertices and dropped zero-length edges
     "grid": lambda: grid(200),
-    "rounded": lambda: np.round(generate("uniform", 40_000, seed=5), 2),   # repeats and cocircular ties
+    "rounded": lambda: np.round(generate("uniform", 40_000, seed=5), 2),  # repeats and cocircular ties
 }
 
 
@@ -78,18 +91,29 @@ def test_kernels_split_on_every_family(name):
     e = engines.scale_exponent(pts)
     t = engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
     if t.flat:
-        return          # collinear sites: parallel strips, no triangles and nothing split
+        return  # collinear sites: parallel strips, no triangles and nothing split
     s = t.sites
-    outs = [dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1)
-            for threads in (1, 2, 3)]
+    outs = [dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1) for threads in (1, 2, 3)]
     for out in outs[1:]:
         for key in outs[0]:
             assert np.array_equal(outs[0][key], out[key]), key
     out = outs[0]
     active = (t.dup < 0).astype(np.int8)
     cells = [
-        clip.clip_cells(s.xs, s.ys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"],
-                        out["face_edge"], active, box, e, threads, parallel_min=1)
+        clip.clip_cells(
+            s.xs,
+            s.ys,
+            out["vertices"],
+            out["he_origin"],
+            out["he_twin"],
+            out["he_face"],
+            out["face_edge"],
+            active,
+            box,
+            e,
+            threads,
+            parallel_min=1,
+        )
         for threads in (1, 2, 3)
     ]
     for got in cells[1:]:
@@ -99,15 +123,41 @@ def test_kernels_split_on_every_family(name):
     # the new points written into the dual's room after the vertices: the same points and rings
     roomy = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, 2, parallel_min=1, clip_room=True)
     room = roomy["vertex_room"]
-    got = clip.clip_cells(s.xs, s.ys, roomy["vertices"], roomy["he_origin"], roomy["he_twin"], roomy["he_face"],
-                          roomy["face_edge"], active, box, e, 2, parallel_min=1, room=room)
+    got = clip.clip_cells(
+        s.xs,
+        s.ys,
+        roomy["vertices"],
+        roomy["he_origin"],
+        roomy["he_twin"],
+        roomy["he_face"],
+        roomy["face_edge"],
+        active,
+        box,
+        e,
+        2,
+        parallel_min=1,
+        room=room,
+    )
     assert np.shares_memory(got[0], room)
     for x, y in zip(got[:3], cells[0][:3]):
         assert np.array_equal(x, y)
     # room that does not start with the vertices, or is too small: a copy, the same result
-    for other in (room.copy(), room[:len(roomy["vertices"]) + 3]):
-        got = clip.clip_cells(s.xs, s.ys, roomy["vertices"], roomy["he_origin"], roomy["he_twin"],
-                              roomy["he_face"], roomy["face_edge"], active, box, e, 2, parallel_min=1, room=other)
+    for other in (room.copy(), room[: len(roomy["vertices"]) + 3]):
+        got = clip.clip_cells(
+            s.xs,
+            s.ys,
+            roomy["vertices"],
+            roomy["he_origin"],
+            roomy["he_twin"],
+            roomy["he_face"],
+            roomy["face_edge"],
+            active,
+            box,
+            e,
+            2,
+            parallel_min=1,
+            room=other,
+        )
         assert not np.shares_memory(got[0], other)
         for x, y in zip(got[:3], cells[0][:3]):
             assert np.array_equal(x, y)

@@ -53,9 +53,14 @@ def brute_delaunay(pts: np.ndarray) -> set:
                         continue
                     dx, dy = q[d]
                     m = [[ax - dx, ay - dy], [bx - dx, by - dy], [cx - dx, cy - dy]]
-                    det = sum(m[i][0] * (m[(i + 1) % 3][1] * (m[(i + 2) % 3][0] ** 2 + m[(i + 2) % 3][1] ** 2)
-                                          - m[(i + 2) % 3][1] * (m[(i + 1) % 3][0] ** 2 + m[(i + 1) % 3][1] ** 2))
-                              for i in range(3))
+                    det = sum(
+                        m[i][0]
+                        * (
+                            m[(i + 1) % 3][1] * (m[(i + 2) % 3][0] ** 2 + m[(i + 2) % 3][1] ** 2)
+                            - m[(i + 2) % 3][1] * (m[(i + 1) % 3][0] ** 2 + m[(i + 1) % 3][1] ** 2)
+                        )
+                        for i in range(3)
+                    )
                     s = det if turn > 0 else -det
                     if s > 0:
                         inside = True
@@ -106,7 +111,7 @@ def test_canonical_triangles_of_a_grid_fan_each_square_from_its_lowest_corner():
 
 @pytest.mark.parametrize("seed", range(6))
 def test_canonical_triangles_equal_brute_force_on_rounded_points(seed):
-    pts = np.round(np.random.default_rng(seed).random((40, 2)) * 4) / 2     # many cocircular quadruples
+    pts = np.round(np.random.default_rng(seed).random((40, 2)) * 4) / 2  # many cocircular quadruples
     assert as_set(canonical(pts)) == brute_delaunay(pts)
 
 
@@ -125,8 +130,9 @@ def test_without_cocircular_sites_the_canonical_triangles_are_the_engines_and_sc
 
 def test_boundary_hull_keeps_collinear_sites_and_the_lowest_of_repeats():
     # a square with points along its sides, repeats and inner points
-    pts = np.array([[0, 0], [2, 0], [2, 2], [0, 2], [1, 0], [2, 1], [1, 1], [0, 1], [1, 2], [0.5, 0.5],
-                    [1, 0], [0, 0]], float)
+    pts = np.array(
+        [[0, 0], [2, 0], [2, 2], [0, 2], [1, 0], [2, 1], [1, 1], [0, 1], [1, 2], [0.5, 0.5], [1, 0], [0, 0]], float
+    )
     assert boundary_hull(pts, np.arange(len(pts))).tolist() == [0, 4, 1, 5, 2, 8, 3, 7]
     # every hull vertex of scipy's hull is there, in counter-clockwise order, on larger random input
     pts = generate("gaussian", 20_000, seed=4)
@@ -148,8 +154,8 @@ def test_the_hull_of_collinear_sites_has_no_edge():
 
 
 def test_disk_inside_is_exact_at_tangency():
-    corners = [(-1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]            # the unit circle about the origin
-    assert disk_inside(corners, [], (-1.0, -1.0, 1.0, 1.0))       # tangent to every side: inside
+    corners = [(-1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]  # the unit circle about the origin
+    assert disk_inside(corners, [], (-1.0, -1.0, 1.0, 1.0))  # tangent to every side: inside
     assert not disk_inside(corners, [], (-1.0, -1.0, 1.0, 0.9999999999999999))
     # cut by the hull line through (-1, 0) and (1, 0) (the sites above it), the lower half no longer counts
     assert disk_inside(corners, [((-1.0, 0.0), (1.0, 0.0))], (-1.0, -0.5, 1.0, 1.0))
@@ -179,8 +185,9 @@ def test_hunt_emitted_triangles_are_final(seed, k):
     whole = as_set(canonical(pts))
     d = tvoronoi.voronoi(pts[seen], threads=1)
     extent = (*pts.min(axis=0).tolist(), *pts.max(axis=0).tolist())
-    got = tile_triangles(pts[seen], ids, np.ones(len(seen), bool), region, d,
-                         hull=Hull.of(pts, np.arange(len(pts))), extent=extent)
+    got = tile_triangles(
+        pts[seen], ids, np.ones(len(seen), bool), region, d, hull=Hull.of(pts, np.arange(len(pts))), extent=extent
+    )
     assert as_set(got.triangles) <= whole
     for i in got.done.tolist():
         assert {t for t in whole if min(t) == i} <= as_set(got.triangles)
@@ -202,8 +209,13 @@ def test_adversarial_families_tile_to_the_canonical_triangles(family):
 
 
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(1, 300), tiles=st.integers(1, 9), decimals=st.integers(0, 3),
-       halo=st.sampled_from([0.05, 0.3, 1.0]), seed=st.integers(0, 2**32 - 1))
+@given(
+    n=st.integers(1, 300),
+    tiles=st.integers(1, 9),
+    decimals=st.integers(0, 3),
+    halo=st.sampled_from([0.05, 0.3, 1.0]),
+    seed=st.integers(0, 2**32 - 1),
+)
 def test_hunt_rounded_points_tile_to_the_canonical_triangles(n, tiles, decimals, halo, seed):
     pts = np.round(np.random.default_rng(seed).random((n, 2)) * 10, decimals)
     got = tiled_triangles(pts, tiles=tiles, halo_scale=halo, seed=seed)

@@ -41,8 +41,10 @@ def test_kd_rects_partition_the_plane_into_balanced_tiles():
     rects = kd_rects(pts, 7)
     owner = tile_of(pts[:, 0], pts[:, 1], rects)
     # each point in exactly one tile
-    hits = sum(((pts[:, 0] >= x0) & (pts[:, 0] < x1) & (pts[:, 1] >= y0) & (pts[:, 1] < y1)).astype(int)
-               for x0, y0, x1, y1 in rects)
+    hits = sum(
+        ((pts[:, 0] >= x0) & (pts[:, 0] < x1) & (pts[:, 1] >= y0) & (pts[:, 1] < y1)).astype(int)
+        for x0, y0, x1, y1 in rects
+    )
     assert (hits == 1).all() and (owner >= 0).all()
     counts = np.bincount(owner, minlength=7)
     assert counts.min() >= 0.8 * len(pts) / 7 and counts.max() <= 1.2 * len(pts) / 7
@@ -109,8 +111,7 @@ def test_adversarial_families_tile_to_the_same_cells(family):
 def test_hunt_rounded_points_tile_to_the_same_cells(n, tiles, decimals, halo, seed):
     # rounded coordinates: repeats, collinear runs and cocircular quadruples at tile edges
     pts = np.round(np.random.default_rng(seed).random((n, 2)) * 10, decimals)
-    assert_same_cells(tiled_cells(pts, tiles=tiles, halo_scale=halo, seed=seed),
-                      tvoronoi.voronoi(pts, threads=1))
+    assert_same_cells(tiled_cells(pts, tiles=tiles, halo_scale=halo, seed=seed), tvoronoi.voronoi(pts, threads=1))
 
 
 def test_certification_refuses_a_cell_a_hidden_site_cuts():
@@ -118,14 +119,15 @@ def test_certification_refuses_a_cell_a_hidden_site_cuts():
     seen = np.array([[0.0, 0.0], [-1.0, 0.0], [1.0, 0.0]])
     hidden = np.array([[0.0, 0.9]])
     box = (-2.0, -2.0, 2.0, 2.0)
-    region = (-1.5, -1.5, 1.5, 0.5)                 # y <= 0.5: the hidden site is outside
+    region = (-1.5, -1.5, 1.5, 0.5)  # y <= 0.5: the hidden site is outside
     assert not in_region(hidden[:, 0], hidden[:, 1], region).any()
     cells = build_tile(seen, np.arange(3), np.array([True, False, False]), region, box)
     assert cells.ids.size == 0 and cells.pending.tolist() == [0]
     # once the region holds it, the cell is certified and is the cell of all four sites
     everything = np.concatenate([seen, hidden])
-    cells = build_tile(everything, np.arange(4), np.array([True, False, False, False]),
-                       grown(extent_of(everything), 10.0), box)
+    cells = build_tile(
+        everything, np.arange(4), np.array([True, False, False, False]), grown(extent_of(everything), 10.0), box
+    )
     assert cells.ids.tolist() == [0]
     assert np.array_equal(cells.ring_xy, tvoronoi.voronoi(everything, bbox=box).cell_polygon(0))
 
@@ -180,6 +182,8 @@ def test_group_reaches_keeps_far_cells_apart_and_joins_overlapping_ones():
     reaches = np.array([[0.0, 0.0, 1.0, 1.0], [0.9, 0.9, 2.0, 2.0], [10.0, 10.0, 11.0, 11.0]])
     groups = group_reaches(pending, reaches, 0.05)
     assert sorted((g.tolist(), box) for g, box in groups) == [
-        ([3, 7], (0.0, 0.0, 2.0, 2.0)), ([9], (10.0, 10.0, 11.0, 11.0))]
+        ([3, 7], (0.0, 0.0, 2.0, 2.0)),
+        ([9], (10.0, 10.0, 11.0, 11.0)),
+    ]
     # a margin that bridges the gap joins all three
     assert [g.tolist() for g, _ in group_reaches(pending, reaches, 5.0)] == [[3, 7, 9]]

@@ -47,7 +47,7 @@ def test_fortune_pending_circles_are_ahead_and_fit_their_arcs(fortune_run):
     for s in steps:
         for (cx, cy, r), arc in zip(s.circles, s.circle_arcs):
             assert cy + r >= s.sweep_y - 1e-9
-            for site in s.beach[arc - 1:arc + 2]:
+            for site in s.beach[arc - 1 : arc + 2]:
                 assert abs(np.hypot(*(pts[site] - (cx, cy))) - r) <= 1e-9
 
 
@@ -108,8 +108,7 @@ def test_incremental_conflict_region(incremental_run):
             assert tuple(sorted(t)) in tris, f"step {s.index}: conflict triangle not in the mesh"
             a, b, c = pts[t]
             # the new site lies strictly inside the circumcircle of every triangle it destroys
-            m = np.array([[*(a - p), (a - p) @ (a - p)], [*(b - p), (b - p) @ (b - p)],
-                          [*(c - p), (c - p) @ (c - p)]])
+            m = np.array([[*(a - p), (a - p) @ (a - p)], [*(b - p), (b - p) @ (b - p)], [*(c - p), (c - p) @ (c - p)]])
             assert np.linalg.det(m) > 0
         after = {tuple(sorted(t)) for t in s.diagram.delaunay_triangles().tolist()}
         assert not {tuple(sorted(t)) for t in s.conflict} & after
@@ -186,7 +185,7 @@ def test_visibility_walk_matches_a_brute_force_containment():
     tri = d.delaunay_triangles()
     res = incremental.triangulate(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]))
     tv, opp = res[1], res[2]
-    finite = [t for t in range(len(tv) // 3) if (tv[3 * t:3 * t + 3] < len(pts)).all()]
+    finite = [t for t in range(len(tv) // 3) if (tv[3 * t : 3 * t + 3] < len(pts)).all()]
     assert len(finite) == len(tri)
     rng = np.random.default_rng(5)
     for q in rng.uniform(0.2, 0.8, size=(20, 2)):
@@ -253,8 +252,9 @@ def test_the_seed_orders_the_insertions_and_leaves_the_sweep_alone():
     first = [tvoronoi.steps(pts, engine="incremental", seed=s).step(1).site for s in range(6)]
     assert len(set(first)) > 1, "the insertion order does not depend on the seed"
     # the sweep takes the sites by y whatever the seed
-    sweep = {tuple(int(tvoronoi.steps(pts, engine="fortune", seed=s).step(k).site) for k in range(1, 10))
-             for s in range(3)}
+    sweep = {
+        tuple(int(tvoronoi.steps(pts, engine="fortune", seed=s).step(k).site) for k in range(1, 10)) for s in range(3)
+    }
     assert len(sweep) == 1
 
 
@@ -277,5 +277,6 @@ def test_the_engine_named_entries_are_steps(name, engine):
     trace = getattr(tvoronoi, name)(pts, bbox=(-1, -1, 2, 2))
     assert trace.engine == engine and trace.bbox == (-1.0, -1.0, 2.0, 2.0)
     same = tvoronoi.steps(pts, engine=engine, bbox=(-1, -1, 2, 2))
-    assert [trace.step(k).describe() for k in range(len(trace) + 1)] == \
-        [same.step(k).describe() for k in range(len(same) + 1)]
+    assert [trace.step(k).describe() for k in range(len(trace) + 1)] == [
+        same.step(k).describe() for k in range(len(same) + 1)
+    ]

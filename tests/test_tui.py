@@ -14,8 +14,8 @@ import tvoronoi
 from tvoronoi.errors import EngineError
 from tvoronoi.generators import generate
 from tvoronoi.tui.app import VoronoiApp
-from tvoronoi.tui.viewport import View
 from tvoronoi.tui.screens import HelpScreen, PathDialog
+from tvoronoi.tui.viewport import View
 
 SIZE = (100, 40)
 CITIES = Path(__file__).resolve().parent.parent / "data" / "cities.csv"
@@ -56,7 +56,7 @@ def status_text(app) -> str:
 
 def view_text(app) -> str:
     """Where the status line says the view is."""
-    return str(app.query_one("#status").render()).rstrip()[len(status_text(app)):].strip()
+    return str(app.query_one("#status").render()).rstrip()[len(status_text(app)) :].strip()
 
 
 @pilot_test
@@ -649,8 +649,7 @@ def test_sixteen_colours_draw_no_fills():
     from tvoronoi.tui.canvas import plain_terminal
 
     def app(no_color=False, system="truecolor", headless=False):
-        return SimpleNamespace(no_color=no_color, is_headless=headless,
-                               console=SimpleNamespace(color_system=system))
+        return SimpleNamespace(no_color=no_color, is_headless=headless, console=SimpleNamespace(color_system=system))
 
     assert plain_terminal(app(system="standard"))
     assert plain_terminal(app(system="windows"))
@@ -688,7 +687,7 @@ async def test_the_status_line_shows_where_the_view_is_and_its_zoom():
         # zoomed far in, the coordinates get the digits a character needs
         for _ in range(12):
             await pilot.press("plus")
-        assert shown().endswith(f"×{1.25 ** 13:.3g}")
+        assert shown().endswith(f"×{1.25**13:.3g}")
         assert len(shown().split(",")[0]) > len("(0.500")
         await pilot.press("0")
         assert shown() == f"({view.cx:.3f}, {view.cy:.3f}) ×1"
@@ -718,11 +717,14 @@ async def test_an_unreadable_file_at_start_is_an_error_and_the_default_points_sh
         assert app.built.diagram.n_sites == 300
 
 
-@pytest.mark.parametrize("name, text, columns", [
-    ("words.csv", "name,kind\nLisbon,city\n", {}),
-    ("bad.csv", "x,y\n0,0\nabc,1\n", {}),
-    ("points.geojson", '{"type": "FeatureCollection", "features": []}', {"x": "a", "y": "b"}),
-])
+@pytest.mark.parametrize(
+    "name, text, columns",
+    [
+        ("words.csv", "name,kind\nLisbon,city\n", {}),
+        ("bad.csv", "x,y\n0,0\nabc,1\n", {}),
+        ("points.geojson", '{"type": "FeatureCollection", "features": []}', {"x": "a", "y": "b"}),
+    ],
+)
 def test_reader_advice_names_the_open_dialogs_fields(tmp_path, name, text, columns):
     from tvoronoi.errors import TvoronoiError
     from tvoronoi.readers import read_points
@@ -776,8 +778,19 @@ async def test_toggling_a_layer_keeps_the_cells_under_the_characters(monkeypatch
             frame = canvas._frame
             assert bool(calls) == finds, key
             width, height = canvas.content_size.width, canvas.content_size.height
-            fresh = raster.rasterize(canvas.scene, canvas.view, width, height, delaunay=canvas.show_delaunay,
-                                     vertices=canvas.show_vertices, site_blocks=not canvas.palette().filled)
-            for a, b in ((frame.codes, fresh.codes), (frame.mark, fresh.mark), (frame.fill, fresh.fill),
-                         (frame.owner, fresh.owner)):
+            fresh = raster.rasterize(
+                canvas.scene,
+                canvas.view,
+                width,
+                height,
+                delaunay=canvas.show_delaunay,
+                vertices=canvas.show_vertices,
+                site_blocks=not canvas.palette().filled,
+            )
+            for a, b in (
+                (frame.codes, fresh.codes),
+                (frame.mark, fresh.mark),
+                (frame.fill, fresh.fill),
+                (frame.owner, fresh.owner),
+            ):
                 assert np.array_equal(a, b), key

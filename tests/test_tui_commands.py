@@ -19,7 +19,7 @@ async def test_every_command_names_an_action_that_exists():
             assert callable(getattr(owner, f"action_{action}", None)), target
         titles = [command.title for command in app_commands(app)]
         assert {"Generate", "Relax", "Delaunay", "Playback", "Fit", "Engine"} <= set(titles)
-        assert "Follow" not in titles          # only during playback
+        assert "Follow" not in titles  # only during playback
 
 
 @pilot_test

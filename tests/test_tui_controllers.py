@@ -78,8 +78,9 @@ class FakeHost:
         self.player = None
         self.canvas = FakeCanvas(built.diagram.bbox)
         self.focused = self.canvas
-        self.timeline = SimpleNamespace(n_steps=0, engine="", speed=0, playing=False, following=False,
-                                        display=False, index=0)
+        self.timeline = SimpleNamespace(
+            n_steps=0, engine="", speed=0, playing=False, following=False, display=False, index=0
+        )
         self.now = 0.0
         self.clock = lambda: self.now
         self.status = ""
@@ -109,8 +110,17 @@ class FakeHost:
         self.posted.append(message)
         return True
 
-    def run_worker(self, work, name="", group="default", description="", exit_on_error=True, start=True,
-                   exclusive=False, thread=False):
+    def run_worker(
+        self,
+        work,
+        name="",
+        group="default",
+        description="",
+        exit_on_error=True,
+        start=True,
+        exclusive=False,
+        thread=False,
+    ):
         self.workers += 1
         work()
 
@@ -288,8 +298,9 @@ def test_playback_allows_its_keys_only_while_it_runs(small):
 
 
 def test_many_sites_ask_for_a_sample_first():
-    host = FakeHost(build(generate("uniform", playback.TEACHING_MAX_SITES + 1, seed=1), "incremental", "test",
-                          lambda: 0.0))
+    host = FakeHost(
+        build(generate("uniform", playback.TEACHING_MAX_SITES + 1, seed=1), "incremental", "test", lambda: 0.0)
+    )
     control = Playback(host)
     control.toggle()
     assert control.player is None and len(host.screens) == 1

@@ -13,8 +13,8 @@ import tvoronoi
 from test_tui import SIZE, error_toasts, make_app, pilot_test, status_text
 from tvoronoi.generators import generate
 from tvoronoi.tui.building import build
-from tvoronoi.tui.editing import make_live
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+from tvoronoi.tui.editing import make_live
 from tvoronoi.tui.raster import rasterize, redraw_part
 from tvoronoi.tui.scene import cell_owner
 from tvoronoi.tui.viewport import View
@@ -323,8 +323,15 @@ def assert_frame_is_fresh(canvas):
     """The frame the canvas shows, updated part by part, equals one drawn afresh."""
     width, height = canvas.content_size
     canvas._draw(canvas.content_size)
-    fresh = rasterize(canvas.scene, canvas.view, width, height, delaunay=canvas.show_delaunay,
-                      vertices=canvas.show_vertices, cursor=canvas.cursor)
+    fresh = rasterize(
+        canvas.scene,
+        canvas.view,
+        width,
+        height,
+        delaunay=canvas.show_delaunay,
+        vertices=canvas.show_vertices,
+        cursor=canvas.cursor,
+    )
     shown = canvas._frame
     for name in ("codes", "mark", "fill", "owner"):
         assert np.array_equal(getattr(shown, name), getattr(fresh, name)), name
@@ -411,7 +418,7 @@ def test_neighbours_keep_their_colours(live_case):
     before = live.colours.copy()
     i = live.insert(0.5, 0.5)
     changed = set(np.asarray(live.dynamic.changed).tolist()) | {i}
-    differ = set(np.flatnonzero(live.colours[:len(before)] != before).tolist())
+    differ = set(np.flatnonzero(live.colours[: len(before)] != before).tolist())
     assert differ <= changed
     assert live.colours[i] >= 0
     assert no_colour_clash(live)
@@ -455,6 +462,5 @@ def test_snapshot_editing_with_the_keyboard_cursor(snap_compare):
     cell colours, the site under it still yellow) and the second one moved one character
     left with m: their cells cut into their neighbours', which keep their colours; the
     status line counts the edits."""
-    keys = ["plus", "plus", "c", "shift+right", "shift+right", "a", "shift+up", "shift+up", "a",
-            "m", "left", "enter"]
+    keys = ["plus", "plus", "c", "shift+right", "shift+right", "a", "shift+up", "shift+up", "a", "m", "left", "enter"]
     assert snap_compare(make_app(), press=keys, terminal_size=SIZE)

@@ -19,8 +19,8 @@ from tvoronoi.tui.commands import app_commands
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.export import PX_PER_DOT, picture, png_bytes, rasterise, to_svg, view_window
 from tvoronoi.tui.scene import Scene
-from tvoronoi.tui.viewport import View
 from tvoronoi.tui.screens import PathDialog
+from tvoronoi.tui.viewport import View
 
 SVG = "{http://www.w3.org/2000/svg}"
 COLS, ROWS = 90, 30
@@ -38,8 +38,11 @@ def zoomed():
 def cells_in_window(diagram, window):
     """Ids of the cells that meet the window, by shapely."""
     box = shapely.box(*window)
-    return [i for i in range(diagram.n_sites)
-            if len(diagram.cell_polygon(i)) and shapely.Polygon(diagram.cell_polygon(i)).intersects(box)]
+    return [
+        i
+        for i in range(diagram.n_sites)
+        if len(diagram.cell_polygon(i)) and shapely.Polygon(diagram.cell_polygon(i)).intersects(box)
+    ]
 
 
 def parse_svg(text: str):
@@ -54,7 +57,10 @@ def test_the_svg_holds_the_visible_cells_in_their_colours(zoomed):
     diagram, scene, view = zoomed
     pic = picture(scene, view, COLS, ROWS, DARK, dark=True, delaunay=False, diagram=diagram)
     root, polygons, circles, lines = parse_svg(to_svg(pic))
-    assert int(root.get("width")) == COLS * DOT_COLS * PX_PER_DOT and int(root.get("height")) == ROWS * DOT_ROWS * PX_PER_DOT
+    assert (
+        int(root.get("width")) == COLS * DOT_COLS * PX_PER_DOT
+        and int(root.get("height")) == ROWS * DOT_ROWS * PX_PER_DOT
+    )
     window = view_window(view, COLS, ROWS)
     expected = cells_in_window(diagram, window)
     assert 20 < len(expected) < diagram.n_sites  # zoomed: some cells, not all
@@ -93,9 +99,9 @@ def decode_png(data: bytes) -> np.ndarray:
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
     at, chunks = 8, []
     while at < len(data):
-        (length,) = struct.unpack(">I", data[at:at + 4])
-        kind, body = data[at + 4:at + 8], data[at + 8:at + 8 + length]
-        (crc,) = struct.unpack(">I", data[at + 8 + length:at + 12 + length])
+        (length,) = struct.unpack(">I", data[at : at + 4])
+        kind, body = data[at + 4 : at + 8], data[at + 8 : at + 8 + length]
+        (crc,) = struct.unpack(">I", data[at + 8 + length : at + 12 + length])
         assert crc == zlib.crc32(kind + body) & 0xFFFFFFFF
         chunks.append((kind, body))
         at += 12 + length
@@ -121,10 +127,10 @@ def test_the_png_is_the_canvas_size_and_shows_each_cell_in_its_colour(zoomed):
     _, ys = view.to_world(0 * v, v, COLS, ROWS)
     gx, gy = np.meshgrid(xs, ys)
     _, owner = cKDTree(diagram.sites).query(np.column_stack([gx.ravel(), gy.ravel()]))
-    fills = np.array([[int(c[k:k + 2], 16) for k in (1, 3, 5)] for c in DARK.fills], np.uint8)
+    fills = np.array([[int(c[k : k + 2], 16) for k in (1, 3, 5)] for c in DARK.fills], np.uint8)
     expected = fills[scene.colours[owner]].reshape(h, w, 3)
     same = (image == expected).all(axis=2)
-    marks = np.array([[int(c[k:k + 2], 16) for k in (1, 3, 5)] for c in (DARK.edge, DARK.site)], np.uint8)
+    marks = np.array([[int(c[k : k + 2], 16) for k in (1, 3, 5)] for c in (DARK.edge, DARK.site)], np.uint8)
     marked = (image[:, :, None, :] == marks[None, None]).all(axis=3).any(axis=2)
     assert (same | marked).all()
     assert same.mean() > 0.8

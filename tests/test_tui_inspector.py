@@ -133,4 +133,3 @@ def test_snapshot_inspector_line_at_80x24(snap_compare):
         await pilot.pause()
 
     assert snap_compare(make_app(), run_before=rome, terminal_size=(80, 24))
-

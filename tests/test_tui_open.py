@@ -148,7 +148,6 @@ async def test_the_same_column_twice_is_refused_in_the_dialog(tmp_path):
         assert "must differ" in str(dialog.query_one("#dialog-hint").render())
 
 
-
 DATA = Path(__file__).resolve().parent.parent / "data"
 
 

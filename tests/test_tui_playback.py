@@ -13,8 +13,7 @@ from test_tui import SIZE, error_toasts, footer_keys, make_app, pilot_test, stat
 from tvoronoi.generators import generate
 from tvoronoi.tui import playback
 from tvoronoi.tui.colours import DARK, adjacency_lists, cell_adjacency, repair_colours
-from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
-from tvoronoi.tui.screens import SampleDialog
+from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.layers import (
     BEACH,
     CIRCLE,
@@ -27,11 +26,12 @@ from tvoronoi.tui.layers import (
     TINTED,
     WALK,
 )
+from tvoronoi.tui.overlay import beach_heights, circle_segments, fortune_picture, incremental_picture
 from tvoronoi.tui.raster import rasterize
 from tvoronoi.tui.scene import Scene
+from tvoronoi.tui.screens import SampleDialog
 from tvoronoi.tui.styles import frame_lines
 from tvoronoi.tui.viewport import View
-from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 
 
 def warning_toasts(app) -> list[str]:
@@ -395,8 +395,9 @@ def fortune_case():
 def test_fortune_picture_draws_the_sweep_state(fortune_case):
     points, diagram, full = fortune_case
     trace = tvoronoi.fortune_steps(points)
-    k = next(k for k in range(len(trace) // 2, len(trace)) if trace.step(k).kind == "circle"
-             and len(trace.step(k).circles))
+    k = next(
+        k for k in range(len(trace) // 2, len(trace)) if trace.step(k).kind == "circle" and len(trace.step(k).circles)
+    )
     step = trace.step(k)
     scene, overlay = fortune_picture(step, points, full.colours, diagram.bbox)
     # the sites reached and the others
@@ -454,8 +455,7 @@ def test_incremental_picture_draws_the_location_walk(fortune_case):
     """The triangles the walk visited are outlined in the walk's colour, along their sides."""
     points, diagram, full = fortune_case
     trace = tvoronoi.incremental_steps(points, bbox=diagram.bbox)
-    k = next(k for k in range(60, len(trace)) if len(trace.step(k).walk) >= 4
-             and (trace.step(k).walk >= 0).all())
+    k = next(k for k in range(60, len(trace)) if len(trace.step(k).walk) >= 4 and (trace.step(k).walk >= 0).all())
     step = trace.step(k)
     scene, overlay = incremental_picture(step, points, full.colours)
     # every side of a visited triangle, each once
@@ -466,8 +466,7 @@ def test_incremental_picture_draws_the_location_walk(fortune_case):
     walked = np.argwhere(frame.mark == WALK)
     assert len(walked) >= 10
     # each character marked lies on a side of the walk (within a character of one)
-    centres = np.column_stack(view.to_world((walked[:, 1] + 0.5) * DOT_COLS, (walked[:, 0] + 0.5) * DOT_ROWS,
-                                            100, 40))
+    centres = np.column_stack(view.to_world((walked[:, 1] + 0.5) * DOT_COLS, (walked[:, 0] + 0.5) * DOT_ROWS, 100, 40))
     a, b = overlay.walk[:, :2], overlay.walk[:, 2:]
     ab = b - a
     t = np.clip(np.einsum("pkd,kd->pk", centres[:, None] - a[None], ab) / np.einsum("kd,kd->k", ab, ab), 0, 1)
@@ -692,8 +691,7 @@ async def test_the_legend_follows_playback_of_each_engine():
         assert "L" not in footer_keys(app)  # the playback keys need the room; L still works
         await pilot.press("t")
         await start_playback(app, pilot, "fortune")
-        for words in ("sweep line", "beach line", "circle events", "growing edges", "finished edges",
-                      "sites to come"):
+        for words in ("sweep line", "beach line", "circle events", "growing edges", "finished edges", "sites to come"):
             assert words in legend_shown(app)
         await pilot.press("L")
         assert legend_shown(app) == ""
@@ -824,10 +822,10 @@ def test_a_huge_circle_is_the_arc_that_enters_the_view():
 
 def test_circles_outside_the_view_or_around_it_draw_nothing():
     window = (0.0, 0.0, 1.0, 1.0)
-    around = [0.5, 0.5, 5.0]      # holds the whole view
-    beside = [3.0, 0.5, 1.0]      # wholly to the right
+    around = [0.5, 0.5, 5.0]  # holds the whole view
+    beside = [3.0, 0.5, 1.0]  # wholly to the right
     assert len(circle_segments([around, beside], scale=0.005, window=window)) == 0
-    inside = [0.5, 0.5, 0.2]      # drawn whole, as without a window
+    inside = [0.5, 0.5, 0.2]  # drawn whole, as without a window
     assert np.array_equal(circle_segments([inside], 0.005, window), circle_segments([inside], 0.005))
 
 

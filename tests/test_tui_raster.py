@@ -19,8 +19,16 @@ from tvoronoi.tui.viewport import View
 
 def test_dot_bits_follow_the_braille_standard():
     """Each dot of a character lights the bit Unicode gives it."""
-    expected = {(0, 0): 0x01, (0, 1): 0x02, (0, 2): 0x04, (1, 0): 0x08,
-                (1, 1): 0x10, (1, 2): 0x20, (0, 3): 0x40, (1, 3): 0x80}
+    expected = {
+        (0, 0): 0x01,
+        (0, 1): 0x02,
+        (0, 2): 0x04,
+        (1, 0): 0x08,
+        (1, 1): 0x10,
+        (1, 2): 0x20,
+        (0, 3): 0x40,
+        (1, 3): 0x80,
+    }
     for (col, row), bit in expected.items():
         dots = np.zeros((4, 2), bool)
         dots[row, col] = True
@@ -224,8 +232,11 @@ def test_adjacency_lists_each_pair_of_neighbours_once(name):
     diagram = tvoronoi.voronoi(DATASETS[name])
     a, b = cell_adjacency(diagram)
     faces, twins = diagram.he_face.tolist(), diagram.he_twin.tolist()
-    expected = {(min(f, faces[t]), max(f, faces[t])) for f, t in zip(faces, twins)
-                if t >= 0 and f >= 0 and faces[t] >= 0 and f != faces[t]}
+    expected = {
+        (min(f, faces[t]), max(f, faces[t]))
+        for f, t in zip(faces, twins)
+        if t >= 0 and f >= 0 and faces[t] >= 0 and f != faces[t]
+    }
     pairs = list(zip(a.tolist(), b.tolist()))
     assert (a < b).all()
     assert len(pairs) == len(set(pairs))
@@ -263,7 +274,7 @@ def test_segment_dots_match_the_segments(segments):
     centres = np.column_stack([cols + 0.5, rows + 0.5])
     a, b = seg[:, :2], seg[:, 2:]
     ab = b - a
-    length2 = np.maximum((ab ** 2).sum(1), 1e-12)
+    length2 = np.maximum((ab**2).sum(1), 1e-12)
     t = np.clip(((centres[:, None, :] - a) * ab).sum(2) / length2, 0, 1)
     nearest = a + t[..., None] * ab
     distance = np.sqrt(((centres[:, None, :] - nearest) ** 2).sum(2)).min(1)
@@ -278,10 +289,10 @@ def test_segment_dots_match_the_segments(segments):
         segment_dots(alone, [x0], [y0], [x1], [y1])
         if abs(x1 - x0) >= abs(y1 - y0):
             lo, hi = sorted((int(x0), int(x1)))
-            assert alone[:, lo:hi + 1].any(axis=0).all()
+            assert alone[:, lo : hi + 1].any(axis=0).all()
         else:
             lo, hi = sorted((int(y0), int(y1)))
-            assert alone[lo:hi + 1, :].any(axis=1).all()
+            assert alone[lo : hi + 1, :].any(axis=1).all()
 
 
 @settings(max_examples=25, deadline=None)
@@ -348,8 +359,8 @@ def test_the_layer_cache_draws_the_same_frames_and_skips_layers_drawn_before(mon
     cache = LayerCache()
     steps = [
         (scene, view, 60, 24, False),
-        (scene, view, 60, 24, True),      # Delaunay on: only its layer is new
-        (scene, view, 60, 24, False),     # off: nothing to draw
+        (scene, view, 60, 24, True),  # Delaunay on: only its layer is new
+        (scene, view, 60, 24, False),  # off: nothing to draw
         (scene, view.panned(3, 0), 60, 24, False),
         (other, view, 60, 24, False),
         (other, view, 50, 24, False),
@@ -390,15 +401,15 @@ def test_the_layer_cache_keeps_recent_views_and_lets_other_scenes_go(monkeypatch
         assert np.array_equal(cached.codes, fresh.codes) and np.array_equal(cached.mark, fresh.mark)
         return count
 
-    assert drawn(scene, fit, True) == 2            # edges and Delaunay edges
-    assert drawn(scene, fit.zoomed(2)) == 1         # a new view: its edges
-    assert drawn(scene, fit) == 0                   # fit again: kept
-    assert drawn(scene, fit.zoomed(2), True) == 1   # the Delaunay edges of that view are new
+    assert drawn(scene, fit, True) == 2  # edges and Delaunay edges
+    assert drawn(scene, fit.zoomed(2)) == 1  # a new view: its edges
+    assert drawn(scene, fit) == 0  # fit again: kept
+    assert drawn(scene, fit.zoomed(2), True) == 1  # the Delaunay edges of that view are new
     for k in range(LAYER_FRAMES_KEPT):
         drawn(scene, fit.zoomed(3 + k))
-    assert drawn(scene, fit) == 1                   # too many frames ago: drawn again
+    assert drawn(scene, fit) == 1  # too many frames ago: drawn again
     drawn(other, fit)
-    assert drawn(scene, fit) == 1                   # the other scene's frame let this one go
+    assert drawn(scene, fit) == 1  # the other scene's frame let this one go
 
 
 @settings(max_examples=40, deadline=None)
@@ -418,7 +429,7 @@ def test_a_window_of_the_dot_plane_gets_the_dots_of_the_whole(seed, ou, ov, dash
         assert (whole == reference_dots(whole.shape, *p.T, *q.T)).all()
     part = np.zeros((12, 16), bool)
     segment_dots(part, p[:, 0], p[:, 1], q[:, 0], q[:, 1], dash=dash, origin=(ou, ov))
-    rows, cols = np.mgrid[ov:ov + 12, ou:ou + 16]
+    rows, cols = np.mgrid[ov : ov + 12, ou : ou + 16]
     on_whole = (rows >= 0) & (rows < 48) & (cols >= 0) & (cols < 40)
     assert (part[on_whole] == whole[rows[on_whole], cols[on_whole]]).all()
 
@@ -519,7 +530,11 @@ def test_the_scene_finds_its_delaunay_edges_when_first_shown():
     edges = scene.delaunay
     assert scene.delaunay is edges and scene.triangles is None
     tri = Delaunay(points).simplices
-    expected = {frozenset(map(tuple, points[[a, b]].tolist())) for t in tri for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    expected = {
+        frozenset(map(tuple, points[[a, b]].tolist()))
+        for t in tri
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))
+    }
     got = [frozenset(map(tuple, (e[:2].tolist(), e[2:].tolist()))) for e in edges]
     assert len(got) == len(set(got)) and set(got) == expected
 
@@ -534,13 +549,24 @@ def test_a_scene_drawn_from_its_edge_mesh_equals_one_drawn_from_its_segments(nam
     points = generate("uniform", 2000, seed=12) if name == "uniform-2000" else DATASETS[name]
     scene = Scene.from_diagram(tvoronoi.voronoi(points))
     assert scene.edge_mesh is not None
-    plain = Scene(sites=scene.sites, edges=scene.edge_mesh.segments(), vertices=scene.vertices,
-                  colours=scene.colours, bbox=scene.bbox)
+    plain = Scene(
+        sites=scene.sites,
+        edges=scene.edge_mesh.segments(),
+        vertices=scene.vertices,
+        colours=scene.colours,
+        bbox=scene.bbox,
+    )
     cols, rows = 50, 20
     fit = View.fit(scene.bbox, cols, rows)
     x0, y0, x1, y1 = scene.bbox
-    views = [fit, fit.zoomed(0.3), fit.zoomed(7.0), fit.zoomed(60.0, (x0, y1)),
-             fit.zoomed(4.0).panned(3.5, -17.25), fit.zoomed(2.0, (x1, y0)).panned(2, 4)]
+    views = [
+        fit,
+        fit.zoomed(0.3),
+        fit.zoomed(7.0),
+        fit.zoomed(60.0, (x0, y1)),
+        fit.zoomed(4.0).panned(3.5, -17.25),
+        fit.zoomed(2.0, (x1, y0)).panned(2, 4),
+    ]
     for view in views:
         got = rasterize(scene, view, cols, rows, vertices=False)
         want = rasterize(plain, view, cols, rows, vertices=False)

@@ -1,9 +1,9 @@
 """The Relax key: one Lloyd step on the sites shown, as tvoronoi.lloyd computes it."""
 
 import numpy as np
+from textual.widgets._toast import Toast
 
 from test_tui import SIZE, make_app, pilot_test, status_text
-from textual.widgets._toast import Toast
 from tvoronoi.relax import lloyd
 
 
@@ -50,7 +50,7 @@ async def test_relax_after_an_edit_relaxes_the_edited_sites():
     app = make_app()
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
-        await pilot.press("c")          # the keyboard cursor, then a site added under it
+        await pilot.press("c")  # the keyboard cursor, then a site added under it
         await pilot.press("a")
         await pilot.pause()
         live = app.live

@@ -2,8 +2,17 @@
 
 __version__ = "0.1.0"
 
-__all__ = ["voronoi", "lloyd", "Diagram", "DynamicVoronoi", "TvoronoiError", "generate", "steps",
-           "fortune_steps", "incremental_steps"]
+__all__ = [
+    "voronoi",
+    "lloyd",
+    "Diagram",
+    "DynamicVoronoi",
+    "TvoronoiError",
+    "generate",
+    "steps",
+    "fortune_steps",
+    "incremental_steps",
+]
 
 from tvoronoi.errors import TvoronoiError
 

@@ -45,8 +45,10 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
         row, col = (int(v) for v in np.argwhere(bad)[0])
         top_row, top_col = (int(v) for v in np.unravel_index(int(np.argmax(mag)), mag.shape))
         raise CoordinateRangeError(
-            rows=(row, top_row), values=(float(pts[row, col]), float(pts[top_row, top_col])),
-            small=bool(mag[row, col] < low), locate=lambda i: f"{what} {i}",
+            rows=(row, top_row),
+            values=(float(pts[row, col]), float(pts[top_row, top_col])),
+            small=bool(mag[row, col] < low),
+            locate=lambda i: f"{what} {i}",
         )
 
 
@@ -114,9 +116,13 @@ def default_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
     return (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
 
 
-def as_bbox(bbox, *, what: str | None = None,
-            names: tuple[str, str, str, str] = ("xmin", "ymin", "xmax", "ymax"),
-            sep: str = ", ") -> tuple[float, float, float, float]:
+def as_bbox(
+    bbox,
+    *,
+    what: str | None = None,
+    names: tuple[str, str, str, str] = ("xmin", "ymin", "xmax", "ymax"),
+    sep: str = ", ",
+) -> tuple[float, float, float, float]:
     """Check a box: four finite numbers (xmin, ymin, xmax, ymax) with xmin < xmax and ymin < ymax.
 
     The one box check of the package: ``voronoi``, dynamic diagrams, traces and the CLI's
@@ -157,9 +163,7 @@ def as_bbox(bbox, *, what: str | None = None,
         values.append(value)
     xmin, ymin, xmax, ymax = values
     if not (xmin < xmax and ymin < ymax):
-        raise TvoronoiError(
-            f"{what}: the box is empty; it needs {names[0]} < {names[2]} and {names[1]} < {names[3]}"
-        )
+        raise TvoronoiError(f"{what}: the box is empty; it needs {names[0]} < {names[2]} and {names[1]} < {names[3]}")
     return xmin, ymin, xmax, ymax
 
 
@@ -177,8 +181,16 @@ def check_engine(engine: str, insertion: str = "brio") -> None:
         raise EngineError(f"unknown insertion order {insertion!r}: choose one of {', '.join(INSERTION_ORDERS)}")
 
 
-def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = "brio",
-            seed: int = 0, clip=None, threads: int | None = None) -> Diagram:
+def voronoi(
+    points,
+    *,
+    engine: str = "incremental",
+    bbox=None,
+    insertion: str = "brio",
+    seed: int = 0,
+    clip=None,
+    threads: int | None = None,
+) -> Diagram:
     """The Voronoi diagram of a set of points, with its cells clipped to a box or to a region.
 
     Parameters
@@ -228,7 +240,7 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
     """
     from tvoronoi.build import build_arrays, build_diagram
 
-    with build_arrays():                             # its checks' temporaries too
+    with build_arrays():  # its checks' temporaries too
         pts = as_points(points)
         check_engine(engine, insertion)
         threads = as_threads(threads)
@@ -238,9 +250,11 @@ def voronoi(points, *, engine: str = "incremental", bbox=None, insertion: str = 
             region = as_region(clip)
             box = region_box(region) if bbox is None else as_bbox(bbox)
             return clip_to_region(
-                pts, region,
-                lambda inside: build_diagram(inside, box, engine=engine, insertion=insertion, seed=seed,
-                                             threads=threads),
+                pts,
+                region,
+                lambda inside: build_diagram(
+                    inside, box, engine=engine, insertion=insertion, seed=seed, threads=threads
+                ),
             )
         box = default_bbox(pts) if bbox is None else as_bbox(bbox)
         return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
@@ -251,7 +265,7 @@ def as_threads(threads) -> int:
     if threads is None:
         try:
             return max(1, len(os.sched_getaffinity(0)))
-        except AttributeError:                       # no affinity on this platform
+        except AttributeError:  # no affinity on this platform
             return max(1, os.cpu_count() or 1)
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
         raise TvoronoiError(f"threads must be a positive integer, got {threads!r}")

@@ -21,15 +21,17 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     with build_arrays():
-        t = engines.run(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads,
-                        exponent=e)
+        t = engines.run(
+            pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
+        )
         s, out = t.sites, t.voronoi(threads, clip_room=True)
-        del t                                        # the triangulation is not needed to clip
+        del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 
 
-def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True,
-             threads: int = 1) -> Diagram:
+def assemble(
+    pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True, threads: int = 1
+) -> Diagram:
     """Clip an engine's DCEL and map it back to input rows.
 
     Parameters
@@ -51,22 +53,32 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     first = dup < 0 if present is None else (dup < 0) & present
     # the cell of a repeated point belongs to the first input row at that place
     root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
-    owner = perm.astype(np.int32)                    # engine site -> input row owning its cell (a copy)
+    owner = perm.astype(np.int32)  # engine site -> input row owning its cell (a copy)
     if first_row_holds and (dup >= 0).any():
         np.minimum.at(owner, root, perm)
     site_of = np.empty(n, np.int32)
     site_of[perm] = owner[root]
 
     points, offsets, ring, status = clip.clip_cells(
-        exs, eys, out["vertices"], out["he_origin"], out["he_twin"], out["he_face"], out["face_edge"],
-        first.astype(np.int8), box, e, threads, room=out.pop("vertex_room", None),
+        exs,
+        eys,
+        out["vertices"],
+        out["he_origin"],
+        out["he_twin"],
+        out["he_face"],
+        out["face_edge"],
+        first.astype(np.int8),
+        box,
+        e,
+        threads,
+        room=out.pop("vertex_room", None),
     )
     if status != 0:
         raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
 
     # cells to input rows (CSR gather; the clipper works in engine order, where a cell's edges and
     # vertices lie near its neighbours' in memory)
-    cell_of_row = np.full(n, -1, np.int32)           # engine site whose cell row r shows
+    cell_of_row = np.full(n, -1, np.int32)  # engine site whose cell row r shows
     firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
     cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row)
@@ -81,7 +93,7 @@ def assemble(pts, box, e, perm, exs, eys, out, *, engine, present=None, first_ro
     return Diagram(
         sites=pts,
         site_of=site_of,
-        vertices=points[:len(out["vertices"])],
+        vertices=points[: len(out["vertices"])],
         he_origin=out["he_origin"],
         he_twin=out["he_twin"],
         he_face=he_face,

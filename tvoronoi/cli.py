@@ -73,10 +73,16 @@ exit status:
 # output formats: --to names, and the extensions that choose them
 OUTPUT_FORMATS = ("geojson", "geojsonseq", "geojsonl", "parquet")
 OUTPUT_EXTENSIONS = {
-    ".geojson": "geojson", ".json": "geojson",
-    ".geojsons": "geojsonseq", ".geojsonseq": "geojsonseq",
-    ".geojsonl": "geojsonl", ".jsonl": "geojsonl", ".ndjson": "geojsonl",
-    ".parquet": "parquet", ".geoparquet": "parquet", ".pq": "parquet",
+    ".geojson": "geojson",
+    ".json": "geojson",
+    ".geojsons": "geojsonseq",
+    ".geojsonseq": "geojsonseq",
+    ".geojsonl": "geojsonl",
+    ".jsonl": "geojsonl",
+    ".ndjson": "geojsonl",
+    ".parquet": "parquet",
+    ".geoparquet": "parquet",
+    ".pq": "parquet",
 }
 GEOJSON_LAYOUT = {"geojson": "collection", "geojsonseq": "seq", "geojsonl": "lines"}
 CRS84 = "OGC:CRS84"
@@ -93,8 +99,12 @@ def parse_bbox(text: str) -> tuple[float, float, float, float]:
     >>> parse_bbox("-1,0,2.5,1e3")
     (-1.0, 0.0, 2.5, 1000.0)
     """
-    return as_bbox([part.strip() for part in text.split(",")], what=f"--bbox {text!r}",
-                   names=("XMIN", "YMIN", "XMAX", "YMAX"), sep=",")
+    return as_bbox(
+        [part.strip() for part in text.split(",")],
+        what=f"--bbox {text!r}",
+        names=("XMIN", "YMIN", "XMAX", "YMAX"),
+        sep=",",
+    )
 
 
 def parse_delimiter(text: str) -> str:
@@ -105,7 +115,7 @@ def parse_delimiter(text: str) -> str:
     """
     named = {"tab": "\t", "\\t": "\t", "comma": ",", "semicolon": ";", "pipe": "|", "space": " "}
     value = named.get(text.lower(), text)
-    if len(value) != 1 or value in "\r\n\"":
+    if len(value) != 1 or value in '\r\n"':
         raise argparse.ArgumentTypeError(f"{text!r}: give one character, e.g. ';' or 'tab'")
     return value
 
@@ -117,7 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
         description="Exact, fast 2D Voronoi diagrams. Without a command, tvoronoi starts the terminal UI "
-                    "(on a generated point set, or on FILE: tvoronoi FILE).",
+        "(on a generated point set, or on FILE: tvoronoi FILE).",
         usage=f"{PROG} [-h] [--version] [FILE | batch ...]",
     )
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
@@ -126,48 +136,92 @@ def build_parser() -> argparse.ArgumentParser:
         "batch",
         help="write the Voronoi cells of a point file as GeoJSON or GeoParquet",
         description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON, "
-                    "a GeoJSON sequence or GeoParquet.",
+        "a GeoJSON sequence or GeoParquet.",
         epilog=BATCH_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    batch.add_argument("input", metavar="INPUT",
-                       help='point file (CSV, TSV, text, GeoJSON, .npy, (Geo)Parquet), or "-" for stdin')
-    batch.add_argument("-o", "--output", required=True, metavar="OUTPUT",
-                       help='file of the cells (.geojson, .geojsons, .geojsonl, .parquet), or "-" for stdout')
+    batch.add_argument(
+        "input", metavar="INPUT", help='point file (CSV, TSV, text, GeoJSON, .npy, (Geo)Parquet), or "-" for stdin'
+    )
+    batch.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUTPUT",
+        help='file of the cells (.geojson, .geojsons, .geojsonl, .parquet), or "-" for stdout',
+    )
     batch.add_argument("--engine", choices=ENGINES, default="incremental", help="default: %(default)s")
-    batch.add_argument("--bbox", metavar="XMIN,YMIN,XMAX,YMAX",
-                       help="the box bounding the cells; default: the points' bounding box grown by 10%% "
-                            "of its larger side on every side")
-    batch.add_argument("--clip", metavar="FILE",
-                       help="cut the cells to the (Multi)Polygons of a GeoJSON file; sites outside get no cell")
-    batch.add_argument("--lloyd", type=int, metavar="N",
-                       help="Lloyd relaxation: move each site to its cell's centroid N times, then write the cells")
-    batch.add_argument("--delaunay", metavar="FILE",
-                       help='also write the Delaunay triangles, in the format of its extension or --to ("-" for '
-                            'stdout); with --dask, a new directory of parts')
+    batch.add_argument(
+        "--bbox",
+        metavar="XMIN,YMIN,XMAX,YMAX",
+        help="the box bounding the cells; default: the points' bounding box grown by 10%% "
+        "of its larger side on every side",
+    )
+    batch.add_argument(
+        "--clip",
+        metavar="FILE",
+        help="cut the cells to the (Multi)Polygons of a GeoJSON file; sites outside get no cell",
+    )
+    batch.add_argument(
+        "--lloyd",
+        type=int,
+        metavar="N",
+        help="Lloyd relaxation: move each site to its cell's centroid N times, then write the cells",
+    )
+    batch.add_argument(
+        "--delaunay",
+        metavar="FILE",
+        help='also write the Delaunay triangles, in the format of its extension or --to ("-" for '
+        "stdout); with --dask, a new directory of parts",
+    )
     batch.add_argument("--x", metavar="COL", help="x column of a table: a name, a 0-based index or colN")
     batch.add_argument("--y", metavar="COL", help="y column of a table: a name, a 0-based index or colN")
     batch.add_argument("--format", choices=FORMATS, help="input format; default: from the extension, else the content")
-    batch.add_argument("--delimiter", metavar="CHAR", type=parse_delimiter,
-                       help='field separator of a CSV input: ",", ";", "tab", "|", ...; default: a tab for .tsv, '
-                            "else found from the first rows (a ;-separated file may use decimal commas)")
-    batch.add_argument("--insertion", choices=INSERTION_ORDERS, default="brio",
-                       help="incremental engine: insertion order (default: %(default)s)")
+    batch.add_argument(
+        "--delimiter",
+        metavar="CHAR",
+        type=parse_delimiter,
+        help='field separator of a CSV input: ",", ";", "tab", "|", ...; default: a tab for .tsv, '
+        "else found from the first rows (a ;-separated file may use decimal commas)",
+    )
+    batch.add_argument(
+        "--insertion",
+        choices=INSERTION_ORDERS,
+        default="brio",
+        help="incremental engine: insertion order (default: %(default)s)",
+    )
     batch.add_argument("--seed", type=int, default=0, help="seed of the insertion order (default: %(default)s)")
-    batch.add_argument("--to", choices=OUTPUT_FORMATS,
-                       help="output format of OUTPUT and --delaunay FILE; default: from the extension "
-                            "(.geojson, .geojsons, .geojsonl/.jsonl, .parquet), else geojson")
-    batch.add_argument("--precision", type=int, metavar="N",
-                       help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles)")
-    batch.add_argument("--crs", metavar="AUTH:CODE",
-                       help="the CRS of the input coordinates, e.g. EPSG:3857, recorded in GeoParquet "
-                            "(default: the input's own, else OGC:CRS84 for lon/lat columns, else unknown)")
-    batch.add_argument("--dask", metavar="local[:WORKERS]|tcp://HOST:PORT",
-                       help="build tile by tile on Dask: a LocalCluster of this machine (local, local:WORKERS) or "
-                            "an existing scheduler; INPUT may be a CSV/Parquet file, a directory or a glob, read "
-                            "in partitions, and OUTPUT a new directory of parts (needs tvoronoi[dask])")
-    batch.add_argument("--tiles", type=int, metavar="N",
-                       help="with --dask: tiles, one task each per round (default: from the points and workers)")
+    batch.add_argument(
+        "--to",
+        choices=OUTPUT_FORMATS,
+        help="output format of OUTPUT and --delaunay FILE; default: from the extension "
+        "(.geojson, .geojsons, .geojsonl/.jsonl, .parquet), else geojson",
+    )
+    batch.add_argument(
+        "--precision",
+        type=int,
+        metavar="N",
+        help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles)",
+    )
+    batch.add_argument(
+        "--crs",
+        metavar="AUTH:CODE",
+        help="the CRS of the input coordinates, e.g. EPSG:3857, recorded in GeoParquet "
+        "(default: the input's own, else OGC:CRS84 for lon/lat columns, else unknown)",
+    )
+    batch.add_argument(
+        "--dask",
+        metavar="local[:WORKERS]|tcp://HOST:PORT",
+        help="build tile by tile on Dask: a LocalCluster of this machine (local, local:WORKERS) or "
+        "an existing scheduler; INPUT may be a CSV/Parquet file, a directory or a glob, read "
+        "in partitions, and OUTPUT a new directory of parts (needs tvoronoi[dask])",
+    )
+    batch.add_argument(
+        "--tiles",
+        type=int,
+        metavar="N",
+        help="with --dask: tiles, one task each per round (default: from the points and workers)",
+    )
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress display and no warnings")
     batch.add_argument("--force", action="store_true", help="replace an existing OUTPUT or --delaunay FILE")
     return parser
@@ -197,8 +251,10 @@ def main(argv: list[str] | None = None) -> int:
         # tvoronoi FILE: the terminal UI on a point file
         path = argv[0]
         if not os.path.isfile(path):
-            print(f"{PROG}: error: {path}: no such file (to compute cells without the UI: "
-                  f"{PROG} batch INPUT -o OUTPUT)", file=sys.stderr)
+            print(
+                f"{PROG}: error: {path}: no such file (to compute cells without the UI: {PROG} batch INPUT -o OUTPUT)",
+                file=sys.stderr,
+            )
             return EXIT_USAGE
         return run_tui(path)
     try:
@@ -265,8 +321,12 @@ def _batch_run(args, phases: Phases) -> int:
     names = [name for name in (args.output, args.delaunay) if name is not None]
     if names.count(STDIO) > 1:
         raise TvoronoiError('-o and --delaunay cannot both be "-": stdout takes one of them')
-    if (len(names) == 2 and STDIO not in names and os.path.abspath(names[0]) == os.path.abspath(names[1])
-            and not (is_direct(names[0]) and descriptor_of(names[0]) is None)):  # /dev/null takes both
+    if (
+        len(names) == 2
+        and STDIO not in names
+        and os.path.abspath(names[0]) == os.path.abspath(names[1])
+        and not (is_direct(names[0]) and descriptor_of(names[0]) is None)
+    ):  # /dev/null takes both
         raise TvoronoiError(f"-o and --delaunay name the same file {names[0]}; choose two names")
     if args.precision is not None and not 0 <= args.precision <= 17:
         raise TvoronoiError(f"--precision {args.precision}: give a number of decimal digits from 0 to 17")
@@ -372,8 +432,14 @@ def _batch_run(args, phases: Phases) -> int:
 
                 write_cells_parquet(diagram, points, stream, crs=crs)
             else:
-                write_cells(diagram, points, stream, progress=progress, precision=args.precision,
-                                    layout=GEOJSON_LAYOUT[formats[args.output]])
+                write_cells(
+                    diagram,
+                    points,
+                    stream,
+                    progress=progress,
+                    precision=args.precision,
+                    layout=GEOJSON_LAYOUT[formats[args.output]],
+                )
         if args.delaunay is not None:
             with phases.counter("write triangles") as progress, _writing(args.delaunay):
                 stream = outputs[args.delaunay].file
@@ -382,8 +448,13 @@ def _batch_run(args, phases: Phases) -> int:
 
                     write_delaunay_parquet(diagram, stream, crs=crs)
                 else:
-                    write_delaunay(diagram, stream, progress=progress, precision=args.precision,
-                                           layout=GEOJSON_LAYOUT[formats[args.delaunay]])
+                    write_delaunay(
+                        diagram,
+                        stream,
+                        progress=progress,
+                        precision=args.precision,
+                        layout=GEOJSON_LAYOUT[formats[args.delaunay]],
+                    )
         for name, output in outputs.items():
             with _writing(name):
                 output.commit()

@@ -46,10 +46,13 @@ def parse_dask(text: str) -> tuple[str, int | None]:
 def input_files(spec: str) -> list[str]:
     """The point files of INPUT: a file, a directory (its CSV and Parquet files) or a glob, in sorted order."""
     if spec == "-":
-        raise TvoronoiError('--dask reads files in partitions, not stdin: give a file, a directory or a glob')
+        raise TvoronoiError("--dask reads files in partitions, not stdin: give a file, a directory or a glob")
     if os.path.isdir(spec):
-        files = sorted(os.path.join(spec, name) for name in os.listdir(spec)
-                       if name.lower().endswith(CSV_EXTENSIONS + PARQUET_EXTENSIONS) and not name.startswith(("_", ".")))
+        files = sorted(
+            os.path.join(spec, name)
+            for name in os.listdir(spec)
+            if name.lower().endswith(CSV_EXTENSIONS + PARQUET_EXTENSIONS) and not name.startswith(("_", "."))
+        )
         if not files:
             raise TvoronoiError(f"{spec}: the directory holds no CSV or Parquet file")
         return files
@@ -101,7 +104,7 @@ def locate(error, frame, sources: list, client) -> str:
     # the rows of the same file's earlier partitions
     before = 0
     if error.partition > first:
-        lengths = frame.partitions[first:error.partition].map_partitions(len)
+        lengths = frame.partitions[first : error.partition].map_partitions(len)
         before = int(sum(client.compute(lengths).result()))
     row = before + error.row
     if kind == "parquet":
@@ -125,8 +128,14 @@ def _bad_csv_value(error, frame, sources: list, x: str | None, y: str | None) ->
     names = coordinate_columns(frame, x, y)
     seen = 0
     try:
-        chunks = pd.read_csv(path, sep=sources[error.partition][3], usecols=list(names), dtype=str, chunksize=1_000_000,
-                             keep_default_na=False)
+        chunks = pd.read_csv(
+            path,
+            sep=sources[error.partition][3],
+            usecols=list(names),
+            dtype=str,
+            chunksize=1_000_000,
+            keep_default_na=False,
+        )
         for chunk in chunks:
             for name in names:
                 text = chunk[name].to_numpy(object)
@@ -136,8 +145,9 @@ def _bad_csv_value(error, frame, sources: list, x: str | None, y: str | None) ->
                     k = int(np.flatnonzero(bad)[0])
                     line = _csv_line(path, seen + k)
                     where = f"{path}, line {line}" if line is not None else f"{path}, data row {seen + k} (0-based)"
-                    return (f"{where}: {name} is {text[k]!r}, not a finite number; drop or fix that row "
-                            f"(and any like it)")
+                    return (
+                        f"{where}: {name} is {text[k]!r}, not a finite number; drop or fix that row (and any like it)"
+                    )
             seen += len(chunk)
     except (OSError, ValueError):
         return None
@@ -151,7 +161,7 @@ def _csv_line(path: str, row: int) -> int | None:
     with open(path, newline="", encoding="utf-8", errors="replace") as stream:
         reader = csv.reader(stream)
         previous = 0
-        seen = -1                                   # the header is row -1
+        seen = -1  # the header is row -1
         for record in reader:
             if record:
                 if seen == row:
@@ -237,9 +247,20 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
     x, y = _column(frame, args.x), _column(frame, args.y)
     client = client_for(args.dask)
     try:
-        result = voronoi(frame, client=client, bbox=bbox, tiles=args.tiles, to=args.output, format=output_format,
-                         clip=region, engine=args.engine, x=x, y=y, crs=args.crs,
-                         delaunay=False if args.delaunay is None else args.delaunay)
+        result = voronoi(
+            frame,
+            client=client,
+            bbox=bbox,
+            tiles=args.tiles,
+            to=args.output,
+            format=output_format,
+            clip=region,
+            engine=args.engine,
+            x=x,
+            y=y,
+            crs=args.crs,
+            delaunay=False if args.delaunay is None else args.delaunay,
+        )
     except PartitionError as exc:
         # partitions are numbered through the files in sorted order (a CSV file may hold several)
         found = _bad_csv_value(exc, frame, sources, x, y)
@@ -251,10 +272,15 @@ def run(args, output_format: str, bbox, region, quiet: bool) -> None:
             cluster.close()
     if not quiet:
         parts = sum(1 for name in result.parts if name)
-        print(f"tvoronoi: {len(files)} file(s) -> {args.output}: {parts} parts from {result.n_tiles} tiles, "
-              f"{result.rounds} round(s) (cells left after each: {', '.join(map(str, result.pending_after))})",
-              file=sys.stderr)
+        print(
+            f"tvoronoi: {len(files)} file(s) -> {args.output}: {parts} parts from {result.n_tiles} tiles, "
+            f"{result.rounds} round(s) (cells left after each: {', '.join(map(str, result.pending_after))})",
+            file=sys.stderr,
+        )
         if args.delaunay is not None:
             parts = sum(1 for name in result.triangle_parts if name)
-            print(f"tvoronoi: Delaunay triangles -> {args.delaunay}: {parts} parts (sites with triangles left after "
-                  f"each round: {', '.join(map(str, result.triangles_pending_after))})", file=sys.stderr)
+            print(
+                f"tvoronoi: Delaunay triangles -> {args.delaunay}: {parts} parts (sites with triangles left after "
+                f"each round: {', '.join(map(str, result.triangles_pending_after))})",
+                file=sys.stderr,
+            )

@@ -18,7 +18,7 @@ def named_column(names: list[str], role: str) -> int | None:
 
     >>> named_column(["id", "Lat", "Lon"], "x"), named_column(["id", "Lat", "Lon"], "y")
     (2, 1)
-    >>> named_column(["e", "height"], "x") is None   # "e" only beside an "n"
+    >>> named_column(["e", "height"], "x") is None  # "e" only beside an "n"
     True
     """
     lowered = [name.lower() for name in names]

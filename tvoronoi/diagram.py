@@ -66,7 +66,7 @@ class Diagram:
         """(h,) int32: the next half-edge counter-clockwise around the same cell."""
         f = self.he_face
         nxt = np.arange(1, len(f) + 1, dtype=np.int32)
-        last = np.ones(len(f), bool)                  # the last half-edge of its cell
+        last = np.ones(len(f), bool)  # the last half-edge of its cell
         last[:-1] = f[1:] != f[:-1]
         nxt[last] = self.face_edge[f[last]]
         return nxt

@@ -48,7 +48,9 @@ def require_dask():
         import dask.dataframe  # noqa: F401
         import distributed
     except ImportError:
-        raise TvoronoiError(f"running on Dask needs dask and distributed, which are not installed: {INSTALL_HINT}") from None
+        raise TvoronoiError(
+            f"running on Dask needs dask and distributed, which are not installed: {INSTALL_HINT}"
+        ) from None
     return distributed
 
 
@@ -167,8 +169,13 @@ def _summary(part, x: str, y: str, n_sample: int, seed: int, clip, number: int, 
         column = x if not np.isfinite(xs[row]) else y
         value = part[column].iloc[row]
         value = float(value) if isinstance(value, (float, np.floating)) else value
-        raise PartitionError(number, row, f"{column} is {value!r}, not a finite number ({int(bad.sum())} such "
-                             f"row(s) in this partition); drop or fix those rows", part.index[row])
+        raise PartitionError(
+            number,
+            row,
+            f"{column} is {value!r}, not a finite number ({int(bad.sum())} such "
+            f"row(s) in this partition); drop or fix those rows",
+            part.index[row],
+        )
     out: dict = {"n": len(part), "extent_all": _extent(xs, ys)}
     if clip is not None:
         from tvoronoi.region import sites_inside
@@ -200,8 +207,9 @@ def _extent(xs: np.ndarray, ys: np.ndarray) -> Region | None:
 
 def _meets(extent: Region | None, region: Region) -> bool:
     """Whether a partition's sites (their extent) can lie in the closed region."""
-    return extent is not None and not (extent[2] < region[0] or extent[0] > region[2] or extent[3] < region[1]
-                                       or extent[1] > region[3])
+    return extent is not None and not (
+        extent[2] < region[0] or extent[0] > region[2] or extent[3] < region[1] or extent[1] > region[3]
+    )
 
 
 def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str], clip) -> tuple:
@@ -257,7 +265,7 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
     plan = job.plan
     xs, ys = sites[X].to_numpy(), sites[Y].to_numpy()
     ids = sites[ID].to_numpy(np.int64)
-    own = tile_of(xs, ys, plan.rects[t:t + 1]) == 0 if len(sites) else np.zeros(0, bool)
+    own = tile_of(xs, ys, plan.rects[t : t + 1]) == 0 if len(sites) else np.zeros(0, bool)
     if group is not None:
         own &= np.isin(ids, group)
     inside = sites["__tvoronoi_inside"].to_numpy(bool)
@@ -268,8 +276,9 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
     diagram = build(pts, bbox=plan.box, engine=job.engine, threads=1) if want.any() else None
     cells_out = tris_out = left_cells = left_tris = None
     if kind in (BOTH, CELLS):
-        cells = build_tile(pts, ids[built], want, region, plan.box, everything=everything, engine=job.engine,
-                           diagram=diagram)
+        cells = build_tile(
+            pts, ids[built], want, region, plan.box, everything=everything, engine=job.engine, diagram=diagram
+        )
         # the tile's own sites outside the clip region get no cell: written once, in the first round
         outside = np.flatnonzero(own & ~inside) if round_ == 1 else np.empty(0, np.int64)
         left_cells = (cells.pending, cells.reaches)
@@ -286,8 +295,9 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
             left_tris = (np.empty(0, np.int64), np.empty((0, 4)))
         else:
             assert job.hull is not None
-            got = tile_triangles(pts, ids[built], want, region, diagram, hull=job.hull, extent=plan.extent,
-                                 everything=everything)
+            got = tile_triangles(
+                pts, ids[built], want, region, diagram, hull=job.hull, extent=plan.extent, everything=everything
+            )
             tri, left_tris = got.triangles, (got.pending, got.reaches)
         tris_out = _triangles_out(tri, ids[built], pts, job, name)
     return cells_out, tris_out, left_cells, left_tris
@@ -306,8 +316,9 @@ def _triangles_out(tri: np.ndarray, ids: np.ndarray, pts: np.ndarray, job: Job, 
         return write_triangles_part(tri, xy, job.delaunay_to, name, job.format, job.crs)
     rings = shapely.polygons(np.concatenate([xy, xy[:, :1]], axis=1)) if len(tri) else np.empty(0, object)
     wkb = shapely.to_wkb(rings) if len(tri) else np.empty(0, object)
-    return pd.DataFrame({"a": tri[:, 0], "b": tri[:, 1], "c": tri[:, 2],
-                         GEOMETRY: pd.array(wkb, dtype=_binary_dtype())})
+    return pd.DataFrame(
+        {"a": tri[:, 0], "b": tri[:, 1], "c": tri[:, 2], GEOMETRY: pd.array(wkb, dtype=_binary_dtype())}
+    )
 
 
 def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
@@ -320,7 +331,7 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
     import shapely
 
     lengths = np.diff(cells.offsets)
-    has = lengths >= 3                              # fewer points: no area (a cell touching the box)
+    has = lengths >= 3  # fewer points: no area (a cell touching the box)
     if job.to is not None and job.format == "parquet" and job.clip is None:
         # rings straight to WKB in bulk (writers.geoparquet), no shapely geometry per cell
         return _rings_frame(sites, ids, cells, has, job)
@@ -359,7 +370,7 @@ def _rings_frame(sites, ids: np.ndarray, cells, has: np.ndarray, job: Job):
     kept = lengths[has]
     stops = np.cumsum(kept)
     starts = stops - kept
-    xy = np.insert(ring, stops, ring[starts], axis=0)           # each ring's first point again at its end
+    xy = np.insert(ring, stops, ring[starts], axis=0)  # each ring's first point again at its end
     ring_offsets = np.zeros(len(kept) + 1, np.int64)
     np.cumsum(kept + 1, out=ring_offsets[1:])
     position = np.searchsorted(ids, cells.ids)
@@ -391,9 +402,23 @@ def _meta(frame_meta, job: Job):
 # the public entry
 
 
-def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None, format: str = "parquet",
-            clip=None, engine: str = "incremental", x: str | None = None, y: str | None = None, crs=None,
-            seed: int = 0, halo_scale: float = 1.0, delaunay=False) -> Result:
+def voronoi(
+    points,
+    *,
+    client=None,
+    bbox=None,
+    tiles: int | None = None,
+    to=None,
+    format: str = "parquet",
+    clip=None,
+    engine: str = "incremental",
+    x: str | None = None,
+    y: str | None = None,
+    crs=None,
+    seed: int = 0,
+    halo_scale: float = 1.0,
+    delaunay=False,
+) -> Result:
     """The clipped Voronoi cells of a Dask DataFrame or array of points, built tile by tile on a cluster.
 
     Every cell equals, bit for bit, the cell ``tvoronoi.voronoi`` gives the same row (see tvoronoi.tiles).
@@ -465,18 +490,21 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
 
     renames = {**property_renames(list(properties)), **({GEOMETRY: GEOMETRY + "_2"} if GEOMETRY in properties else {})}
     parts = frame.to_delayed()
-    workers = max(1, len(client.scheduler_info(n_workers=-1).get("workers", {})) if hasattr(client, "scheduler_info") else 1)
+    workers = max(
+        1, len(client.scheduler_info(n_workers=-1).get("workers", {})) if hasattr(client, "scheduler_info") else 1
+    )
 
     # one pass: counts, extent, sample
     n_tiles_guess = tiles if tiles is not None else 4 * workers
     per_part = max(1, (SAMPLE_PER_TILE * n_tiles_guess) // max(1, len(parts)))
-    futures = client.compute([dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k, bool(delaunay))
-                              for k, p in enumerate(parts)])
+    futures = client.compute(
+        [dask.delayed(_summary)(p, xname, yname, per_part, seed, clip, k, bool(delaunay)) for k, p in enumerate(parts)]
+    )
     try:
         summaries = client.gather(futures)
     except TvoronoiError:
         raise
-    except Exception as exc:                        # a partition that cannot be read: name the first that failed
+    except Exception as exc:  # a partition that cannot be read: name the first that failed
         failed = next((k for k, f in enumerate(futures) if f.status == "error"), None)
         raise PartitionError(failed, None, f"cannot be read ({exc.__class__.__name__}: {exc})") from None
     counts = [s["n"] for s in summaries]
@@ -487,8 +515,12 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     if tiles is None:
         tiles = default_tiles(m, workers)
     extents = np.array([s["extent"] for s in summaries if s["extent"] is not None])
-    extent = (float(extents[:, 0].min()), float(extents[:, 1].min()), float(extents[:, 2].max()),
-              float(extents[:, 3].max()))
+    extent = (
+        float(extents[:, 0].min()),
+        float(extents[:, 1].min()),
+        float(extents[:, 2].max()),
+        float(extents[:, 3].max()),
+    )
     if bbox is not None:
         box = as_bbox(bbox)
     elif clip is not None:
@@ -515,8 +547,21 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
             for done in written[:k]:
                 remove_directory(done)
             raise
-    job = Job(xname, yname, properties, renames, plan, engine, clip, None if to is None else str(to), format, crs,
-              bool(delaunay), None if delaunay_to is None else str(delaunay_to), hull)
+    job = Job(
+        xname,
+        yname,
+        properties,
+        renames,
+        plan,
+        engine,
+        clip,
+        None if to is None else str(to),
+        format,
+        crs,
+        bool(delaunay),
+        None if delaunay_to is None else str(delaunay_to),
+        hull,
+    )
 
     try:
         run = _rounds(client, plan, job, parts, summaries, firsts)
@@ -529,7 +574,7 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
             tri_names = tuple(client.gather(run.triangles))
             finish_directory(delaunay_to, [name for name in tri_names if name], format, crs)
     except BaseException:
-        for directory in written:                   # no half-written dataset left behind
+        for directory in written:  # no half-written dataset left behind
             remove_directory(directory)
         raise
     import dask.dataframe as dd
@@ -538,15 +583,29 @@ def voronoi(points, *, client=None, bbox=None, tiles: int | None = None, to=None
     triangles = None
     if delaunay and delaunay_to is None:
         triangles = dd.from_delayed(run.triangles, meta=_triangles_meta(), verify_meta=False)
-    return Result(cells, run.rounds, tuple(run.pending_after), plan.n_tiles, names, triangles,
-                  tuple(run.triangles_pending_after), tri_names)
+    return Result(
+        cells,
+        run.rounds,
+        tuple(run.pending_after),
+        plan.n_tiles,
+        names,
+        triangles,
+        tuple(run.triangles_pending_after),
+        tri_names,
+    )
 
 
 def _triangles_meta():
     import pandas as pd
 
-    return pd.DataFrame({"a": pd.Series(dtype="int64"), "b": pd.Series(dtype="int64"),
-                         "c": pd.Series(dtype="int64"), GEOMETRY: pd.Series(dtype=_binary_dtype())})
+    return pd.DataFrame(
+        {
+            "a": pd.Series(dtype="int64"),
+            "b": pd.Series(dtype="int64"),
+            "c": pd.Series(dtype="int64"),
+            GEOMETRY: pd.Series(dtype=_binary_dtype()),
+        }
+    )
 
 
 @dataclass
@@ -566,7 +625,8 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
     # rounds: every tile in the first; then each group of pending cells, or of sites with pending
     # triangles (group_reaches), with the box it needs, grown by the tile's halo doubled each round
     units: list[tuple[int, np.ndarray | None, Region | None, str]] = [
-        (t, None, None, BOTH) for t in range(plan.n_tiles)]
+        (t, None, None, BOTH) for t in range(plan.n_tiles)
+    ]
     run = _Run([], [], 0, [], [])
     round_ = 0
     while units:
@@ -584,8 +644,9 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
                 serves.setdefault(k, []).append(u)
         pieces: list[list] = [[] for _ in units]
         for k, us in serves.items():
-            chosen = dask.delayed(_select, nout=len(us))(parts[k], int(firsts[k]), xname, yname,
-                                                         [regions[u] for u in us], list(properties), clip)
+            chosen = dask.delayed(_select, nout=len(us))(
+                parts[k], int(firsts[k]), xname, yname, [regions[u] for u in us], list(properties), clip
+            )
             for j, u in enumerate(us):
                 pieces[u].append(chosen[j])
         tasks = []
@@ -594,9 +655,9 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
             tasks.append(dask.delayed(_run_tile, nout=4)(pieces[g], t, regions[g], group, kind, job, round_, name))
         k = len(tasks)
         futures = client.compute([task[j] for j in range(4) for task in tasks])
-        left_cells, left_tris = client.gather(futures[2 * k:3 * k]), client.gather(futures[3 * k:])
+        left_cells, left_tris = client.gather(futures[2 * k : 3 * k]), client.gather(futures[3 * k :])
         next_units: list[tuple[int, np.ndarray | None, Region | None, str]] = []
-        for (t, _, _, kind), cells, tris, lc, lt in zip(units, futures[:k], futures[k:2 * k], left_cells, left_tris):
+        for (t, _, _, kind), cells, tris, lc, lt in zip(units, futures[:k], futures[k : 2 * k], left_cells, left_tris):
             if kind != TRIANGLES:
                 run.cells.append(cells)
                 next_units += [(t, ids, b, CELLS) for ids, b in group_reaches(lc[0], lc[1], plan.margin(t, round_))]
@@ -624,9 +685,13 @@ def local_client(workers: int | None = None, *, quiet: bool = False):
             workers = len(os.sched_getaffinity(0))
         except AttributeError:
             workers = os.cpu_count() or 1
-    cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=":0",
-                                       silence_logs=logging.CRITICAL if quiet else logging.WARN)
+    cluster = distributed.LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        silence_logs=logging.CRITICAL if quiet else logging.WARN,
+    )
     return distributed.Client(cluster)
 
 

@@ -49,9 +49,10 @@ class DynamicVoronoi:
     --------
     >>> dv = DynamicVoronoi([[0, 0], [2, 0], [0, 2]])
     >>> i = dv.insert(1.5, 1.5)
-    >>> sorted(dv.changed.tolist())      # the new site and the cells it took area from
+    >>> sorted(dv.changed.tolist())  # the new site and the cells it took area from
     [0, 1, 2, 3]
-    >>> dv.move(i, 3, 3); dv.remove(0)
+    >>> dv.move(i, 3, 3)
+    ... dv.remove(0)
     >>> len(dv.diagram().cell_polygon(0)), len(dv.diagram().cell_polygon(1)) > 0
     (0, True)
     """
@@ -72,10 +73,10 @@ class DynamicVoronoi:
         self._alive = np.zeros(len(self._xy), bool)
         self._alive[:n] = True
         self._n_ids = n
-        self._primary: dict[int, int] = {}      # a repeated point's id -> the id holding the place
+        self._primary: dict[int, int] = {}  # a repeated point's id -> the id holding the place
         self._copies: dict[int, list[int]] = {}  # the holder -> its repeats, oldest first
         self._mesh: dynamic.DynamicMesh | None = None
-        self._flat: Diagram | None = None       # the diagram while the sites are collinear
+        self._flat: Diagram | None = None  # the diagram while the sites are collinear
         self.changed = np.arange(n, dtype=np.int32)
         self._rebuild()
 
@@ -103,7 +104,7 @@ class DynamicVoronoi:
 
     def _holders(self) -> np.ndarray:
         """Alive ids that hold a place (not repeats), ascending."""
-        ids = np.flatnonzero(self._alive[:self._n_ids])
+        ids = np.flatnonzero(self._alive[: self._n_ids])
         if self._primary:
             ids = ids[~np.isin(ids, list(self._primary))]
         return ids.astype(np.int32)
@@ -111,7 +112,7 @@ class DynamicVoronoi:
     def _rebuild(self) -> None:
         """Build the triangulation of all holders at once (the start, or after the sites were flat)."""
         self._mesh, self._flat = None, None
-        ids = np.flatnonzero(self._alive[:self._n_ids]).astype(np.int32)
+        ids = np.flatnonzero(self._alive[: self._n_ids]).astype(np.int32)
         self._primary.clear()
         self._copies.clear()
         if len(ids) == 0:
@@ -132,7 +133,7 @@ class DynamicVoronoi:
             for c in everyone[1:]:
                 self._primary[c] = everyone[0]
         if t.tv is None or t.opp is None:
-            return      # the distinct sites are collinear (t.flat): no mesh until a site leaves the line
+            return  # the distinct sites are collinear (t.flat): no mesh until a site leaves the line
         mesh = dynamic.DynamicMesh(max(len(self._xy), 16))
         mesh.load(sx, sy, order_ids.astype(np.int32), t.tv, t.opp, len(sx))
         for k, holder in holder_of_vertex.items():
@@ -231,7 +232,7 @@ class DynamicVoronoi:
         return DynamicDiagram(self)
 
     def __len__(self) -> int:
-        return int(self._alive[:self._n_ids].sum())
+        return int(self._alive[: self._n_ids].sum())
 
 
 class DynamicDiagram:
@@ -249,11 +250,11 @@ class DynamicDiagram:
     @property
     def sites(self) -> np.ndarray:
         """(n_sites, 2) coordinates by id; NaN rows for removed ids."""
-        return self._owner._xy[:self._owner._n_ids]
+        return self._owner._xy[: self._owner._n_ids]
 
     @property
     def alive(self) -> np.ndarray:
-        return self._owner._alive[:self._owner._n_ids]
+        return self._owner._alive[: self._owner._n_ids]
 
     def cell_polygon(self, i: int) -> np.ndarray:
         """Cell of site i, clipped to the box: (k, 2), counter-clockwise; empty for a removed
@@ -298,8 +299,18 @@ class DynamicDiagram:
             holders = o._holders()
             out = engines.lift_dcel(engines.collinear_dcel(xs[holders], ys[holders]), holders, n)
         out["dup"] = dup
-        return assemble(pts, self.bbox, o._e, np.arange(n, dtype=np.int32), xs, ys, out,
-                        engine=o.engine, present=present, first_row_holds=False)
+        return assemble(
+            pts,
+            self.bbox,
+            o._e,
+            np.arange(n, dtype=np.int32),
+            xs,
+            ys,
+            out,
+            engine=o.engine,
+            present=present,
+            first_row_holds=False,
+        )
 
     def delaunay_triangles(self) -> np.ndarray:
         return self.to_diagram().delaunay_triangles()

@@ -19,8 +19,8 @@ from tvoronoi.kernels import dual, fortune, incremental, order
 # under (1.3e300 for sites of unit size). From below, a side times a coordinate difference (down to
 # 2^-223) must not underflow. Ring tests between points of the box and the sites, whose magnitudes
 # may then span 2^1700, are exact at any span (clipper.turn).
-BOX_SCALED_MIN = 2.0 ** -700
-BOX_SCALED_MAX = math.ldexp(1.0 - 2.0 ** -20, 997)
+BOX_SCALED_MIN = 2.0**-700
+BOX_SCALED_MAX = math.ldexp(1.0 - 2.0**-20, 997)
 
 
 def scale_exponent(*values) -> int:
@@ -56,7 +56,7 @@ def first_copies(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     dup = np.full(n, -1, np.int32)
     if n < 2:
         return dup
-    by_place = np.lexsort((ys, xs))            # stable: earlier indices first within a tie
+    by_place = np.lexsort((ys, xs))  # stable: earlier indices first within a tie
     same = (xs[by_place][1:] == xs[by_place][:-1]) & (ys[by_place][1:] == ys[by_place][:-1])
     if not same.any():
         return dup
@@ -71,7 +71,7 @@ def collinear_dcel(xs: np.ndarray, ys: np.ndarray) -> dict:
     """Voronoi DCEL of 0, 1, 2 or more collinear sites (parallel strips), repeats included."""
     dup = first_copies(xs, ys)
     distinct = np.flatnonzero(dup < 0)
-    line = distinct[np.lexsort((ys[distinct], xs[distinct]))]   # sorted by x then y: line order
+    line = distinct[np.lexsort((ys[distinct], xs[distinct]))]  # sorted by x then y: line order
     out = dual.voronoi_collinear(np.ascontiguousarray(xs[line]), np.ascontiguousarray(ys[line]))
     out["he_face"] = line[out["he_face"]].astype(np.int32)
     face_edge = np.full(len(xs), -1, np.int32)
@@ -106,8 +106,9 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return perm.astype(np.int32)
 
 
-def engine_order(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio",
-                 seed: int = 0, threads: int = 1) -> np.ndarray:
+def engine_order(
+    xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1
+) -> np.ndarray:
     """The order in which an engine takes the sites: perm[k] is the k-th site (int32).
 
     Fortune's sweep takes them by y then x; the incremental engine in a biased randomized
@@ -126,16 +127,24 @@ class Sites:
     """Sites ready for an engine: scaled by 2^-exponent (exact) and in the engine's order."""
 
     exponent: int
-    perm: np.ndarray    # (n,) int32: engine site k is input site perm[k]
-    xs: np.ndarray      # (n,) float64 scaled coordinates, in engine order, C-contiguous
+    perm: np.ndarray  # (n,) int32: engine site k is input site perm[k]
+    xs: np.ndarray  # (n,) float64 scaled coordinates, in engine order, C-contiguous
     ys: np.ndarray
 
     def __len__(self) -> int:
         return len(self.perm)
 
 
-def prepare(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1,
-            exponent: int | None = None) -> Sites:
+def prepare(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    *,
+    engine: str,
+    insertion: str = "brio",
+    seed: int = 0,
+    threads: int = 1,
+    exponent: int | None = None,
+) -> Sites:
     """Scale the sites (input order) by 2^-exponent (default: their own scale) and order them for an engine."""
     xs = np.asarray(xs, np.float64)
     ys = np.asarray(ys, np.float64)
@@ -201,8 +210,16 @@ def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triang
     return Triangulation(engine, sites, tv, opp, dup)
 
 
-def run(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1,
-        exponent: int | None = None) -> Triangulation:
+def run(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    *,
+    engine: str,
+    insertion: str = "brio",
+    seed: int = 0,
+    threads: int = 1,
+    exponent: int | None = None,
+) -> Triangulation:
     """prepare, then triangulate: the Delaunay triangulation of sites given in input order."""
     sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=exponent)
     return triangulate(sites, engine=engine, insertion=insertion)

@@ -193,8 +193,7 @@ def generate(distribution: str, n: int, *, seed: int | None = 0, **params) -> np
     unknown = sorted(set(params) - set(accepted))
     if unknown:
         raise TvoronoiError(
-            f"{distribution} has no parameter {unknown[0]!r}; "
-            f"its parameters are: {', '.join(accepted)}"
+            f"{distribution} has no parameter {unknown[0]!r}; its parameters are: {', '.join(accepted)}"
         )
     return func(n, seed=seed, **params)
 
@@ -234,9 +233,7 @@ def _check_bounds(bounds) -> tuple[float, float, float, float]:
     try:
         xmin, ymin, xmax, ymax = (float(v) for v in bounds)
     except (TypeError, ValueError):
-        raise TvoronoiError(
-            f"bounds must be four numbers (xmin, ymin, xmax, ymax), got {bounds!r}"
-        ) from None
+        raise TvoronoiError(f"bounds must be four numbers (xmin, ymin, xmax, ymax), got {bounds!r}") from None
     if not all(math.isfinite(v) for v in (xmin, ymin, xmax, ymax)):
         raise TvoronoiError(f"bounds must be finite, got {bounds!r}")
     if not (xmin < xmax and ymin < ymax):
@@ -246,8 +243,7 @@ def _check_bounds(bounds) -> tuple[float, float, float, float]:
     return xmin, ymin, xmax, ymax
 
 
-def coastline(n_vertices: int = 4000, *, spikes: int = 300, lakes: int = 6, islands: int = 10,
-              seed: int | None = 0):
+def coastline(n_vertices: int = 4000, *, spikes: int = 300, lakes: int = 6, islands: int = 10, seed: int | None = 0):
     """A country-like clip region: a wiggly coast with thin spikes (fjords and capes), lakes and islands.
 
     The coast is a star-shaped ring of ``n_vertices`` vertices around the origin (radius about 1,

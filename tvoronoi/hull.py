@@ -39,7 +39,7 @@ def boundary_hull(xy: np.ndarray, ids: np.ndarray) -> np.ndarray:
     pts = xy.tolist()
     lower = _chain(pts, range(len(pts)))
     upper = _chain(pts, range(len(pts) - 1, -1, -1))
-    if len(lower) == len(pts) and len(upper) == len(pts):     # every site on one line
+    if len(lower) == len(pts) and len(upper) == len(pts):  # every site on one line
         return ids
     return ids[np.array(lower[:-1] + upper[:-1], np.int64)]
 

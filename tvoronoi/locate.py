@@ -81,8 +81,20 @@ class SiteLocator:
         found = np.empty(len(q), np.int32)
         mark = np.full(self.n_sites, -1, np.int64)
         stack = np.empty(self.n_sites, np.int32)
-        nearest_sites(self.scaled, self.face_edge, self.he_next, self.he_twin, self.he_face, np.ascontiguousarray(scaled[order, 0]),
-                      np.ascontiguousarray(scaled[order, 1]), start, self.first, found, mark, stack)
+        nearest_sites(
+            self.scaled,
+            self.face_edge,
+            self.he_next,
+            self.he_twin,
+            self.he_face,
+            np.ascontiguousarray(scaled[order, 0]),
+            np.ascontiguousarray(scaled[order, 1]),
+            start,
+            self.first,
+            found,
+            mark,
+            stack,
+        )
         out = np.empty(len(q), np.int32)
         out[order] = found
         return out.reshape(shape)
@@ -91,9 +103,11 @@ class SiteLocator:
 def _graph_nodes(diagram) -> np.ndarray:
     """The rows a walk may visit: those with a cell edge; else (a lone site) the row with a cell; else the
     first copies. Repeated points, and the rows of removed sites in a dynamic diagram, are never answers."""
-    for rows in (np.flatnonzero(np.asarray(diagram.face_edge) >= 0),
-                 np.flatnonzero(np.diff(np.asarray(diagram.cell_offsets)) > 0),
-                 np.flatnonzero(np.asarray(diagram.site_of) == np.arange(diagram.n_sites))):
+    for rows in (
+        np.flatnonzero(np.asarray(diagram.face_edge) >= 0),
+        np.flatnonzero(np.diff(np.asarray(diagram.cell_offsets)) > 0),
+        np.flatnonzero(np.asarray(diagram.site_of) == np.arange(diagram.n_sites)),
+    ):
         if len(rows):
             return rows
     return np.empty(0, np.intp)

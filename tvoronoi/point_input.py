@@ -83,8 +83,10 @@ def explain_failure(points) -> str | None:
         return None
     for i, value in enumerate(points):
         if _is_shapely(value):
-            return (f"point {i} is a shapely {value.geom_type} among other values: give only shapely Points, "
-                    f"or only coordinate pairs")
+            return (
+                f"point {i} is a shapely {value.geom_type} among other values: give only shapely Points, "
+                f"or only coordinate pairs"
+            )
     return None
 
 
@@ -105,7 +107,7 @@ def _parts(geom) -> np.ndarray:
 
 
 def _label(labels, i: int) -> str:
-    """ ' (index label)' when a pandas index names row i otherwise than by its position."""
+    """' (index label)' when a pandas index names row i otherwise than by its position."""
     if labels is None:
         return ""
     label = labels[i]

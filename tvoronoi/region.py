@@ -98,9 +98,7 @@ def as_region(clip, *, what: str = "clip"):
     import shapely
 
     if not isinstance(clip, (shapely.Polygon, shapely.MultiPolygon)):
-        raise TvoronoiError(
-            f"{what} must be a shapely Polygon or MultiPolygon, got {type(clip).__name__}"
-        )
+        raise TvoronoiError(f"{what} must be a shapely Polygon or MultiPolygon, got {type(clip).__name__}")
     if clip.is_empty:
         raise TvoronoiError(f"{what} is an empty {clip.geom_type}: it has no area to clip to")
     if not np.isfinite(shapely.get_coordinates(clip)).all():
@@ -136,8 +134,12 @@ def region_box(region) -> tuple[float, float, float, float]:
     """The region's bounds grown by 1% of their larger side on every side (at least one double each way)."""
     xmin, ymin, xmax, ymax = (float(v) for v in region.bounds)
     margin = REGION_MARGIN * max(xmax - xmin, ymax - ymin)
-    return (min(xmin - margin, math.nextafter(xmin, -math.inf)), min(ymin - margin, math.nextafter(ymin, -math.inf)),
-            max(xmax + margin, math.nextafter(xmax, math.inf)), max(ymax + margin, math.nextafter(ymax, math.inf)))
+    return (
+        min(xmin - margin, math.nextafter(xmin, -math.inf)),
+        min(ymin - margin, math.nextafter(ymin, -math.inf)),
+        max(xmax + margin, math.nextafter(xmax, math.inf)),
+        max(ymax + margin, math.nextafter(ymax, math.inf)),
+    )
 
 
 class _Grid:
@@ -155,8 +157,12 @@ class _Grid:
         self.origin = (xmin, ymin)
         self.step = (max(xmax - xmin, 0.0) / GRID_TILES or 1.0, max(ymax - ymin, 0.0) / GRID_TILES or 1.0)
         i, j = np.divmod(np.arange(GRID_TILES * GRID_TILES), GRID_TILES)
-        boxes = shapely.box(xmin + i * self.step[0], ymin + j * self.step[1],
-                            xmin + (i + 1) * self.step[0], ymin + (j + 1) * self.step[1])
+        boxes = shapely.box(
+            xmin + i * self.step[0],
+            ymin + j * self.step[1],
+            xmin + (i + 1) * self.step[0],
+            ymin + (j + 1) * self.step[1],
+        )
         shapely.prepare(region)
         # inside: the closed tile lies in the region's interior; outside: they share no point
         self.inside = shapely.contains_properly(region, boxes).reshape(GRID_TILES, GRID_TILES)
@@ -342,8 +348,11 @@ def _cut_locally(cells: np.ndarray, bounds: np.ndarray, region, margin: float, r
     while stack:
         piece, (x0, y0, x1, y1), held = stack.pop()
         xm, ym = (x0 + x1) / 2, (y0 + y1) / 2
-        if (shapely.get_num_coordinates(piece) <= PIECE_VERTICES or len(held) < LOCAL_MIN_CELLS
-                or max(x1 - x0, y1 - y0) < 2 * margin):
+        if (
+            shapely.get_num_coordinates(piece) <= PIECE_VERTICES
+            or len(held) < LOCAL_MIN_CELLS
+            or max(x1 - x0, y1 - y0) < 2 * margin
+        ):
             out[held] = shapely.intersection(cells[held], piece)
             continue
         quadrants = [(x0, y0, xm, ym), (xm, y0, x1, ym), (x0, ym, xm, y1), (xm, ym, x1, y1)]

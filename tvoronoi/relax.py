@@ -36,7 +36,7 @@ def cell_centroids(diagram) -> tuple[np.ndarray, np.ndarray]:
     xy = np.take(diagram.cell_points, diagram.cell_vertices, axis=0) - np.take(diagram.sites, row, axis=0)
     after = np.arange(1, len(row) + 1)
     rings = lengths > 0
-    after[offsets[1:][rings] - 1] = offsets[:-1][rings]   # the last point of a ring is followed by its first
+    after[offsets[1:][rings] - 1] = offsets[:-1][rings]  # the last point of a ring is followed by its first
     x, y = xy[:, 0], xy[:, 1]
     x1, y1 = x[after], y[after]
     cross = x * y1 - x1 * y
@@ -59,8 +59,16 @@ def cell_centroids(diagram) -> tuple[np.ndarray, np.ndarray]:
     return centroids, has_cell
 
 
-def lloyd(points, iterations: int, *, bbox=None, clip=None, engine: str = "incremental",
-          insertion: str = "brio", seed: int = 0) -> np.ndarray:
+def lloyd(
+    points,
+    iterations: int,
+    *,
+    bbox=None,
+    clip=None,
+    engine: str = "incremental",
+    insertion: str = "brio",
+    seed: int = 0,
+) -> np.ndarray:
     """Lloyd relaxation: move each site to the centroid of its cell, ``iterations`` times.
 
     The sites tend to a centroidal Voronoi tessellation: evenly spread, each

@@ -48,9 +48,7 @@ def cell_polygons(diagram) -> np.ndarray:
     # np.take gathers whole rows several times faster than fancy indexing
     coords = np.take(np.ascontiguousarray(diagram.cell_points, np.float64), ids, axis=0)
     polygon_offsets = np.arange(len(ring_lengths) + 1, dtype=np.int64)
-    out[has_cell] = shapely.from_ragged_array(
-        shapely.GeometryType.POLYGON, coords, (closed_offsets, polygon_offsets)
-    )
+    out[has_cell] = shapely.from_ragged_array(shapely.GeometryType.POLYGON, coords, (closed_offsets, polygon_offsets))
     return out
 
 

@@ -64,8 +64,13 @@ def circumcentres(pts: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return dual.circumcentres(xs, ys, np.ascontiguousarray(triangles, np.int32), e)
 
 
-def canonical_triangles(pts: np.ndarray, triangles: np.ndarray, n_vertices: int | None = None,
-                        centres: np.ndarray | None = None, sort: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def canonical_triangles(
+    pts: np.ndarray,
+    triangles: np.ndarray,
+    n_vertices: int | None = None,
+    centres: np.ndarray | None = None,
+    sort: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
     """The canonical Delaunay triangulation: each polygon of cocircular sites a fan from its lowest index.
 
     Parameters
@@ -112,7 +117,7 @@ def _fan_cocircular(pts: np.ndarray, tri: np.ndarray, centres: np.ndarray) -> tu
     stops = np.append(starts[1:], len(tri))
     drop = np.zeros(len(tri), bool)
     new_tri, new_centres = [], []
-    xy = np.ldexp(pts, -scale_exponent(pts)).tolist()        # the predicates want coordinates near 1
+    xy = np.ldexp(pts, -scale_exponent(pts)).tolist()  # the predicates want coordinates near 1
     for a, b in zip(starts.tolist(), stops.tolist()):
         if b - a < 2:
             continue
@@ -138,8 +143,10 @@ def _fan_cocircular(pts: np.ndarray, tri: np.ndarray, centres: np.ndarray) -> tu
                 new_centres.append(centres[group[0]])
     if not new_tri:
         return tri, centres
-    return (np.concatenate([tri[~drop], np.array(new_tri, np.int64)]),
-            np.concatenate([centres[~drop], np.array(new_centres, np.float64)]))
+    return (
+        np.concatenate([tri[~drop], np.array(new_tri, np.int64)]),
+        np.concatenate([centres[~drop], np.array(new_centres, np.float64)]),
+    )
 
 
 def _boundary_cycle(group: np.ndarray) -> list[int]:
@@ -157,8 +164,9 @@ def _boundary_cycle(group: np.ndarray) -> list[int]:
 # certification
 
 
-def certified_triangles(pts: np.ndarray, tri: np.ndarray, centres: np.ndarray, on_hull: np.ndarray,
-                        region: Region) -> np.ndarray:
+def certified_triangles(
+    pts: np.ndarray, tri: np.ndarray, centres: np.ndarray, on_hull: np.ndarray, region: Region
+) -> np.ndarray:
     """(k,) bool: which triangles no site outside the closed ``region`` can make non-Delaunay.
 
     ``tri`` (k, 3) counter-clockwise rows of ``pts``, ``centres`` their correctly rounded circumcentres,
@@ -185,7 +193,7 @@ def certified_triangles(pts: np.ndarray, tri: np.ndarray, centres: np.ndarray, o
         high = r * (1 + CERTIFY_RELATIVE) + slack
         for j, sigma, beta in _sides(region):
             o = ox if j == 0 else oy
-            room = sigma * (beta - o)                      # how far the side is from the centre
+            room = sigma * (beta - o)  # how far the side is from the centre
             err = np.abs(room) * CERTIFY_RELATIVE + slack
             passed &= finite & (room - err >= high)
             failed |= finite & (room + err < low)
@@ -294,8 +302,17 @@ class Hull:
         return np.column_stack([np.minimum(a, b), np.maximum(a, b)])
 
 
-def tile_triangles(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Region, diagram, *,
-                   hull: Hull, extent: Region, everything: bool = False) -> TileTriangles:
+def tile_triangles(
+    pts: np.ndarray,
+    ids: np.ndarray,
+    want: np.ndarray,
+    region: Region,
+    diagram,
+    *,
+    hull: Hull,
+    extent: Region,
+    everything: bool = False,
+) -> TileTriangles:
     """The final Delaunay triangles a task emits, from the diagram it built of the sites it saw.
 
     Parameters
@@ -327,16 +344,15 @@ def tile_triangles(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: R
         local = hull_edges(boundary_hull(pts, np.arange(m)))
         global_ = np.array([(int(ids[p]), int(ids[q])) in hull.edges for p, q in local.tolist()], bool)
         open_site[local[~global_].ravel()] = True
-        keys = tri * m + np.roll(tri, -1, axis=1)          # edge j: tri[:, j] -> tri[:, j + 1]
+        keys = tri * m + np.roll(tri, -1, axis=1)  # edge j: tri[:, j] -> tri[:, j + 1]
         on_hull = np.isin(keys, local[global_, 0] * m + local[global_, 1])
         ok = certified_triangles(pts, tri, centres, on_hull, within(region, extent))
     bad = open_site.copy()
     bad[tri[~ok].ravel()] = True
     done = want & ~bad
-    emit = done[tri[:, 0]]                                  # the lowest site is first
+    emit = done[tri[:, 0]]  # the lowest site is first
     pending = want & bad & ~duplicate
-    return TileTriangles(ids[tri[emit]], ids[done], ids[pending],
-                         _reaches(pts, tri, centres, pending, hull, extent))
+    return TileTriangles(ids[tri[emit]], ids[done], ids[pending], _reaches(pts, tri, centres, pending, hull, extent))
 
 
 def within(region: Region, extent: Region) -> Region:
@@ -344,8 +360,12 @@ def within(region: Region, extent: Region) -> Region:
     a disk may cross it (a triangle near the hull has a wide disk, mostly outside every site)."""
     x0, y0, x1, y1 = region
     ex0, ey0, ex1, ey1 = extent
-    return (-math.inf if x0 <= ex0 else x0, -math.inf if y0 <= ey0 else y0,
-            math.inf if x1 >= ex1 else x1, math.inf if y1 >= ey1 else y1)
+    return (
+        -math.inf if x0 <= ex0 else x0,
+        -math.inf if y0 <= ey0 else y0,
+        math.inf if x1 >= ex1 else x1,
+        math.inf if y1 >= ey1 else y1,
+    )
 
 
 def _reaches(pts, tri, centres, pending: np.ndarray, hull: Hull, extent: Region) -> np.ndarray:
@@ -369,8 +389,12 @@ def _reaches(pts, tri, centres, pending: np.ndarray, hull: Hull, extent: Region)
     edges = hull.edge_boxes
     if len(edges):
         for k in range(len(out)):
-            meet = ~((edges[:, 2] < out[k, 0]) | (edges[:, 0] > out[k, 2]) | (edges[:, 3] < out[k, 1])
-                     | (edges[:, 1] > out[k, 3]))
+            meet = ~(
+                (edges[:, 2] < out[k, 0])
+                | (edges[:, 0] > out[k, 2])
+                | (edges[:, 3] < out[k, 1])
+                | (edges[:, 1] > out[k, 3])
+            )
             if meet.any():
                 out[k, :2] = np.minimum(out[k, :2], edges[meet, :2].min(axis=0))
                 out[k, 2:] = np.maximum(out[k, 2:], edges[meet, 2:].max(axis=0))
@@ -398,8 +422,9 @@ class TiledTriangles:
     pending_after: list[int] = field(default_factory=list)
 
 
-def tiled_triangles(points, *, tiles: int, bbox=None, engine: str = "incremental", seed: int = 0,
-                    halo_scale: float = 1.0) -> TiledTriangles:
+def tiled_triangles(
+    points, *, tiles: int, bbox=None, engine: str = "incremental", seed: int = 0, halo_scale: float = 1.0
+) -> TiledTriangles:
     """The canonical Delaunay triangles of ``points``, built tile by tile in this process.
 
     The reference of the distributed build (``tvoronoi.distributed.voronoi(..., delaunay=True)``): the
@@ -449,8 +474,9 @@ def tiled_triangles(points, *, tiles: int, bbox=None, engine: str = "incremental
             if not want.any():
                 continue
             d = voronoi(pts[rows], bbox=box, engine=engine, threads=1)
-            got = tile_triangles(pts[rows], ids[rows], want, region, d, hull=hull, extent=extent,
-                                 everything=plan.sees_everything(region))
+            got = tile_triangles(
+                pts[rows], ids[rows], want, region, d, hull=hull, extent=extent, everything=plan.sees_everything(region)
+            )
             todo[got.done] = False
             found.append(got.triangles)
             next_units += [(t, g, b) for g, b in group_reaches(got.pending, got.reaches, plan.margin(t, round_))]

@@ -31,7 +31,7 @@ HALO_SPACINGS = 4.0
 SAMPLE_PER_TILE = 1000
 # The certification's safety margins (see ``certified``): a relative slack far above the few roundings
 # of the test itself (each at most 2^-53), and ulps for the rounding of a ring's point.
-CERTIFY_RELATIVE = 2.0 ** -40
+CERTIFY_RELATIVE = 2.0**-40
 CERTIFY_ULPS = 2.0
 # Rounds after which a tile sees everything: its region doubles each round, so this bounds nothing
 # in practice; it guards against a region that stops growing (a halo of 0).
@@ -70,7 +70,7 @@ def kd_rects(sample: np.ndarray, n_tiles: int) -> np.ndarray:
         if len(pts):
             ordered = np.sort(pts[:, axis])
             cut = float(ordered[min(len(ordered) - 1, (len(ordered) * k_low) // k)])
-        else:                                        # no sample left: cut the rectangle's finite middle
+        else:  # no sample left: cut the rectangle's finite middle
             lo, hi = rect[axis], rect[axis + 2]
             cut = 0.0 if not (math.isfinite(lo) and math.isfinite(hi)) else (lo + hi) / 2
         low, high = rect.copy(), rect.copy()
@@ -126,9 +126,9 @@ def first_halos(rects: np.ndarray, counts: np.ndarray, extent: Region) -> np.nda
         share = max(1, int(counts[t]))
         if w > 0 and h > 0:
             spacing = math.sqrt(w * h / share)
-        elif side > 0:                               # sites on a line: spacing along it
+        elif side > 0:  # sites on a line: spacing along it
             spacing = side / total
-        else:                                        # every site at one place
+        else:  # every site at one place
             spacing = max(1.0, abs(ex0), abs(ey0))
         halos[t] = HALO_SPACINGS * spacing
     # a halo that rounds to nothing at the sites' magnitude would never grow a region
@@ -179,8 +179,9 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
         farthest = np.zeros(n_cells)
         farthest[has] = np.maximum.reduceat(radius, offsets[:-1][has])
         site_room = _room(sites[:, 0], sites[:, 1], region)
-        easy = np.isfinite(farthest) & (site_room * (1 - CERTIFY_RELATIVE) - slack
-                                        >= 2 * (farthest * (1 + CERTIFY_RELATIVE) + slack))
+        easy = np.isfinite(farthest) & (
+            site_room * (1 - CERTIFY_RELATIVE) - slack >= 2 * (farthest * (1 + CERTIFY_RELATIVE) + slack)
+        )
         if easy.all():
             return ok
         hard = np.repeat(~easy, lengths)
@@ -238,12 +239,21 @@ class TileCells:
     def rings(self):
         """Iterate over (id, ring) pairs."""
         for k, i in enumerate(self.ids.tolist()):
-            yield i, self.ring_xy[self.offsets[k]:self.offsets[k + 1]]
+            yield i, self.ring_xy[self.offsets[k] : self.offsets[k + 1]]
 
 
-def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Region, box, *,
-               everything: bool = False, engine: str = "incremental", threads: int = 1,
-               diagram=None) -> TileCells:
+def build_tile(
+    pts: np.ndarray,
+    ids: np.ndarray,
+    want: np.ndarray,
+    region: Region,
+    box,
+    *,
+    everything: bool = False,
+    engine: str = "incremental",
+    threads: int = 1,
+    diagram=None,
+) -> TileCells:
     """Build the diagram of the sites a task saw and certify the cells it must emit.
 
     Parameters
@@ -288,8 +298,13 @@ def build_tile(pts: np.ndarray, ids: np.ndarray, want: np.ndarray, region: Regio
     for j, k in enumerate(failed.tolist()):
         a, b = offsets[k], offsets[k + 1]
         reaches[j] = flower_box(ring_xy[a:b], np.repeat(pts[rows[k]][None], b - a, axis=0))
-    return TileCells(ids[rows[keep]].astype(np.int64), k_off, ring_xy[np.repeat(ok, lengths)],
-                     ids[rows[failed]].astype(np.int64), reaches)
+    return TileCells(
+        ids[rows[keep]].astype(np.int64),
+        k_off,
+        ring_xy[np.repeat(ok, lengths)],
+        ids[rows[failed]].astype(np.int64),
+        reaches,
+    )
 
 
 def group_reaches(pending: np.ndarray, reaches: np.ndarray, margin: float) -> list[tuple[np.ndarray, Region]]:
@@ -308,8 +323,12 @@ def group_reaches(pending: np.ndarray, reaches: np.ndarray, margin: float) -> li
                 continue
             for b in range(a + 1, len(boxes)):
                 if members[b] and _overlap(boxes[a], boxes[b]):
-                    boxes[a] = [min(boxes[a][0], boxes[b][0]), min(boxes[a][1], boxes[b][1]),
-                                max(boxes[a][2], boxes[b][2]), max(boxes[a][3], boxes[b][3])]
+                    boxes[a] = [
+                        min(boxes[a][0], boxes[b][0]),
+                        min(boxes[a][1], boxes[b][1]),
+                        max(boxes[a][2], boxes[b][2]),
+                        max(boxes[a][3], boxes[b][3]),
+                    ]
                     members[a] += members[b]
                     members[b] = []
                     merged = True
@@ -352,7 +371,7 @@ class Plan:
 
     def margin(self, t: int, round_: int) -> float:
         """How far beyond its reach a group of cells left after round ``round_`` is seen next."""
-        return float(self.halos[t]) * 2.0 ** round_
+        return float(self.halos[t]) * 2.0**round_
 
     def sees_everything(self, region: Region) -> bool:
         return covers(region, self.extent)
@@ -389,7 +408,7 @@ class TiledCells:
     pending_after: list[int] = field(default_factory=list)
 
     def ring(self, k: int) -> np.ndarray:
-        return self.ring_xy[self.offsets[k]:self.offsets[k + 1]]
+        return self.ring_xy[self.offsets[k] : self.offsets[k + 1]]
 
 
 def concat_cells(parts: list[TileCells]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -407,8 +426,9 @@ def concat_cells(parts: list[TileCells]) -> tuple[np.ndarray, np.ndarray, np.nda
     return ids[order], offsets, ring_xy[gather]
 
 
-def tiled_cells(points, *, tiles: int, bbox=None, engine: str = "incremental", seed: int = 0,
-                halo_scale: float = 1.0) -> TiledCells:
+def tiled_cells(
+    points, *, tiles: int, bbox=None, engine: str = "incremental", seed: int = 0, halo_scale: float = 1.0
+) -> TiledCells:
     """Every clipped cell of ``voronoi(points, bbox=bbox)``, built tile by tile in this process.
 
     The reference of the distributed build, and a way to test the tiling with plain calls.
@@ -449,8 +469,15 @@ def tiled_cells(points, *, tiles: int, bbox=None, engine: str = "incremental", s
             region = plan.region(t, round_, reach)
             rows = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
             want = (owner[rows] == t) if group is None else np.isin(ids[rows], group)
-            cells = build_tile(pts[rows], ids[rows], want & todo[rows], region, box,
-                               everything=plan.sees_everything(region), engine=engine)
+            cells = build_tile(
+                pts[rows],
+                ids[rows],
+                want & todo[rows],
+                region,
+                box,
+                everything=plan.sees_everything(region),
+                engine=engine,
+            )
             todo[cells.ids] = False
             parts.append(cells)
             next_units += [(t, g, b) for g, b in group_reaches(cells.pending, cells.reaches, plan.margin(t, round_))]

@@ -39,7 +39,7 @@ def breakpoint_xy(a, b, sweep_y):
     (ax, ay), (bx, by) = a, b
     da, db = 2.0 * (ay - sweep_y), 2.0 * (by - sweep_y)
     if da == 0.0 and db == 0.0:
-        return 0.5 * (ax + bx), -math.inf          # two sites on the sweep line: a vertical line
+        return 0.5 * (ax + bx), -math.inf  # two sites on the sweep line: a vertical line
     if da == 0.0:
         return ax, float(parabola_y(bx, by, ax, sweep_y))
     if db == 0.0:
@@ -47,7 +47,7 @@ def breakpoint_xy(a, b, sweep_y):
     # db ((x - ax)^2 + ay^2 - L^2) = da ((x - bx)^2 + by^2 - L^2)
     qa = db - da
     qb = -2.0 * (db * ax - da * bx)
-    qc = db * (ax * ax + ay * ay - sweep_y ** 2) - da * (bx * bx + by * by - sweep_y ** 2)
+    qc = db * (ax * ax + ay * ay - sweep_y**2) - da * (bx * bx + by * by - sweep_y**2)
     if qa == 0.0:
         x = -qc / qb
     else:
@@ -80,18 +80,18 @@ class FortuneStep:
 
     index: int
     n_steps: int
-    kind: str                    # "start", "site", "circle", "repeat"
-    site: int                    # the new site, or the site whose arc vanished
-    position: tuple              # the event's point: the site, or the circle's top
-    vertex: tuple | None         # the Voronoi vertex a circle event created
+    kind: str  # "start", "site", "circle", "repeat"
+    site: int  # the new site, or the site whose arc vanished
+    position: tuple  # the event's point: the site, or the circle's top
+    vertex: tuple | None  # the Voronoi vertex a circle event created
     sweep_y: float
-    beach: np.ndarray            # (k,) sites of the arcs, left to right
-    breakpoints: np.ndarray      # (k - 1, 2) where consecutive arcs meet
-    circles: np.ndarray          # (m, 3) pending circle events: centre x, y, radius
-    circle_arcs: np.ndarray      # (m,) index in beach of the arc each would remove
-    vertices: np.ndarray         # (v, 2) Voronoi vertices so far
-    finished_edges: np.ndarray   # (f, 2, 2)
-    growing_edges: np.ndarray    # (g, 2, 2)
+    beach: np.ndarray  # (k,) sites of the arcs, left to right
+    breakpoints: np.ndarray  # (k - 1, 2) where consecutive arcs meet
+    circles: np.ndarray  # (m, 3) pending circle events: centre x, y, radius
+    circle_arcs: np.ndarray  # (m,) index in beach of the arc each would remove
+    vertices: np.ndarray  # (v, 2) Voronoi vertices so far
+    finished_edges: np.ndarray  # (f, 2, 2)
+    growing_edges: np.ndarray  # (g, 2, 2)
 
     def describe(self) -> str:
         """One line saying what this step did."""
@@ -104,8 +104,10 @@ class FortuneStep:
             return f"site {self.site} repeats an earlier site at ({x:.4g}, {y:.4g}): no new arc"
         assert self.vertex is not None, "a circle event creates a vertex"
         vx, vy = self.vertex
-        return (f"circle event at ({vx:.4g}, {vy:.4g}): vertex {len(self.vertices) - 1} created, "
-                f"arc of site {self.site} vanishes")
+        return (
+            f"circle event at ({vx:.4g}, {vy:.4g}): vertex {len(self.vertices) - 1} created, "
+            f"arc of site {self.site} vanishes"
+        )
 
 
 class FortuneTrace:
@@ -147,8 +149,9 @@ class FortuneTrace:
         centres = dual.circumcentres(self._xs, self._ys, tri, e)
         beach = st["beach"]
         sweep_y = math.ldexp(float(st["sweep_y"]), e)
-        bps = np.array([breakpoint_xy(pts[beach[i]], pts[beach[i + 1]], sweep_y)
-                        for i in range(len(beach) - 1)]).reshape(-1, 2)
+        bps = np.array(
+            [breakpoint_xy(pts[beach[i]], pts[beach[i + 1]], sweep_y) for i in range(len(beach) - 1)]
+        ).reshape(-1, 2)
         rec = st["records"]
         closed = rec["e1"] >= 0
         finished = np.stack((centres[rec["e0"][closed] // 3], centres[rec["e1"][closed] // 3]), axis=1)
@@ -176,11 +179,18 @@ class FortuneTrace:
         else:
             position, vertex = (float(xs[site]), float(ys[site])), None
         return FortuneStep(
-            index=k, n_steps=self.n_steps, kind=name,
+            index=k,
+            n_steps=self.n_steps,
+            kind=name,
             site=int(perm[site]) if site >= 0 else -1,
-            position=position, vertex=vertex, sweep_y=float(sweep_y),
-            beach=perm[beach].astype(np.int32), breakpoints=bps,
-            circles=circles, circle_arcs=arcs, vertices=centres,
+            position=position,
+            vertex=vertex,
+            sweep_y=float(sweep_y),
+            beach=perm[beach].astype(np.int32),
+            breakpoints=bps,
+            circles=circles,
+            circle_arcs=arcs,
+            vertices=centres,
             finished_edges=np.asarray(finished, float).reshape(-1, 2, 2),
             growing_edges=np.asarray(growing, float).reshape(-1, 2, 2),
         )
@@ -221,8 +231,10 @@ class IncrementalStep:
         x, y = self.diagram.sites[self.site]
         if len(self.conflict) == 0:
             return f"site {self.site} inserted at ({x:.4g}, {y:.4g})"
-        return (f"site {self.site} inserted at ({x:.4g}, {y:.4g}): {len(self.conflict)} triangles "
-                f"in conflict, cells taken from {len(self.stolen_from)} sites")
+        return (
+            f"site {self.site} inserted at ({x:.4g}, {y:.4g}): {len(self.conflict)} triangles "
+            f"in conflict, cells taken from {len(self.stolen_from)} sites"
+        )
 
 
 class IncrementalTrace:
@@ -271,8 +283,9 @@ class IncrementalTrace:
             out = engines.lift_dcel(engines.collinear_dcel(self._xs[idx], self._ys[idx]), idx, n)
             cavity = fan = np.empty((0, 3), np.int32)
             new_site = order[k - 1] if k else -1
-        d = assemble(self.points, self.bbox, self._e, self._perm, self._xs, self._ys, out,
-                     engine="incremental", present=present)
+        d = assemble(
+            self.points, self.bbox, self._e, self._perm, self._xs, self._ys, out, engine="incremental", present=present
+        )
         # vertex n is the vertex at infinity: the finite triangles are the ones to show
         conflict = _finite(cavity, n)
         stolen = np.unique(cavity[cavity != n])
@@ -280,9 +293,14 @@ class IncrementalTrace:
         to_row = self._perm
         walk = self._walk(k, new_site) if res[0] == incremental.STATUS_OK and k > 3 else np.empty((0, 3), np.int32)
         return IncrementalStep(
-            index=k, n_steps=n, site=int(to_row[new_site]) if new_site >= 0 else -1,
-            conflict=to_row[conflict].reshape(-1, 3), new_triangles=to_row[_finite(fan, n)].reshape(-1, 3),
-            stolen_from=to_row[stolen], inserted=np.sort(to_row[present]), diagram=d,
+            index=k,
+            n_steps=n,
+            site=int(to_row[new_site]) if new_site >= 0 else -1,
+            conflict=to_row[conflict].reshape(-1, 3),
+            new_triangles=to_row[_finite(fan, n)].reshape(-1, 3),
+            stolen_from=to_row[stolen],
+            inserted=np.sort(to_row[present]),
+            diagram=d,
             walk=np.where(walk == n, -1, to_row[np.minimum(walk, n - 1)]).reshape(-1, 3),
         )
 

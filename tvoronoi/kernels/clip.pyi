@@ -9,15 +9,22 @@ F64 = npt.NDArray[np.float64]
 I32 = npt.NDArray[np.int32]
 
 def clip_cells(
-    xs: F64, ys: F64, vertices: F64, he_origin: I32, he_twin: I32,
-    he_face: I32, face_edge: I32, active: npt.NDArray[np.int8],
-    box_tuple: tuple[float, float, float, float], e: int, threads: int = 1, parallel_min: int = ...,
+    xs: F64,
+    ys: F64,
+    vertices: F64,
+    he_origin: I32,
+    he_twin: I32,
+    he_face: I32,
+    face_edge: I32,
+    active: npt.NDArray[np.int8],
+    box_tuple: tuple[float, float, float, float],
+    e: int,
+    threads: int = 1,
+    parallel_min: int = ...,
     room: F64 | None = None,
 ) -> tuple[F64, npt.NDArray[np.int64], I32, int]: ...
 def cells_by_row(offsets: npt.NDArray[np.int64], ring: I32, cell_of_row: I32) -> tuple[npt.NDArray[np.int64], I32]: ...
 def relabel(label: I32, ids: I32, threads: int = 1) -> I32: ...
-def straighten(points: F64, offsets: npt.NDArray[Any], rings: npt.NDArray[Any],
-               kind: npt.NDArray[np.int8]) -> Any: ...
-def bisector_crossing(ax: float, ay: float, bx: float, by: float, t: float, along_y: bool,
-                      e: int = 0) -> float: ...
+def straighten(points: F64, offsets: npt.NDArray[Any], rings: npt.NDArray[Any], kind: npt.NDArray[np.int8]) -> Any: ...
+def bisector_crossing(ax: float, ay: float, bx: float, by: float, t: float, along_y: bool, e: int = 0) -> float: ...
 def ring_turn(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> int: ...

@@ -10,7 +10,15 @@ I32 = npt.NDArray[np.int32]
 
 # The DCEL dict: vertices (m, 2) float64; he_origin, he_twin, he_next, he_prev, he_face (h,) int32;
 # face_edge (n,) int32 (and triangles where the caller adds them).
-def voronoi_from_delaunay(xs: F64, ys: F64, tv: I32, opp: I32, exponent: int = 0,
-                          threads: int = 1, parallel_min: int = ..., clip_room: bool = False) -> dict[str, Any]: ...
+def voronoi_from_delaunay(
+    xs: F64,
+    ys: F64,
+    tv: I32,
+    opp: I32,
+    exponent: int = 0,
+    threads: int = 1,
+    parallel_min: int = ...,
+    clip_room: bool = False,
+) -> dict[str, Any]: ...
 def circumcentres(xs: F64, ys: F64, tri: I32, e: int = 0) -> F64: ...
 def voronoi_collinear(xs: F64, ys: F64) -> dict[str, Any]: ...

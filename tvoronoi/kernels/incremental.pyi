@@ -11,5 +11,6 @@ STATUS_OK: int
 STATUS_COLLINEAR: int
 
 # (status, tv, opp, dup), and with stop_after >= 0 a fifth item: the trace dict (order, cavity, fan)
-def triangulate(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64], conflict_lists: bool = False,
-                stop_after: int = -1) -> tuple[Any, ...]: ...
+def triangulate(
+    xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64], conflict_lists: bool = False, stop_after: int = -1
+) -> tuple[Any, ...]: ...

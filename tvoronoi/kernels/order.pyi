@@ -3,5 +3,6 @@
 import numpy as np
 import numpy.typing as npt
 
-def brio_order(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64], seed: int = 0,
-               threads: int = 1) -> npt.NDArray[np.int32]: ...
+def brio_order(
+    xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64], seed: int = 0, threads: int = 1
+) -> npt.NDArray[np.int32]: ...

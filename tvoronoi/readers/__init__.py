@@ -11,16 +11,15 @@ import orjson
 
 from ..errors import InputFileError, TvoronoiError
 from ..fileio import STDIO
-from .geojson_points import read_geojson
-from .npy import NPY_MAGIC, read_npy
-from .parquet import PARQUET_MAGIC, read_parquet
-from .pointset import PointSet
-from .tabular import COMMENT, read_table
 
 # the column names recognised and the steps of a table read, reached through the
 # package by the tests that hold the fast path of a table to the slow one
 from .columns import X_NAMES, Y_NAMES  # noqa: F401
-from .tabular import fast_table, line_offset, slow_table, table_layout  # noqa: F401
+from .geojson_points import read_geojson
+from .npy import NPY_MAGIC, read_npy
+from .parquet import PARQUET_MAGIC, read_parquet
+from .pointset import PointSet
+from .tabular import COMMENT, fast_table, line_offset, read_table, slow_table, table_layout  # noqa: F401
 
 __all__ = ["FORMATS", "PointSet", "read_points"]
 
@@ -48,11 +47,13 @@ UNSUPPORTED_MAGIC = (
     (b"SQLite format 3\x00", "GeoPackage (SQLite database)", _GDAL),
     (b"\x00\x00\x27\x0a", "shapefile", _GDAL),
     (b"fgb\x03", "FlatGeobuf", _GDAL),
-    (b"\x1f\x8b", "gzip-compressed",
-     "gunzip -k {source}, or pipe it: gunzip -c {source} | tvoronoi batch - -o ..."),
-    (b"PK\x03\x04", "zip archive",
-     "unzip it and give the point file inside (a zipped shapefile converts directly: "
-     "ogr2ogr -f GeoJSON points.geojson /vsizip/{source})"),
+    (b"\x1f\x8b", "gzip-compressed", "gunzip -k {source}, or pipe it: gunzip -c {source} | tvoronoi batch - -o ..."),
+    (
+        b"PK\x03\x04",
+        "zip archive",
+        "unzip it and give the point file inside (a zipped shapefile converts directly: "
+        "ogr2ogr -f GeoJSON points.geojson /vsizip/{source})",
+    ),
 )
 UNSUPPORTED_EXTENSIONS = {
     ".gpkg": ("GeoPackage", _GDAL),

@@ -53,8 +53,9 @@ def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0)
     raw = raw[:end]
     if not end:
         return None
-    fields = _fields(raw, ord(delimiter), n_cols, has_quotes=encoded.find(b'"', begin) >= 0,
-                     has_cr=encoded.find(b"\r", begin) >= 0)
+    fields = _fields(
+        raw, ord(delimiter), n_cols, has_quotes=encoded.find(b'"', begin) >= 0, has_cr=encoded.find(b"\r", begin) >= 0
+    )
     del encoded
     if fields is None:
         return None

@@ -68,9 +68,7 @@ def resolve_column(sel, role: str, names: list[str], by_name: bool, source: str)
     if index is not None and 0 <= index < n_cols:
         return index
     what = f"column {sel}" if index is not None else f'column "{sel}"'
-    raise InputFileError(
-        f"{source}: no {what} for {role}; the file has {n_cols} columns (index:name): {listing}"
-    )
+    raise InputFileError(f"{source}: no {what} for {role}; the file has {n_cols} columns (index:name): {listing}")
 
 
 def check_distinct(ix: int, iy: int, names: list[str], source: str, noun: str = "column") -> None:

@@ -8,9 +8,9 @@ import re
 
 import numpy as np
 
-from ..errors import InputFileError, TvoronoiError
 from tvoronoi.fileio import gc_paused
 
+from ..errors import InputFileError, TvoronoiError
 from .pointset import PointSet
 
 GEOMETRY_TYPES = (
@@ -27,9 +27,7 @@ GEOMETRY_TYPES = (
 def _describe(value) -> str:
     if isinstance(value, dict):
         return f'an object of type "{value["type"]}"' if "type" in value else "an object without a type"
-    return {list: "a list", str: "a string", bool: "a boolean", type(None): "null"}.get(
-        type(value), "a number"
-    )
+    return {list: "a list", str: "a string", bool: "a boolean", type(None): "null"}.get(type(value), "a number")
 
 
 def _geojson_sites(doc, source: str):
@@ -50,7 +48,7 @@ def _geojson_sites(doc, source: str):
         labelled = iter([("the geometry", {"type": "Feature", "geometry": doc, "properties": None})])
     elif kind in GEOMETRY_TYPES:
         raise InputFileError(
-            f'{source}: the file is a single {kind} geometry; tvoronoi reads Point and MultiPoint geometries'
+            f"{source}: the file is a single {kind} geometry; tvoronoi reads Point and MultiPoint geometries"
         )
     else:
         raise InputFileError(
@@ -194,8 +192,9 @@ def read_geojson(data: bytes, source: str, x, y, loads) -> PointSet:
         )
     crs = _crs_member(doc, source)
     # the document is not kept: ``where`` holds one label per site at most
-    return PointSet(xy, source, {}, records if any(records) else None, crs=crs,
-                    lonlat=crs is None or crs == CRS84, where=where)
+    return PointSet(
+        xy, source, {}, records if any(records) else None, crs=crs, lonlat=crs is None or crs == CRS84, where=where
+    )
 
 
 def _crs_member(doc, source: str) -> str | None:
@@ -220,4 +219,3 @@ def _crs_member(doc, source: str) -> str | None:
     if (authority, code) in (("OGC", "CRS84"), ("EPSG", "4326")):
         return CRS84
     return f"{authority}:{code}"
-

@@ -7,7 +7,7 @@ import io
 import numpy as np
 
 from ..errors import InputFileError
-from .columns import LAT_NAMES, LON_NAMES, check_distinct, col_name, resolve_column, describe_choice, is_id_like
+from .columns import LAT_NAMES, LON_NAMES, check_distinct, col_name, describe_choice, is_id_like, resolve_column
 from .pointset import PointSet, json_column
 
 NPY_MAGIC = b"\x93NUMPY"
@@ -94,8 +94,16 @@ def _structured_npy(array: np.ndarray, source: str, x, y) -> PointSet:
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
     every = tuple(name for name in names if array.dtype[name].kind in "iuf" and not array.dtype[name].shape)
     ambiguous = x is None and y is None and how != "by name" and len(every) > 2
-    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, xy_columns=(names[ix], names[iy]),
-                    candidates=every if ambiguous else (), where=lambda i: f"row {i} (0-based)")
+    return PointSet(
+        xy,
+        source,
+        columns,
+        lonlat=lonlat,
+        choice=choice,
+        xy_columns=(names[ix], names[iy]),
+        candidates=every if ambiguous else (),
+        where=lambda i: f"row {i} (0-based)",
+    )
 
 
 def _check_finite_rows(xy: np.ndarray, source: str) -> None:
@@ -103,7 +111,4 @@ def _check_finite_rows(xy: np.ndarray, source: str) -> None:
     if finite.all():
         return
     i, k = np.argwhere(~finite)[0]
-    raise InputFileError(
-        f"{source}, row {i} (0-based): {'xy'[k]} is {xy[i, k]}; tvoronoi needs finite coordinates"
-    )
-
+    raise InputFileError(f"{source}, row {i} (0-based): {'xy'[k]} is {xy[i, k]}; tvoronoi needs finite coordinates")

@@ -7,7 +7,7 @@ import io
 import numpy as np
 
 from ..errors import InputFileError, TvoronoiError
-from .columns import LAT_NAMES, LON_NAMES, check_distinct, resolve_column, describe_choice, is_id_like
+from .columns import LAT_NAMES, LON_NAMES, check_distinct, describe_choice, is_id_like, resolve_column
 from .pointset import PointSet
 
 PARQUET_MAGIC = b"PAR1"
@@ -20,7 +20,9 @@ def read_parquet(data: bytes, source: str, x, y) -> PointSet:
         import orjson
         import pyarrow.parquet as pq
     except ImportError:
-        raise TvoronoiError(f"{source}: reading Parquet needs pyarrow, which is not installed: {INSTALL_HINT}") from None
+        raise TvoronoiError(
+            f"{source}: reading Parquet needs pyarrow, which is not installed: {INSTALL_HINT}"
+        ) from None
     if not data:
         raise InputFileError(f"{source}: no points found (the file is empty)")
     try:
@@ -73,8 +75,11 @@ def _xy_table(table, source: str, x, y) -> PointSet:
     import pyarrow.types as pt
 
     names = table.column_names
-    numeric = [j for j, name in enumerate(names) if pt.is_integer(table.schema.field(name).type)
-               or pt.is_floating(table.schema.field(name).type)]
+    numeric = [
+        j
+        for j, name in enumerate(names)
+        if pt.is_integer(table.schema.field(name).type) or pt.is_floating(table.schema.field(name).type)
+    ]
     ix = resolve_column(x, "x", names, True, source)
     iy = resolve_column(y, "y", names, True, source)
     how, skipped = "by name", []
@@ -87,8 +92,7 @@ def _xy_table(table, source: str, x, y) -> PointSet:
     if ix is None or iy is None:
         ids = f" (id-like columns are not taken: {', '.join(skipped)})" if skipped else ""
         raise InputFileError(
-            f"{source}: no geo metadata and no x and y columns among {', '.join(names)}{ids}; "
-            f"choose them with --x/--y"
+            f"{source}: no geo metadata and no x and y columns among {', '.join(names)}{ids}; choose them with --x/--y"
         )
     check_distinct(ix, iy, names, source)
     for j in (ix, iy):
@@ -104,16 +108,25 @@ def _xy_table(table, source: str, x, y) -> PointSet:
         values = table.column(j)
         if values.null_count:
             i = int(np.flatnonzero(values.is_null().to_numpy(zero_copy_only=False))[0])
-            raise InputFileError(f'{source}, row {i} (0-based): column "{names[j]}" is null; tvoronoi needs finite coordinates')
+            raise InputFileError(
+                f'{source}, row {i} (0-based): column "{names[j]}" is null; tvoronoi needs finite coordinates'
+            )
         xy[:, k] = values.to_numpy()
     _check_finite(xy, source)
     columns = _properties(table, [j for j in range(len(names)) if j not in (ix, iy)])
     lonlat = names[ix].lower() in LON_NAMES and names[iy].lower() in LAT_NAMES
     choice = describe_choice(names, ix, iy, how, skipped) if x is None or y is None else None
     ambiguous = x is None and y is None and how != "by name" and len(numeric) > 2
-    return PointSet(xy, source, columns, lonlat=lonlat, choice=choice, xy_columns=(names[ix], names[iy]),
-                    candidates=tuple(names[j] for j in numeric) if ambiguous else (),
-                    where=lambda i: f"row {i} (0-based)")
+    return PointSet(
+        xy,
+        source,
+        columns,
+        lonlat=lonlat,
+        choice=choice,
+        xy_columns=(names[ix], names[iy]),
+        candidates=tuple(names[j] for j in numeric) if ambiguous else (),
+        where=lambda i: f"row {i} (0-based)",
+    )
 
 
 def _check_finite(xy: np.ndarray, source: str) -> None:

@@ -13,7 +13,10 @@ from typing import Iterator
 
 import numpy as np
 
+from tvoronoi.fileio import gc_paused
+
 from ..errors import InputFileError
+from .bulk_csv import bulk_columns, typed_column
 from .columns import (
     LAT_NAMES,
     LON_NAMES,
@@ -22,13 +25,10 @@ from .columns import (
     as_index,
     check_distinct,
     col_name,
-    resolve_column,
     describe_choice,
     is_id_like,
+    resolve_column,
 )
-from tvoronoi.fileio import gc_paused
-
-from .bulk_csv import bulk_columns, typed_column
 from .pointset import PointSet, convert_column
 
 LAYOUT_CHARS = 1 << 16
@@ -262,8 +262,17 @@ def table_layout(text: str, source: str, kind: str, x, y, delimiter: str = ",") 
     choice = None
     if x is None or y is None:
         choice = describe_choice(names, ix, iy, how if x is None and y is None else "by option and " + how, skipped)
-    return _Layout(names, has_header, header_lines, first_line, ix, iy, delimiter, choice,
-                   candidates if how == "the first numeric columns" else ())
+    return _Layout(
+        names,
+        has_header,
+        header_lines,
+        first_line,
+        ix,
+        iy,
+        delimiter,
+        choice,
+        candidates if how == "the first numeric columns" else (),
+    )
 
 
 def _is_header(fields: list[str], x, y, records: Iterator[tuple[int, list[str]]], number=_is_number) -> bool:
@@ -350,8 +359,12 @@ def fast_table(body: str, kind: str, layout: _Layout, *, bulk: bool = True):
             warnings.simplefilter("ignore")
             if kind == "csv":
                 table = np.loadtxt(
-                    io.StringIO(body), dtype=np.float64, delimiter=layout.delimiter, quotechar=QUOTE,
-                    comments=None, ndmin=2,
+                    io.StringIO(body),
+                    dtype=np.float64,
+                    delimiter=layout.delimiter,
+                    quotechar=QUOTE,
+                    comments=None,
+                    ndmin=2,
                 )
             else:
                 table = np.loadtxt(io.StringIO(body), dtype=np.float64, comments=COMMENT, ndmin=2)
@@ -411,11 +424,19 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
         table = pacsv.read_csv(
             pa.py_buffer(body.encode()),
             read_options=pacsv.ReadOptions(column_names=names),
-            parse_options=pacsv.ParseOptions(delimiter=layout.delimiter, quote_char=False,
-                                             double_quote=False, escape_char=False, newlines_in_values=False,
-                                             ignore_empty_lines=False),
-            convert_options=pacsv.ConvertOptions(column_types={name: pa.string() for name in names},
-                                                 strings_can_be_null=False, quoted_strings_can_be_null=False),
+            parse_options=pacsv.ParseOptions(
+                delimiter=layout.delimiter,
+                quote_char=False,
+                double_quote=False,
+                escape_char=False,
+                newlines_in_values=False,
+                ignore_empty_lines=False,
+            ),
+            convert_options=pacsv.ConvertOptions(
+                column_types={name: pa.string() for name in names},
+                strings_can_be_null=False,
+                quoted_strings_can_be_null=False,
+            ),
             memory_pool=pool,
         )
     except (pa.ArrowInvalid, pa.ArrowTypeError):
@@ -501,8 +522,15 @@ def slow_table(text: str, source: str, kind: str, layout: _Layout) -> PointSet:
         r = bad[0]
         for j, role in ((ix, "x"), (iy, "y")):
             text = columns[j][r]
-            _coordinate(_decimal_points([text], layout.delimiter)[0], role, names[j], line_nos[r], source,
-                        layout.has_header, text)
+            _coordinate(
+                _decimal_points([text], layout.delimiter)[0],
+                role,
+                names[j],
+                line_nos[r],
+                source,
+                layout.has_header,
+                text,
+            )
     points = PointSet(xy, source, _extras(columns, layout, text))
     points.where = np.asarray(line_nos, np.int64).__getitem__
     return points
@@ -554,8 +582,9 @@ def _row_shape(layout: _Layout) -> str:
     return f"the first row (line {layout.first_line}) has {n_cols}"
 
 
-def _coordinate(text: str, role: str, name: str, line_no: int, source: str, named: bool,
-                written: str | None = None) -> float:
+def _coordinate(
+    text: str, role: str, name: str, line_no: int, source: str, named: bool, written: str | None = None
+) -> float:
     column = f'column "{name}"' if name == role else f'column "{name}" ({role})'
     try:
         value = float(text)
@@ -569,8 +598,5 @@ def _coordinate(text: str, role: str, name: str, line_no: int, source: str, name
         shown = text.strip()
         if shown.lower().lstrip("+-") not in ("nan", "inf", "infinity"):
             shown += " (it overflows to infinity)"
-        raise InputFileError(
-            f"{source}, line {line_no}: {who} is {shown}; tvoronoi needs finite coordinates"
-        )
+        raise InputFileError(f"{source}, line {line_no}: {who} is {shown}; tvoronoi needs finite coordinates")
     return value
-

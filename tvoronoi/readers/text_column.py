@@ -141,5 +141,9 @@ class TextColumn(Sequence):
         if self.valid is not None:
             validity = pa.py_buffer(np.packbits(self.valid, bitorder="little"))
         kind, index = (pa.string(), np.int32) if len(data) < 2**31 else (pa.large_string(), np.int64)
-        return pa.Array.from_buffers(kind, len(self), [validity, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)],
-                                     null_count=-1 if validity is not None else 0)
+        return pa.Array.from_buffers(
+            kind,
+            len(self),
+            [validity, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)],
+            null_count=-1 if validity is not None else 0,
+        )

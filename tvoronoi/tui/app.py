@@ -62,6 +62,7 @@ PARAMETERS = {
     "clustered": (("clusters", int), ("spread", float)),
 }
 
+
 class Workspace(Horizontal):
     """The canvas and the side panel, as wide as the terminal: its resizes are the terminal's."""
 
@@ -139,8 +140,16 @@ class VoronoiApp(App[int]):
         *editing.BINDINGS,
     ]
 
-    def __init__(self, points: Any = None, *, path: str | Path | None = None, x: str | None = None,
-                 y: str | None = None, engine: str = "incremental", clock: Clock = time.perf_counter) -> None:
+    def __init__(
+        self,
+        points: Any = None,
+        *,
+        path: str | Path | None = None,
+        x: str | None = None,
+        y: str | None = None,
+        engine: str = "incremental",
+        clock: Clock = time.perf_counter,
+    ) -> None:
         super().__init__()
         self.initial_points = None if points is None else np.asarray(points, np.float64)
         self.initial_file = None if path is None else OpenRequest(Path(path), x, y)
@@ -172,7 +181,10 @@ class VoronoiApp(App[int]):
                         yield _tip(
                             PanelSelect(
                                 [(name, name) for name in DISTRIBUTIONS],
-                                value=DEFAULT_DISTRIBUTION, allow_blank=False, compact=True, id="distribution",
+                                value=DEFAULT_DISTRIBUTION,
+                                allow_blank=False,
+                                compact=True,
+                                id="distribution",
                             ),
                             "How the points are spread: uniform in the unit square, one gaussian blob, "
                             "or gaussian clusters",
@@ -218,7 +230,10 @@ class VoronoiApp(App[int]):
                     yield _tip(
                         PanelSelect(
                             [(name, name) for name in ENGINES],
-                            value=self.initial_engine, allow_blank=False, compact=True, id="engine",
+                            value=self.initial_engine,
+                            allow_blank=False,
+                            compact=True,
+                            id="engine",
                         ),
                         "The algorithm that builds the diagram: randomized incremental "
                         "(Delaunay, then its dual) or Fortune's sweepline",
@@ -316,12 +331,19 @@ class VoronoiApp(App[int]):
         """The engine chosen in the panel."""
         return str(self.query_one("#engine", Select).value)
 
-    def request_build(self, make_points: Callable[[], Any], *, source: str, size: int | None,
-                      fit: bool = True, point_set: PointSet | None = None,
-                      read: Callable[[], PointSet] | None = None, bbox: Box | None = None) -> None:
+    def request_build(
+        self,
+        make_points: Callable[[], Any],
+        *,
+        source: str,
+        size: int | None,
+        fit: bool = True,
+        point_set: PointSet | None = None,
+        read: Callable[[], PointSet] | None = None,
+        bbox: Box | None = None,
+    ) -> None:
         """Build a whole diagram and show it (see ``Building.request``)."""
-        self.building.request(make_points, source=source, size=size, fit=fit, point_set=point_set, read=read,
-                              bbox=bbox)
+        self.building.request(make_points, source=source, size=size, fit=fit, point_set=point_set, read=read, bbox=bbox)
 
     def fail(self, error: str) -> None:
         """Tell the user that nothing was built; the last good diagram stays."""
@@ -541,7 +563,7 @@ class VoronoiApp(App[int]):
         left, right = self._status_text, self._view_text
         room = status.content_size.width or max(self.size.width - 2, 0)
         if len(left) + 2 + len(right) > room:
-            right = right[right.rindex(" ") + 1:] if right else ""  # the zoom alone
+            right = right[right.rindex(" ") + 1 :] if right else ""  # the zoom alone
             if len(left) + 2 + len(right) > room:
                 right = ""
         line = Text(left, no_wrap=True, overflow="ellipsis")
@@ -635,8 +657,9 @@ class VoronoiApp(App[int]):
         if built is None:
             return
         if self.player is not None:
-            self.notify("relaxing changes the sites: end playback first (t)", title="Not relaxed",
-                        severity="warning", timeout=5)
+            self.notify(
+                "relaxing changes the sites: end playback first (t)", title="Not relaxed", severity="warning", timeout=5
+            )
             return
         source = relaxed_source(built.source)
         live = self.live
@@ -647,8 +670,9 @@ class VoronoiApp(App[int]):
         else:
             points = relaxed_points(built.diagram, built.points)
             bbox = built.diagram.bbox
-        self.request_build(lambda: points, source=source, size=len(points), fit=False,
-                           point_set=built.point_set, bbox=bbox)
+        self.request_build(
+            lambda: points, source=source, size=len(points), fit=False, point_set=built.point_set, bbox=bbox
+        )
 
     def action_toggle_delaunay(self) -> None:
         """Show or hide the Delaunay triangulation over the cells."""
@@ -772,6 +796,7 @@ class VoronoiApp(App[int]):
         rows.append(("tab", "next control"))
         rows.append(("ctrl+p", "command palette (themes, screenshot, quit)"))
         return rows
+
 
 # Second bindings of a key, already in the help under the first.
 HELP_HIDDEN = {"toggle_legend('playback')"}

@@ -37,8 +37,14 @@ class Built:
     source: str
 
 
-def build(points: np.ndarray, engine: str, source: str, clock: Clock, point_set: PointSet | None = None,
-          bbox: Box | None = None) -> Built:
+def build(
+    points: np.ndarray,
+    engine: str,
+    source: str,
+    clock: Clock,
+    point_set: PointSet | None = None,
+    bbox: Box | None = None,
+) -> Built:
     """Build the diagram of some points and prepare it for drawing (any thread)."""
     start = clock()
     diagram = tvoronoi.voronoi(points, engine=engine, bbox=bbox)
@@ -96,9 +102,17 @@ class Building:
         self.running: str | None = None
         self._request = 0
 
-    def request(self, make_points: Callable[[], np.ndarray], *, source: str, size: int | None,
-                fit: bool = True, point_set: PointSet | None = None,
-                read: Callable[[], PointSet] | None = None, bbox: Box | None = None) -> None:
+    def request(
+        self,
+        make_points: Callable[[], np.ndarray],
+        *,
+        source: str,
+        size: int | None,
+        fit: bool = True,
+        point_set: PointSet | None = None,
+        read: Callable[[], PointSet] | None = None,
+        bbox: Box | None = None,
+    ) -> None:
         """Build a diagram now, or in a worker thread when it is large or its size unknown.
 
         ``make_points`` gives the sites; ``read``, if given, instead gives a
@@ -128,8 +142,13 @@ class Building:
         else:
             what = f"{size:,} sites" if size is not None else source
             self._show_running(f"building {what} with {engine}…")
-            self.host.run_worker(lambda: self._build_in_thread(request, job, fit), thread=True,
-                                 exclusive=True, group="build", exit_on_error=False)
+            self.host.run_worker(
+                lambda: self._build_in_thread(request, job, fit),
+                thread=True,
+                exclusive=True,
+                group="build",
+                exit_on_error=False,
+            )
 
     def _show_running(self, text: str | None) -> None:
         """Say that a build runs (text) or that none does (None).

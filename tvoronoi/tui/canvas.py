@@ -41,7 +41,6 @@ MAX_ZOOM_OUT = 50.0
 PLAIN_COLOR_SYSTEMS = ("standard", "windows")
 
 
-
 def plain_terminal(app) -> bool:
     """Whether the app's terminal shows no colours (NO_COLOR) or only 16: cells are not filled then."""
     if app.no_color:
@@ -388,13 +387,23 @@ class DiagramCanvas(Widget, can_focus=True):
         elif base != self._base_key or not self._redraw_changes(scene, size, palette):
             # the cells under the characters stay while the scene, its version, the view and size do
             # (the scene itself is held, so that another scene cannot take its id)
-            same = (self._owner_key is not None and self._owner_key[0] is scene
-                    and self._owner_key[1:] == (version, self.view, size))
+            same = (
+                self._owner_key is not None
+                and self._owner_key[0] is scene
+                and self._owner_key[1:] == (version, self.view, size)
+            )
             owner = self._frame.owner if self._frame is not None and same else None
             self._frame = rasterize(
-                scene, self.view, size.width, size.height,
-                delaunay=self.show_delaunay, vertices=self.show_vertices,
-                overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled, layers=self._layers,
+                scene,
+                self.view,
+                size.width,
+                size.height,
+                delaunay=self.show_delaunay,
+                vertices=self.show_vertices,
+                overlay=self.overlay,
+                cursor=self.cursor,
+                site_blocks=not palette.filled,
+                layers=self._layers,
                 owner=owner,
             )
             self._lines = frame_lines(self._frame, palette)
@@ -444,9 +453,20 @@ class DiagramCanvas(Widget, can_focus=True):
         if ids is not None:
             part_view = self.view.window(c0, r0, cols, rows)
             owner = scene.update_owner(frame.owner[r0:r1, c0:c1], ids, part_view, c1 - c0, r1 - r0)
-        redraw_part(frame, scene, self.view, cols, rows, (c0, r0, c1, r1), owner=owner,
-                    delaunay=self.show_delaunay, vertices=self.show_vertices,
-                    overlay=self.overlay, cursor=self.cursor, site_blocks=not palette.filled)
+        redraw_part(
+            frame,
+            scene,
+            self.view,
+            cols,
+            rows,
+            (c0, r0, c1, r1),
+            owner=owner,
+            delaunay=self.show_delaunay,
+            vertices=self.show_vertices,
+            overlay=self.overlay,
+            cursor=self.cursor,
+            site_blocks=not palette.filled,
+        )
         part = Frame(frame.codes[r0:r1], frame.mark[r0:r1], frame.fill[r0:r1], frame.owner[r0:r1])
         self._lines[r0:r1] = frame_lines(part, palette)
         return True

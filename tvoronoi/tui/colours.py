@@ -30,7 +30,7 @@ CUBE_LEVELS = (0x00, 0x5F, 0x87, 0xAF, 0xD7, 0xFF)
 
 def cube_shift(colour: str, steps: int) -> str:
     """A cube colour moved ``steps`` levels up (lighter) or down on every channel, within the cube."""
-    channels = [int(colour[k:k + 2], 16) for k in (1, 3, 5)]
+    channels = [int(colour[k : k + 2], 16) for k in (1, 3, 5)]
     levels = [min(range(6), key=lambda i: abs(CUBE_LEVELS[i] - c)) for c in channels]
     return "#" + "".join(f"{CUBE_LEVELS[min(max(lv + steps, 0), 5)]:02x}" for lv in levels)
 
@@ -156,12 +156,26 @@ LIGHT = Palette(
 # marks drawn over them get lost. These palettes draw no fills: grey edges, and sites
 # in the brightest (darkest) colour there is, which stays the brightest (darkest) grey.
 PLAIN_DARK = replace(
-    DARK, filled=False, edge="#808080", site="#ffff00", vertex="#ff0000", delaunay="#008080",
-    cursor="#ff00ff", walk="#00ffff", plain_highlight="#000080",
+    DARK,
+    filled=False,
+    edge="#808080",
+    site="#ffff00",
+    vertex="#ff0000",
+    delaunay="#008080",
+    cursor="#ff00ff",
+    walk="#00ffff",
+    plain_highlight="#000080",
 )
 PLAIN_LIGHT = replace(
-    LIGHT, filled=False, edge="#808080", site="#000000", vertex="#800000", delaunay="#008080",
-    cursor="#800080", walk="#000080", plain_highlight="#c0c0c0",
+    LIGHT,
+    filled=False,
+    edge="#808080",
+    site="#000000",
+    vertex="#800000",
+    delaunay="#008080",
+    cursor="#800080",
+    walk="#000080",
+    plain_highlight="#c0c0c0",
 )
 
 
@@ -381,4 +395,4 @@ def adjacency_lists(n: int, a: np.ndarray, b: np.ndarray):
     dst = dst[order]
     offsets = np.zeros(n + 1, np.int64)
     np.cumsum(np.bincount(src, minlength=n), out=offsets[1:])
-    return lambda i: dst[offsets[i]:offsets[i + 1]]
+    return lambda i: dst[offsets[i] : offsets[i + 1]]

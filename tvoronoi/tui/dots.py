@@ -17,8 +17,9 @@ DOT_BITS = np.array([[0x01, 0x08], [0x02, 0x10], [0x04, 0x20], [0x40, 0x80]], np
 SPACE = 0x20
 
 
-def segment_dots(dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tuple[int, int] = (0, 0),
-                 ends: bool = True) -> None:
+def segment_dots(
+    dots: np.ndarray, u0, v0, u1, v1, *, dash: int = 0, origin: tuple[int, int] = (0, 0), ends: bool = True
+) -> None:
     """Set the dots along many segments at once.
 
     Each segment is sampled once per dot along its longer axis (a vectorised
@@ -130,9 +131,15 @@ def _clip(u0, v0, u1, v1, width: float, height: float):
     keep &= t0 <= t1
     # an end the clip did not move is returned as given (u0 + 1 * du can differ from u1 by an ulp)
     start, end = t0 == 0, t1 == 1
-    return (keep, t0, t1,
-            np.where(start, u0, u0 + t0 * du), np.where(start, v0, v0 + t0 * dv),
-            np.where(end, u1, u0 + t1 * du), np.where(end, v1, v0 + t1 * dv))
+    return (
+        keep,
+        t0,
+        t1,
+        np.where(start, u0, u0 + t0 * du),
+        np.where(start, v0, v0 + t0 * dv),
+        np.where(end, u1, u0 + t1 * du),
+        np.where(end, v1, v0 + t1 * dv),
+    )
 
 
 def clip_segments(seg: np.ndarray, bbox) -> np.ndarray:
@@ -141,8 +148,9 @@ def clip_segments(seg: np.ndarray, bbox) -> np.ndarray:
     if not len(seg):
         return seg
     xmin, ymin, xmax, ymax = (float(c) for c in bbox)
-    keep, _, _, u0, v0, u1, v1 = _clip(seg[:, 0] - xmin, seg[:, 1] - ymin, seg[:, 2] - xmin, seg[:, 3] - ymin,
-                                       xmax - xmin, ymax - ymin)
+    keep, _, _, u0, v0, u1, v1 = _clip(
+        seg[:, 0] - xmin, seg[:, 1] - ymin, seg[:, 2] - xmin, seg[:, 3] - ymin, xmax - xmin, ymax - ymin
+    )
     out = np.column_stack([u0 + xmin, v0 + ymin, u1 + xmin, v1 + ymin])
     return out[keep & np.isfinite(out).all(axis=1)]
 

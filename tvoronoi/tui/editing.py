@@ -18,8 +18,8 @@ import tvoronoi
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.tui.building import Built, Clock
 from tvoronoi.tui.canvas import DiagramCanvas
-from tvoronoi.tui.host import Host
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.live import LiveScene
 from tvoronoi.tui.playback import Player
 
@@ -55,8 +55,17 @@ HELP = {
 # How the help names the keys of an action, where its own names are too many.
 HELP_KEYS = {"cursor(-1, 0)": "shift+arrows"}
 # Bindings the help leaves out (explained with another line).
-HELP_HIDDEN = {"nudge(-1, 0)", "nudge(1, 0)", "nudge(0, -1)", "nudge(0, 1)", "drop_site", "cancel_move",
-               "cursor(1, 0)", "cursor(0, -1)", "cursor(0, 1)"}
+HELP_HIDDEN = {
+    "nudge(-1, 0)",
+    "nudge(1, 0)",
+    "nudge(0, -1)",
+    "nudge(0, 1)",
+    "drop_site",
+    "cancel_move",
+    "cursor(1, 0)",
+    "cursor(0, -1)",
+    "cursor(0, 1)",
+}
 
 EDITING_ACTIONS = {"add_site", "remove_site", "move_site", "toggle_cursor", "cursor"}
 MOVING_ACTIONS = {"nudge", "drop_site", "cancel_move"}
@@ -89,8 +98,17 @@ class EditingHost(Host, Protocol):
     def built(self) -> Built | None: ...
     @property
     def player(self) -> Player | None: ...
-    def request_build(self, make_points: Callable[[], Any], *, source: str, size: int | None,
-                      fit: bool = ..., point_set: Any = ..., read: Any = ..., bbox: Any = ...) -> None: ...
+    def request_build(
+        self,
+        make_points: Callable[[], Any],
+        *,
+        source: str,
+        size: int | None,
+        fit: bool = ...,
+        point_set: Any = ...,
+        read: Any = ...,
+        bbox: Any = ...,
+    ) -> None: ...
     def set_status(self, text: str) -> None: ...
     def update_status(self) -> None: ...
     def refresh_bindings(self) -> None: ...
@@ -123,8 +141,13 @@ class Editing:
         built = self.host.built
         if built is None or len(built.points) > PREPARE_MAX_SITES:
             return
-        self.host.run_worker(lambda: self._prepare_in_thread(built), thread=True, exclusive=True,
-                             group="prepare-editing", exit_on_error=False)
+        self.host.run_worker(
+            lambda: self._prepare_in_thread(built),
+            thread=True,
+            exclusive=True,
+            group="prepare-editing",
+            exit_on_error=False,
+        )
 
     def _prepare_in_thread(self, built: Built) -> None:
         try:
@@ -203,8 +226,9 @@ class Editing:
         where = canvas.cursor if canvas.cursor is not None else canvas.pointer
         site = None if where is None else canvas.site_at(*where)
         if site is None:
-            self.host.notify("no site under the cursor: move it onto one (shift+arrows) or point at one",
-                             severity="warning")
+            self.host.notify(
+                "no site under the cursor: move it onto one (shift+arrows) or point at one", severity="warning"
+            )
         return site
 
     def _one_char(self) -> tuple[float, float]:

@@ -74,8 +74,7 @@ class ViewPicture:
 
 def view_window(view: View, cols: int, rows: int) -> tuple[float, float, float, float]:
     """The world box (x0, y0, x1, y1) a canvas of ``cols x rows`` characters shows."""
-    (x0, x1), (y1, y0) = view.to_world(np.array([0.0, cols * DOT_COLS]), np.array([0.0, rows * DOT_ROWS]),
-                                       cols, rows)
+    (x0, x1), (y1, y0) = view.to_world(np.array([0.0, cols * DOT_COLS]), np.array([0.0, rows * DOT_ROWS]), cols, rows)
     return float(x0), float(y0), float(x1), float(y1)
 
 
@@ -96,8 +95,12 @@ def visible_cells(offsets: np.ndarray, xy: np.ndarray, window) -> np.ndarray:
     x0, y0, x1, y1 = window
     starts = offsets[:-1][full]
     xs, ys = xy[:, 0], xy[:, 1]
-    overlap = ((np.minimum.reduceat(xs, starts) <= x1) & (np.maximum.reduceat(xs, starts) >= x0)
-               & (np.minimum.reduceat(ys, starts) <= y1) & (np.maximum.reduceat(ys, starts) >= y0))
+    overlap = (
+        (np.minimum.reduceat(xs, starts) <= x1)
+        & (np.maximum.reduceat(xs, starts) >= x0)
+        & (np.minimum.reduceat(ys, starts) <= y1)
+        & (np.maximum.reduceat(ys, starts) >= y0)
+    )
     # each side: from a ring point to the next one of its ring (wrapping round)
     nxt = ring_next(offsets, len(xy))
     ax, ay, bx, by = xs, ys, xs[nxt], ys[nxt]
@@ -109,8 +112,9 @@ def visible_cells(offsets: np.ndarray, xy: np.ndarray, window) -> np.ndarray:
     return seen
 
 
-def picture(scene, view: View, cols: int, rows: int, palette: Palette, *, dark: bool,
-            delaunay: bool, diagram=None) -> ViewPicture:
+def picture(
+    scene, view: View, cols: int, rows: int, palette: Palette, *, dark: bool, delaunay: bool, diagram=None
+) -> ViewPicture:
     """The picture of what a canvas of ``cols x rows`` shows of ``scene`` through ``view``.
 
     ``diagram`` is the scene's diagram when its cell i is the scene's site row i (a built
@@ -130,7 +134,7 @@ def picture(scene, view: View, cols: int, rows: int, palette: Palette, *, dark: 
     xy = np.asarray(diagram.cell_points, np.float64)[np.asarray(diagram.cell_vertices, np.int64)]
     seen = np.flatnonzero(visible_cells(offsets, xy, window))
     fills = palette.fills
-    rings = [xy[offsets[i]:offsets[i + 1]] for i in seen.tolist()]
+    rings = [xy[offsets[i] : offsets[i + 1]] for i in seen.tolist()]
     ring_colours = [fills[int(colours[ids[i]]) % len(fills)] for i in seen.tolist()]
     sites = np.asarray(diagram.sites, np.float64)
     x0, y0, x1, y1 = window
@@ -138,21 +142,35 @@ def picture(scene, view: View, cols: int, rows: int, palette: Palette, *, dark: 
     links = np.asarray(scene.delaunay, np.float64).reshape(-1, 4) if delaunay else np.empty((0, 4))
     links = links[np.isfinite(links).all(axis=1)]
     if len(links):
-        keep = ((np.maximum(links[:, 0], links[:, 2]) >= x0) & (np.minimum(links[:, 0], links[:, 2]) <= x1)
-                & (np.maximum(links[:, 1], links[:, 3]) >= y0) & (np.minimum(links[:, 1], links[:, 3]) <= y1))
+        keep = (
+            (np.maximum(links[:, 0], links[:, 2]) >= x0)
+            & (np.minimum(links[:, 0], links[:, 2]) <= x1)
+            & (np.maximum(links[:, 1], links[:, 3]) >= y0)
+            & (np.minimum(links[:, 1], links[:, 3]) <= y1)
+        )
         links = links[keep]
     has_cell = np.diff(offsets) > 0
     xmin, ymin, xmax, ymax = diagram.bbox
     return ViewPicture(
-        rings=rings, colours=ring_colours, sites=sites[shown], delaunay=links, window=window, view=view,
-        cols=cols, rows=rows, palette=palette, background=BACKGROUND[dark],
-        owners=sites[has_cell], owner_colours=[fills[int(colours[i]) % len(fills)] for i in ids[has_cell]],
+        rings=rings,
+        colours=ring_colours,
+        sites=sites[shown],
+        delaunay=links,
+        window=window,
+        view=view,
+        cols=cols,
+        rows=rows,
+        palette=palette,
+        background=BACKGROUND[dark],
+        owners=sites[has_cell],
+        owner_colours=[fills[int(colours[i]) % len(fills)] for i in ids[has_cell]],
         bbox=(float(xmin), float(ymin), float(xmax), float(ymax)),
     )
 
 
 # ---------------------------------------------------------------------------
 # SVG
+
 
 def _points_attr(px: np.ndarray) -> str:
     return " ".join(f"{x:.2f},{y:.2f}" for x, y in px.tolist())
@@ -191,6 +209,7 @@ def to_svg(pic: ViewPicture) -> str:
 # ---------------------------------------------------------------------------
 # PNG
 
+
 def _rgb(colour: str) -> tuple[int, int, int]:
     return int(colour[1:3], 16), int(colour[3:5], 16), int(colour[5:7], 16)
 
@@ -225,14 +244,15 @@ def rasterise(pic: ViewPicture) -> np.ndarray:
     edge[1:, :] |= owner[1:, :] != owner[:-1, :]
     image[edge] = _rgb(pic.palette.edge)
     if len(pic.delaunay):
-        _draw_segments(image, pic.to_px(pic.delaunay[:, :2]), pic.to_px(pic.delaunay[:, 2:]),
-                       _rgb(pic.palette.delaunay))
+        _draw_segments(
+            image, pic.to_px(pic.delaunay[:, :2]), pic.to_px(pic.delaunay[:, 2:]), _rgb(pic.palette.delaunay)
+        )
     if len(pic.sites):
         px = pic.to_px(pic.sites)
         r = int(np.ceil(SITE_RADIUS_PX))
         for dy in range(-r, r + 1):
             for dx in range(-r, r + 1):
-                if dx * dx + dy * dy > SITE_RADIUS_PX ** 2:
+                if dx * dx + dy * dy > SITE_RADIUS_PX**2:
                     continue
                 cx = np.floor(px[:, 0]).astype(np.int64) + dx
                 cy = np.floor(px[:, 1]).astype(np.int64) + dy
@@ -264,8 +284,12 @@ def png_bytes(image: np.ndarray) -> bytes:
         return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
 
     header = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
-            + chunk(b"IEND", b""))
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(raw.tobytes(), 6))
+        + chunk(b"IEND", b"")
+    )
 
 
 def export_view(pic: ViewPicture, path: Path) -> str:

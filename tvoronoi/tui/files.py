@@ -15,8 +15,8 @@ from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.readers.pointset import PointSet
 from tvoronoi.tui.building import Built
-from tvoronoi.tui.host import Host
 from tvoronoi.tui.colours import palette_for
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.live import LiveScene
 from tvoronoi.tui.raster import Drawable, View
 from tvoronoi.tui.screens import ColumnsDialog, OpenDialog, OpenRequest, PathDialog
@@ -71,9 +71,17 @@ class FilesHost(Host, Protocol):
     def live(self) -> LiveScene | None: ...
     @property
     def current_theme(self) -> Theme: ...
-    def request_build(self, make_points: Callable[[], Any], *, source: str, size: int | None,
-                      fit: bool = ..., point_set: PointSet | None = ...,
-                      read: Callable[[], PointSet] | None = ..., bbox: Any = ...) -> None: ...
+    def request_build(
+        self,
+        make_points: Callable[[], Any],
+        *,
+        source: str,
+        size: int | None,
+        fit: bool = ...,
+        point_set: PointSet | None = ...,
+        read: Callable[[], PointSet] | None = ...,
+        bbox: Any = ...,
+    ) -> None: ...
     def fail(self, error: str) -> None: ...
     def show_progress(self, done: int = 0, total: int | None = None) -> None: ...
     def progress_done(self) -> None: ...
@@ -102,9 +110,11 @@ class Files:
         last = self.last_open
         self.host.push_screen(
             OpenDialog(
-                "Open a point file (CSV, text, GeoJSON, .npy)", placeholder="points.csv",
+                "Open a point file (CSV, text, GeoJSON, .npy)",
+                placeholder="points.csv",
                 value="" if last is None else str(last.path),
-                x=None if last is None else last.x, y=None if last is None else last.y,
+                x=None if last is None else last.x,
+                y=None if last is None else last.y,
                 folder=self.last_folder,
             ),
             self.open,
@@ -185,15 +195,19 @@ class Files:
             # an edited diagram: the live sites, numbered afresh, built in the worker
             points, engine, bbox = live.points(), built.diagram.engine, live.bbox
             what = lambda: (tvoronoi.voronoi(points, engine=engine, bbox=bbox), None)  # noqa: E731
-        self.host.run_worker(lambda: self._save_in_thread(write_cells, what, path), thread=True, group="save",
-                             exit_on_error=False)
+        self.host.run_worker(
+            lambda: self._save_in_thread(write_cells, what, path), thread=True, group="save", exit_on_error=False
+        )
 
-    def _save_in_thread(self, write_cells: Callable[..., int],
-                        what: Callable[[], tuple[Diagram, PointSet | None]], path: Path) -> None:
+    def _save_in_thread(
+        self, write_cells: Callable[..., int], what: Callable[[], tuple[Diagram, PointSet | None]], path: Path
+    ) -> None:
         try:
             diagram, point_set = what()
             count = write_cells(
-                diagram, point_set, str(path),
+                diagram,
+                point_set,
+                str(path),
                 progress=lambda done, total: self.host.post_message(SaveProgress(done, total)),
                 overwrite=True,  # the dialog asked before replacing a file
             )
@@ -221,8 +235,12 @@ class Files:
             self.host.fail("there is no diagram to export")
             return
         self.host.push_screen(
-            PathDialog("Export the view as SVG or PNG (by the name's ending)", value=self.last_export,
-                       placeholder="view.svg", confirm_overwrite=True),
+            PathDialog(
+                "Export the view as SVG or PNG (by the name's ending)",
+                value=self.last_export,
+                placeholder="view.svg",
+                confirm_overwrite=True,
+            ),
             self._export_path,
         )
 
@@ -242,20 +260,35 @@ class Files:
         cols, rows = max(size.width, 1), max(size.height, 1)
         self.host.run_worker(
             lambda: self._export_in_thread(scene, view, cols, rows, dark, delaunay, diagram, path),
-            thread=True, group="export", exit_on_error=False,
+            thread=True,
+            group="export",
+            exit_on_error=False,
         )
 
-    def _export_in_thread(self, scene: Drawable | None, view: View, cols: int, rows: int, dark: bool,
-                          delaunay: bool, diagram: Diagram | None, path: Path) -> None:
+    def _export_in_thread(
+        self,
+        scene: Drawable | None,
+        view: View,
+        cols: int,
+        rows: int,
+        dark: bool,
+        delaunay: bool,
+        diagram: Diagram | None,
+        path: Path,
+    ) -> None:
         from tvoronoi.tui.export import export_view, picture
 
         try:
-            pic = picture(scene, view, cols, rows, palette_for(dark), dark=dark, delaunay=delaunay,
-                          diagram=diagram)
+            pic = picture(scene, view, cols, rows, palette_for(dark), dark=dark, delaunay=delaunay, diagram=diagram)
             kind = export_view(pic, path)
         except (TvoronoiError, OSError) as exc:
-            self.host.call_from_thread(self.host.notify, str(exc), title="Not exported", severity="error",
-                                       timeout=8, markup=False)
+            self.host.call_from_thread(
+                self.host.notify, str(exc), title="Not exported", severity="error", timeout=8, markup=False
+            )
             return
-        self.host.call_from_thread(self.host.notify, f"{len(pic.rings):,} cells and {len(pic.sites):,} sites "
-                                   f"written to {path} ({kind})", title="Exported", markup=False)
+        self.host.call_from_thread(
+            self.host.notify,
+            f"{len(pic.rings):,} cells and {len(pic.sites):,} sites written to {path} ({kind})",
+            title="Exported",
+            markup=False,
+        )

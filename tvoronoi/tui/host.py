@@ -24,15 +24,30 @@ class Host(Protocol):
     @property
     def canvas(self) -> DiagramCanvas: ...
 
-    def notify(self, message: str, *, title: str = ..., severity: SeverityLevel = ...,
-               timeout: float | None = ..., markup: bool = ...) -> None: ...
+    def notify(
+        self,
+        message: str,
+        *,
+        title: str = ...,
+        severity: SeverityLevel = ...,
+        timeout: float | None = ...,
+        markup: bool = ...,
+    ) -> None: ...
 
     def post_message(self, message: Message) -> bool:
         """Hand a message to the App (from any thread)."""
         ...
 
-    def run_worker(self, work: Callable[[], None], name: str | None = ..., group: str = ...,
-                   description: str = ..., exit_on_error: bool = ..., start: bool = ..., exclusive: bool = ...,
-                   thread: bool = ...) -> Worker[None]:
+    def run_worker(
+        self,
+        work: Callable[[], None],
+        name: str | None = ...,
+        group: str = ...,
+        description: str = ...,
+        exit_on_error: bool = ...,
+        start: bool = ...,
+        exclusive: bool = ...,
+        thread: bool = ...,
+    ) -> Worker[None]:
         """Run ``work`` in a worker (a thread when ``thread``)."""
         ...

@@ -17,8 +17,9 @@ if TYPE_CHECKING:
 # GROWING, CONFLICT, CIRCLE, BEACH, SWEEP and EVENT belong to algorithm playback,
 # CURSOR to editing: the lowest, so that a site or edge under the keyboard cursor
 # keeps its colour (the cursor's characters are lit up by their fill instead).
-(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, WALK, CONFLICT, CIRCLE, BEACH, SWEEP,
- VERTEX, SITE, EVENT) = range(14)
+(NO_MARK, CURSOR, FUTURE, DELAUNAY, EDGE, GROWING, WALK, CONFLICT, CIRCLE, BEACH, SWEEP, VERTEX, SITE, EVENT) = range(
+    14
+)
 N_MARKS = 14
 # Fills: -1 none, 0 .. N_FILLS - 1 the cell colours, TINTED + c the tinted
 # colour c, CONFLICT_FILL the inside of a conflict region, HIGHLIGHTED + c the
@@ -75,8 +76,13 @@ class LayerCache:
         for frame in [self._used] + self._history[::-1]:
             for full, entry in frame.items():
                 old = full[2]
-                if (entry[0] is not scene or full[1] != scene.version or full[3:] != (paint.cols, paint.rows, rest)
-                        or not isinstance(old, View) or (old.ax, old.ay, old.scale) != (view.ax, view.ay, view.scale)):
+                if (
+                    entry[0] is not scene
+                    or full[1] != scene.version
+                    or full[3:] != (paint.cols, paint.rows, rest)
+                    or not isinstance(old, View)
+                    or (old.ax, old.ay, old.scale) != (view.ax, view.ay, view.scale)
+                ):
                     continue
                 dc, dr = view.dc - old.dc, view.dr - old.dr
                 kept = max(paint.cols - abs(dc), 0) * max(paint.rows - abs(dr), 0)
@@ -88,8 +94,9 @@ class LayerCache:
         cols, rows = paint.cols, paint.rows
         packed = np.zeros_like(old_packed)
         # the character (c, r) of the new view is (c + dc, r + dr) of the old one
-        packed[max(-dr, 0):rows - max(dr, 0), max(-dc, 0):cols - max(dc, 0)] = \
-            old_packed[max(dr, 0):rows - max(-dr, 0), max(dc, 0):cols - max(-dc, 0)]
+        packed[max(-dr, 0) : rows - max(dr, 0), max(-dc, 0) : cols - max(dc, 0)] = old_packed[
+            max(dr, 0) : rows - max(-dr, 0), max(dc, 0) : cols - max(-dc, 0)
+        ]
         missing = []
         if dr:  # whole rows
             missing.append((0, rows - dr, cols, rows) if dr > 0 else (0, 0, cols, -dr))
@@ -106,5 +113,5 @@ class LayerCache:
         draw is let go."""
         scenes = {id(entry[0]) for entry in self._used.values()}
         kept = [{k: e for k, e in frame.items() if id(e[0]) in scenes} for frame in self._history]
-        self._history = [frame for frame in kept + [self._used] if frame][-self.frames:]
+        self._history = [frame for frame in kept + [self._used] if frame][-self.frames :]
         self._used = {}

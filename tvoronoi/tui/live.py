@@ -53,7 +53,7 @@ class SegmentPool:
     def get(self, i: int) -> np.ndarray:
         if i >= len(self._start):
             return np.empty((0, 4))
-        return self._data[self._start[i]: self._start[i] + self._count[i]]
+        return self._data[self._start[i] : self._start[i] + self._count[i]]
 
     def _grow_ids(self, n: int) -> None:
         if n <= len(self._start):
@@ -70,17 +70,17 @@ class SegmentPool:
         k = len(segments)
         start, room = self._start[i], self._room[i]
         if k <= room:
-            self._data[start: start + k] = segments
-            self._data[start + k: start + room] = np.nan
+            self._data[start : start + k] = segments
+            self._data[start + k : start + room] = np.nan
             self._count[i] = k
             return
-        self._data[start: start + room] = np.nan
+        self._data[start : start + room] = np.nan
         if self._end + k > len(self._data):
             bigger = np.full((max(2 * len(self._data), self._end + k, 64), 4), np.nan)
             bigger[: self._end] = self._data[: self._end]
             self._data = bigger
         self._start[i], self._count[i], self._room[i] = self._end, k, k
-        self._data[self._end: self._end + k] = segments
+        self._data[self._end : self._end + k] = segments
         self._end += k
         if self._end > 2 * self.n_used + 64:
             self._compact()
@@ -89,8 +89,9 @@ class SegmentPool:
         counts = self._count
         offsets = np.zeros(len(counts) + 1, np.int64)
         np.cumsum(counts, out=offsets[1:])
-        keep = np.concatenate([np.arange(s, s + c) for s, c in zip(self._start.tolist(), counts.tolist())]
-                              + [np.empty(0, np.int64)]).astype(np.int64)
+        keep = np.concatenate(
+            [np.arange(s, s + c) for s, c in zip(self._start.tolist(), counts.tolist())] + [np.empty(0, np.int64)]
+        ).astype(np.int64)
         data = self._data[keep]
         self._data = np.concatenate([data, np.full((max(len(data) // 2, 64), 4), np.nan)])
         self._start, self._room, self._end = offsets[:-1].copy(), counts.copy(), len(data)
@@ -164,8 +165,7 @@ class LiveScene:
         link_offsets = np.zeros(n + 1, np.int64)
         np.cumsum(np.bincount(lo, minlength=n), out=link_offsets[1:])
         sites = self._sites
-        self._links = SegmentPool(np.hstack([sites[lo], sites[hi]]) if len(lo) else np.empty((0, 4)),
-                                  link_offsets)
+        self._links = SegmentPool(np.hstack([sites[lo], sites[hi]]) if len(lo) else np.empty((0, 4)), link_offsets)
         self.version = 0
         self._log: list[Change] = []
         self._drawn: np.ndarray | None = None
@@ -286,8 +286,9 @@ class LiveScene:
         for i in changed.tolist():
             ring = d.cell_polygon(i) if alive[i] else np.empty((0, 2))
             self._has_cell[i] = len(ring) > 0
-            self._boxes[i] = (ring[:, 0].min(), ring[:, 1].min(), ring[:, 0].max(), ring[:, 1].max()) \
-                if len(ring) else np.nan
+            self._boxes[i] = (
+                (ring[:, 0].min(), ring[:, 1].min(), ring[:, 0].max(), ring[:, 1].max()) if len(ring) else np.nan
+            )
             near = np.asarray(d.neighbours(i), np.int64) if len(ring) else np.empty(0, np.int64)
             near = near_of[i] = near[self._alive[near]]
             # a side shared with a smaller id is that cell's to draw
@@ -333,10 +334,12 @@ class LiveScene:
         xmin, ymin, xmax, ymax = self.bbox
         tol = ON_BOX * max(xmax - xmin, ymax - ymin, 1e-300)
         x0, y0, x1, y1 = segs.T
-        on_box = (((np.abs(x0 - xmin) <= tol) & (np.abs(x1 - xmin) <= tol))
-                  | ((np.abs(x0 - xmax) <= tol) & (np.abs(x1 - xmax) <= tol))
-                  | ((np.abs(y0 - ymin) <= tol) & (np.abs(y1 - ymin) <= tol))
-                  | ((np.abs(y0 - ymax) <= tol) & (np.abs(y1 - ymax) <= tol)))
+        on_box = (
+            ((np.abs(x0 - xmin) <= tol) & (np.abs(x1 - xmin) <= tol))
+            | ((np.abs(x0 - xmax) <= tol) & (np.abs(x1 - xmax) <= tol))
+            | ((np.abs(y0 - ymin) <= tol) & (np.abs(y1 - ymin) <= tol))
+            | ((np.abs(y0 - ymax) <= tol) & (np.abs(y1 - ymax) <= tol))
+        )
         inner = ~on_box & ((x0 != x1) | (y0 != y1))
         if inner.any():
             mid = np.column_stack([(x0 + x1)[inner] / 2, (y0 + y1)[inner] / 2])

@@ -183,8 +183,8 @@ class FortuneOverlay:
 
     step: FortuneStep
     points: np.ndarray
-    future: np.ndarray      # (k, 2) sites beyond the sweep line
-    bbox: tuple             # the diagram's box: edges are cut to it, as in the finished diagram
+    future: np.ndarray  # (k, 2) sites beyond the sweep line
+    bbox: tuple  # the diagram's box: edges are cut to it, as in the finished diagram
 
     def draw(self, paint: Painter) -> None:
         step, view, cols, rows = self.step, paint.view, paint.cols, paint.rows
@@ -205,8 +205,7 @@ class FortuneOverlay:
             assert step.vertex is not None, "a circle event creates a vertex"
             vx, vy = step.vertex
             # the circle that just emptied, and its centre: the new vertex
-            paint.segments(EVENT, circle_segments([[vx, vy, step.sweep_y - vy]], view.scale, paint.world),
-                           dash=DASH)
+            paint.segments(EVENT, circle_segments([[vx, vy, step.sweep_y - vy]], view.scale, paint.world), dash=DASH)
             paint.points(EVENT, [[vx, vy]], block=True)
         elif step.kind in ("site", "repeat"):
             paint.points(EVENT, [step.position], block=True)
@@ -261,10 +260,10 @@ class IncrementalOverlay:
 
     step: IncrementalStep
     points: np.ndarray
-    future: np.ndarray          # (k, 2) sites not inserted yet
-    conflict: np.ndarray        # (c, 3, 2) corners of the destroyed triangles
-    new_edges: np.ndarray       # (e, 4) Delaunay edges of the new triangles
-    stolen_rows: np.ndarray     # rows of scene.sites whose cells lost area
+    future: np.ndarray  # (k, 2) sites not inserted yet
+    conflict: np.ndarray  # (c, 3, 2) corners of the destroyed triangles
+    new_edges: np.ndarray  # (e, 4) Delaunay edges of the new triangles
+    stolen_rows: np.ndarray  # rows of scene.sites whose cells lost area
     bbox: tuple
     walk: np.ndarray = dataclasses.field(default_factory=_empty_segments)  # (w, 4) sides visited
 
@@ -315,12 +314,12 @@ def fortune_picture(step, points: np.ndarray, colours: np.ndarray, bbox) -> tupl
     rows = np.flatnonzero(swept)
     vertices = np.asarray(step.vertices, np.float64).reshape(-1, 2)
     xmin, ymin, xmax, ymax = bbox
-    inside = ((vertices[:, 0] >= xmin) & (vertices[:, 0] <= xmax)
-              & (vertices[:, 1] >= ymin) & (vertices[:, 1] <= ymax))
+    inside = (vertices[:, 0] >= xmin) & (vertices[:, 0] <= xmax) & (vertices[:, 1] >= ymin) & (vertices[:, 1] <= ymax)
     box = tuple(float(c) for c in bbox)
     xmin, ymin, xmax, ymax = box
-    outline = np.array([[xmin, ymin, xmax, ymin], [xmax, ymin, xmax, ymax],
-                        [xmax, ymax, xmin, ymax], [xmin, ymax, xmin, ymin]])
+    outline = np.array(
+        [[xmin, ymin, xmax, ymin], [xmax, ymin, xmax, ymax], [xmax, ymax, xmin, ymax], [xmin, ymax, xmin, ymin]]
+    )
     finished = clip_segments(np.asarray(step.finished_edges, np.float64).reshape(-1, 4), box)
     scene = _SubScene(
         rows,

@@ -22,9 +22,9 @@ from textual.timer import Timer
 import tvoronoi
 from tvoronoi.trace import FortuneStep, FortuneTrace, IncrementalStep, IncrementalTrace
 from tvoronoi.tui.building import Built
-from tvoronoi.tui.host import Host
 from tvoronoi.tui.colours import cell_colours
 from tvoronoi.tui.follow import focus_box
+from tvoronoi.tui.host import Host
 from tvoronoi.tui.live import LiveScene
 from tvoronoi.tui.overlay import FortuneOverlay, IncrementalOverlay, fortune_picture, incremental_picture
 from tvoronoi.tui.raster import Scene, View
@@ -100,12 +100,12 @@ class Player:
         self.trace: FortuneTrace | IncrementalTrace = tvoronoi.steps(self.points, engine=engine, bbox=bbox)
         self.n_steps = len(self.trace)
         self.threaded = len(self.points) >= STEP_THREAD_MIN_SITES
-        self.index = 0          # the step asked for
+        self.index = 0  # the step asked for
         self.step: Step | None = None  # the step on screen
-        self.busy = False       # a worker is computing a step
+        self.busy = False  # a worker is computing a step
         self.playing = False
         self.speed = DEFAULT_SPEED
-        self.carry = 0.0        # steps due but not taken (a fraction)
+        self.carry = 0.0  # steps due but not taken (a fraction)
         self.last_tick: float | None = None
         self.sample = False  # the points are a sample of the diagram's
         # the canvas's view and whether it was fitted, before playback
@@ -137,7 +137,6 @@ class StepReady(Message):
         super().__init__()
         self.player = player
         self.picture = picture
-
 
 
 class PlaybackHost(Host, Protocol):
@@ -192,8 +191,14 @@ class Playback:
         n = live.n_sites if live is not None else len(built.points)
         if n > TEACHING_MAX_SITES or n > PLAYBACK_MAX_SITES:
             allowed = n <= PLAYBACK_MAX_SITES
-            why = "" if allowed else (f"Playback takes up to {PLAYBACK_MAX_SITES:,} sites: "
-                                      "a sample, or generate fewer points · Esc to cancel")
+            why = (
+                ""
+                if allowed
+                else (
+                    f"Playback takes up to {PLAYBACK_MAX_SITES:,} sites: "
+                    "a sample, or generate fewer points · Esc to cancel"
+                )
+            )
             self.host.push_screen(SampleDialog(n, SAMPLE_SITES, all_allowed=allowed, why=why), self._chosen)
             return
         self.start()
@@ -268,8 +273,9 @@ class Playback:
             self._compute_step(player, k)
 
     def _compute_step(self, player: Player, k: int) -> None:
-        self.host.run_worker(lambda: self._step_in_thread(player, k), thread=True, group="playback",
-                             exit_on_error=False)
+        self.host.run_worker(
+            lambda: self._step_in_thread(player, k), thread=True, group="playback", exit_on_error=False
+        )
 
     def _step_in_thread(self, player: Player, k: int) -> None:
         self.host.post_message(StepReady(player, player.picture(k)))
@@ -389,8 +395,9 @@ class Playback:
         """The user moved the view: it stays where they put it."""
         if self.player is not None and self.follow:
             self._set_follow(False)
-            self.host.notify("the view stays where you put it; f follows the events again",
-                             title="Follow off", timeout=4)
+            self.host.notify(
+                "the view stays where you put it; f follows the events again", title="Follow off", timeout=4
+            )
 
     def scrubbed(self, step: int) -> None:
         """The timeline was clicked or dragged at ``step``."""

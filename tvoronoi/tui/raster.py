@@ -85,9 +85,12 @@ class Painter:
         """The world box (x0, y0, x1, y1) of the characters span = (c0, r0, c1, r1), a dot wider
         each way: marks beyond it are dropped before any work (NaN coordinates fail its tests too)."""
         c0, r0, c1, r1 = span
-        (x0, x1), (y1, y0) = self.view.to_world(np.array([c0 * DOT_COLS - 1.0, c1 * DOT_COLS + 1.0]),
-                                                np.array([r0 * DOT_ROWS - 1.0, r1 * DOT_ROWS + 1.0]),
-                                                self.cols, self.rows)
+        (x0, x1), (y1, y0) = self.view.to_world(
+            np.array([c0 * DOT_COLS - 1.0, c1 * DOT_COLS + 1.0]),
+            np.array([r0 * DOT_ROWS - 1.0, r1 * DOT_ROWS + 1.0]),
+            self.cols,
+            self.rows,
+        )
         return float(x0), float(y0), float(x1), float(y1)
 
     def new_dots(self) -> np.ndarray:
@@ -169,8 +172,11 @@ class Painter:
             col, row = np.floor(u) - ou, np.floor(v) - ov
             inside = (col >= 0) & (col < width) & (row >= 0) & (row < height)  # False for NaN
             # the dot of each point in the window; beyond it a number no other point has
-            dot = (row * width + col).astype(np.int32) if inside.all() else np.where(
-                inside, row * width + col, -1.0 - np.arange(len(points))).astype(np.int64)
+            dot = (
+                (row * width + col).astype(np.int32)
+                if inside.all()
+                else np.where(inside, row * width + col, -1.0 - np.arange(len(points))).astype(np.int64)
+            )
             # the ends, each point once
             ends = dot[inside] if mesh.ends is None else dot[mesh.ends[inside[mesh.ends]]]
             dots.ravel()[ends] = True
@@ -180,8 +186,12 @@ class Painter:
             if not (x0 <= box[0] and y0 <= box[1] and box[2] <= x1 and box[3] <= y1):
                 # ... and one whose ends lie beyond one side of the window has none here
                 xs, ys = points[:, 0], points[:, 1]
-                beyond = ((xs < x0).view(np.uint8) | ((xs > x1).view(np.uint8) << 1)
-                          | ((ys < y0).view(np.uint8) << 2) | ((ys > y1).view(np.uint8) << 3))
+                beyond = (
+                    (xs < x0).view(np.uint8)
+                    | ((xs > x1).view(np.uint8) << 1)
+                    | ((ys < y0).view(np.uint8) << 2)
+                    | ((ys > y1).view(np.uint8) << 3)
+                )
                 apart &= (beyond[a] & beyond[b]) == 0
             rest = np.flatnonzero(apart)
             if rest.size:
@@ -207,8 +217,14 @@ class Painter:
         dots = self.new_dots()
         u, v = self.to_dots(x, y)
         u, v = float(u), float(v)
-        segment_dots(dots, [u - CURSOR_ARM, u], [v, v - CURSOR_ARM - 1], [u + CURSOR_ARM, u],
-                     [v, v + CURSOR_ARM + 1], origin=self.origin)
+        segment_dots(
+            dots,
+            [u - CURSOR_ARM, u],
+            [v, v - CURSOR_ARM - 1],
+            [u + CURSOR_ARM, u],
+            [v, v + CURSOR_ARM + 1],
+            origin=self.origin,
+        )
         self.lay(layer, dots)
         return pack_braille(dots) != 0
 
@@ -217,8 +233,12 @@ def _visible_segments(seg: np.ndarray, world) -> np.ndarray:
     """The segments (k, 4) that meet the world box (x0, y0, x1, y1)."""
     x0, y0, x1, y1 = world
     sx0, sy0, sx1, sy1 = seg.T
-    keep = ((np.maximum(sx0, sx1) >= x0) & (np.minimum(sx0, sx1) <= x1)
-            & (np.maximum(sy0, sy1) >= y0) & (np.minimum(sy0, sy1) <= y1))
+    keep = (
+        (np.maximum(sx0, sx1) >= x0)
+        & (np.minimum(sx0, sx1) <= x1)
+        & (np.maximum(sy0, sy1) >= y0)
+        & (np.minimum(sy0, sy1) <= y1)
+    )
     return seg if keep.all() else seg[keep]
 
 
@@ -293,8 +313,12 @@ def redraw_part(frame: Frame, scene, view: View, cols: int, rows: int, span, *, 
     c0, r0, c1, r1 = span
     part_view = view.window(c0, r0, cols, rows)
     part = rasterize(scene, part_view, c1 - c0, r1 - r0, owner=owner, **options)
-    for whole, piece in ((frame.codes, part.codes), (frame.mark, part.mark),
-                         (frame.fill, part.fill), (frame.owner, part.owner)):
+    for whole, piece in (
+        (frame.codes, part.codes),
+        (frame.mark, part.mark),
+        (frame.fill, part.fill),
+        (frame.owner, part.owner),
+    ):
         whole[r0:r1, c0:c1] = piece
 
 

@@ -57,8 +57,12 @@ def _cell_sides(a: np.ndarray, b: np.ndarray, points: np.ndarray, bbox) -> tuple
         return a, b
     xmin, ymin, xmax, ymax = bbox
     # per point, a bit for each side of the box it lies on; a side is along the box if its ends share one
-    sides = ((points[:, 0] == xmin).astype(np.uint8) | ((points[:, 0] == xmax).astype(np.uint8) << 1)
-             | ((points[:, 1] == ymin).astype(np.uint8) << 2) | ((points[:, 1] == ymax).astype(np.uint8) << 3))
+    sides = (
+        (points[:, 0] == xmin).astype(np.uint8)
+        | ((points[:, 0] == xmax).astype(np.uint8) << 1)
+        | ((points[:, 1] == ymin).astype(np.uint8) << 2)
+        | ((points[:, 1] == ymax).astype(np.uint8) << 3)
+    )
     on_box = (sides[a] & sides[b]) != 0
     inner = ~on_box & (a != b)
     first = inner & (a < b)
@@ -171,10 +175,19 @@ class Scene:
     are drawn meanwhile.
     """
 
-    def __init__(self, *, sites: np.ndarray, vertices: np.ndarray, colours, bbox: tuple,
-                 edges: np.ndarray | None = None, edge_mesh: EdgeMesh | None = None,
-                 delaunay_edges: np.ndarray | None = None, triangles: np.ndarray | None = None,
-                 tree=None) -> None:
+    def __init__(
+        self,
+        *,
+        sites: np.ndarray,
+        vertices: np.ndarray,
+        colours,
+        bbox: tuple,
+        edges: np.ndarray | None = None,
+        edge_mesh: EdgeMesh | None = None,
+        delaunay_edges: np.ndarray | None = None,
+        triangles: np.ndarray | None = None,
+        tree=None,
+    ) -> None:
         self.sites = sites
         self.vertices = vertices
         self.bbox = bbox
@@ -287,8 +300,7 @@ class Scene:
         xmin, ymin, xmax, ymax = diagram.bbox
         vertices = np.asarray(diagram.vertices, np.float64).reshape(-1, 2)
         inside = (
-            (vertices[:, 0] >= xmin) & (vertices[:, 0] <= xmax)
-            & (vertices[:, 1] >= ymin) & (vertices[:, 1] <= ymax)
+            (vertices[:, 0] >= xmin) & (vertices[:, 0] <= xmax) & (vertices[:, 1] >= ymin) & (vertices[:, 1] <= ymax)
         )
         return cls(
             sites=sites,

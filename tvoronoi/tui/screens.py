@@ -65,8 +65,7 @@ class PathDialog(ModalScreen[Path | None]):
 
     BINDINGS = [Binding("escape", "cancel", "Cancel")]
 
-    def __init__(self, title: str, *, value: str = "", placeholder: str = "",
-                 confirm_overwrite: bool = False) -> None:
+    def __init__(self, title: str, *, value: str = "", placeholder: str = "", confirm_overwrite: bool = False) -> None:
         super().__init__()
         self.title_text = title
         self.value = value
@@ -141,14 +140,16 @@ def complete_path(value: str) -> str | None:
     typed = Path(value).expanduser()
     folder, stem = (typed, "") if value.endswith("/") else (typed.parent, typed.name)
     try:
-        names = sorted(entry.name + ("/" if entry.is_dir() else "")
-                       for entry in folder.iterdir() if entry.name.startswith(stem)
-                       and (stem.startswith(".") or not entry.name.startswith(".")))
+        names = sorted(
+            entry.name + ("/" if entry.is_dir() else "")
+            for entry in folder.iterdir()
+            if entry.name.startswith(stem) and (stem.startswith(".") or not entry.name.startswith("."))
+        )
     except OSError:
         return None
     if not names or names[0] == stem:
         return None
-    return value + names[0][len(stem):]
+    return value + names[0][len(stem) :]
 
 
 class PointFileTree(DirectoryTree):
@@ -178,8 +179,16 @@ class OpenDialog(PathDialog):
     cancelled.
     """
 
-    def __init__(self, title: str, *, value: str = "", placeholder: str = "",
-                 x: str | None = None, y: str | None = None, folder: Path | None = None) -> None:
+    def __init__(
+        self,
+        title: str,
+        *,
+        value: str = "",
+        placeholder: str = "",
+        x: str | None = None,
+        y: str | None = None,
+        folder: Path | None = None,
+    ) -> None:
         super().__init__(title, value=value, placeholder=placeholder)
         self.x = x
         self.y = y
@@ -195,8 +204,10 @@ class OpenDialog(PathDialog):
                 yield Input(self.x or "", placeholder="auto", compact=True, id="x-column")
                 yield Label("y column")
                 yield Input(self.y or "", placeholder="auto", compact=True, id="y-column")
-            yield Label("Enter to open · → completes · Tab: the tree, the columns (a name, an index or "
-                        "colN) · Esc to cancel", id="dialog-hint")
+            yield Label(
+                "Enter to open · → completes · Tab: the tree, the columns (a name, an index or colN) · Esc to cancel",
+                id="dialog-hint",
+            )
 
     def on_directory_tree_file_selected(self, event: DirectoryTree.FileSelected) -> None:
         """A file chosen in the tree: into the field; chosen again (Enter twice), opened."""

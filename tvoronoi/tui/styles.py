@@ -29,6 +29,7 @@ from tvoronoi.tui.layers import (
 )
 from tvoronoi.tui.raster import Frame
 
+
 @lru_cache(maxsize=8)
 def style_table(palette: Palette) -> tuple[Style, ...]:
     """Styles indexed by ``mark * len(palette.backgrounds) + fill + 1``."""
@@ -72,12 +73,11 @@ def frame_lines(frame: Frame, palette: Palette) -> list[list[Segment]]:
     run_styles = [styles[k] for k in keys.ravel()[starts].tolist()]
     make = tuple.__new__  # Segment is a named tuple; this skips its Python-level __new__
     segments = [
-        make(Segment, (text[s:e], style, None))
-        for s, e, style in zip(starts.tolist(), ends.tolist(), run_styles)
+        make(Segment, (text[s:e], style, None)) for s, e, style in zip(starts.tolist(), ends.tolist(), run_styles)
     ]
     per_row = np.bincount(starts // cols, minlength=rows).tolist()
     lines, at = [], 0
     for count in per_row:
-        lines.append(segments[at:at + count])
+        lines.append(segments[at : at + count])
         at += count
     return lines

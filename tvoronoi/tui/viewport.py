@@ -77,8 +77,9 @@ class View:
         """The view moved by a number of dots (right, down on screen); by whole characters, it
         keeps its anchor."""
         if dx_dots % DOT_COLS == 0 and dy_dots % DOT_ROWS == 0:
-            return View(self.ax, self.ay, self.scale,
-                        self.dc + int(dx_dots) // DOT_COLS, self.dr + int(dy_dots) // DOT_ROWS)
+            return View(
+                self.ax, self.ay, self.scale, self.dc + int(dx_dots) // DOT_COLS, self.dr + int(dy_dots) // DOT_ROWS
+            )
         return View(self.cx + dx_dots * self.scale, self.cy - dy_dots * self.scale, self.scale)
 
     def zoomed(self, factor: float, about: tuple[float, float] | None = None) -> "View":
@@ -155,8 +156,9 @@ class Window:
         return u - self.c0 * DOT_COLS, v - self.r0 * DOT_ROWS
 
     def to_world(self, u, v, cols: int, rows: int):
-        return self.view.to_world(np.asarray(u) + self.c0 * DOT_COLS, np.asarray(v) + self.r0 * DOT_ROWS,
-                                  self.cols, self.rows)
+        return self.view.to_world(
+            np.asarray(u) + self.c0 * DOT_COLS, np.asarray(v) + self.r0 * DOT_ROWS, self.cols, self.rows
+        )
 
 
 # What the rasterizer draws through: a whole canvas's view, or a part of it.

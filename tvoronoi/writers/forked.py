@@ -31,8 +31,11 @@ def can_fork() -> bool:
     """Whether a part of an output can be made by a forked process here: on Linux (fork is cheap),
     from the main thread (the batch command; an application saving from a worker thread, such
     as the terminal UI, has threads of its own that may hold locks when it forks)."""
-    return (sys.platform.startswith("linux") and hasattr(os, "fork")
-            and threading.current_thread() is threading.main_thread())
+    return (
+        sys.platform.startswith("linux")
+        and hasattr(os, "fork")
+        and threading.current_thread() is threading.main_thread()
+    )
 
 
 class ForkedPart:

@@ -7,8 +7,8 @@ from typing import Callable
 import numpy as np
 import orjson
 
-from tvoronoi.fileio import gc_paused
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.fileio import gc_paused
 from tvoronoi.readers.text_column import TextColumn
 from tvoronoi.writers import forked
 from tvoronoi.writers.background import background
@@ -312,7 +312,10 @@ class _Properties:
     def ring_features(self, rings: list, a: int, b: int, frame: _Framing) -> None:
         """Write the features of rows a..b-1, each with its ring, as one list of pieces joined
         once: the column values serialized in bulk, no formatting per feature."""
-        variables: list[list] = [rings, orjson.dumps(np.arange(a, b, dtype=np.int64), option=_OPT_NUMPY)[1:-1].split(b",")]
+        variables: list[list] = [
+            rings,
+            orjson.dumps(np.arange(a, b, dtype=np.int64), option=_OPT_NUMPY)[1:-1].split(b","),
+        ]
         # constants[k] comes before variables[k] (constants[0] opens the feature); the last closes it
         constants = [_FEATURE_OPEN, _RING_CLOSE, b""]
         try:
@@ -382,8 +385,16 @@ def _bbox_member(bbox) -> bytes:
     return b'"bbox":%b,' % orjson.dumps([float(v) for v in bbox])
 
 
-def write_cells(diagram, points, out, *, progress: ProgressCallback | None = None,
-                overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
+def write_cells(
+    diagram,
+    points,
+    out,
+    *,
+    progress: ProgressCallback | None = None,
+    overwrite: bool = True,
+    precision: int | None = None,
+    layout: str = "collection",
+) -> int:
     """Write the Voronoi cells as an RFC 7946 GeoJSON FeatureCollection.
 
     One Polygon feature per distinct site, in input order, one feature per
@@ -504,8 +515,9 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
         second = None
         if split < n_sites:
             try:
-                second = forked.ForkedPart(target, lambda file: emit(_Framing(file, layout, b"", opened=True),
-                                                                     split, n_sites, None))
+                second = forked.ForkedPart(
+                    target, lambda file: emit(_Framing(file, layout, b"", opened=True), split, n_sites, None)
+                )
             except OSError:
                 # no room for the temporary file, or no process to be had: one process writes it all
                 split, share = n_sites, total
@@ -527,8 +539,15 @@ def write_cells(diagram, points, out, *, progress: ProgressCallback | None = Non
     return done
 
 
-def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
-                   overwrite: bool = True, precision: int | None = None, layout: str = "collection") -> int:
+def write_delaunay(
+    diagram,
+    out,
+    *,
+    progress: ProgressCallback | None = None,
+    overwrite: bool = True,
+    precision: int | None = None,
+    layout: str = "collection",
+) -> int:
     """Write the Delaunay triangles as a GeoJSON FeatureCollection of Polygons.
 
     Each triangle is a closed counter-clockwise ring of its three sites, with
@@ -559,8 +578,7 @@ def write_delaunay(diagram, out, *, progress: ProgressCallback | None = None,
             first = np.arange(0, 4 * len(chunk), 4, dtype=np.int64)
             text, starts, stops = _ring_texts(_rounded(xy, precision), first, first + 3)
             features = [
-                _TRIANGLE % (text[start:stop], i, j, k)
-                for start, stop, (i, j, k) in zip(starts, stops, chunk.tolist())
+                _TRIANGLE % (text[start:stop], i, j, k) for start, stop, (i, j, k) in zip(starts, stops, chunk.tolist())
             ]
             frame.write(features)
             if progress is not None:

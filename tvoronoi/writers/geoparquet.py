@@ -9,8 +9,15 @@ from tvoronoi.readers.text_column import TextColumn
 
 from .targets import open_output
 
-__all__ = ["write_cells_parquet", "write_delaunay_parquet", "require_pyarrow", "projjson", "crs_name", "is_crs84",
-           "CRS84_PROJJSON"]
+__all__ = [
+    "write_cells_parquet",
+    "write_delaunay_parquet",
+    "require_pyarrow",
+    "projjson",
+    "crs_name",
+    "is_crs84",
+    "CRS84_PROJJSON",
+]
 
 GEOPARQUET_VERSION = "1.1.0"
 # bytes before the points of a one-ring polygon's WKB: byte order, type, ring count, point count
@@ -70,7 +77,7 @@ def is_crs84(crs) -> bool:
 
 
 def crs_name(crs) -> str | None:
-    """"EPSG:3857" for a name or a PROJJSON with that id; a PROJJSON's name without one; None if unknown."""
+    """ "EPSG:3857" for a name or a PROJJSON with that id; a PROJJSON's name without one; None if unknown."""
     if crs is None:
         return None
     if isinstance(crs, dict):
@@ -184,8 +191,10 @@ def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray)
         maxs[present] = np.maximum.reduceat(xy, starts, axis=0)
     mask = None if present.all() else ~present
     bbox = pa.StructArray.from_arrays(
-        [pa.array(np.ascontiguousarray(v), pa.float64(), mask=mask)
-         for v in (mins[:, 0], mins[:, 1], maxs[:, 0], maxs[:, 1])],
+        [
+            pa.array(np.ascontiguousarray(v), pa.float64(), mask=mask)
+            for v in (mins[:, 0], mins[:, 1], maxs[:, 0], maxs[:, 1])
+        ],
         names=["xmin", "ymin", "xmax", "ymax"],
     )
     extent = None
@@ -203,7 +212,8 @@ def _shapely_cells(pa, geoms: np.ndarray):
     bounds = shapely.bounds(geoms)
     mask = ~present
     bbox = pa.StructArray.from_arrays(
-        [pa.array(bounds[:, k], pa.float64(), mask=mask) for k in range(4)], names=["xmin", "ymin", "xmax", "ymax"],
+        [pa.array(bounds[:, k], pa.float64(), mask=mask) for k in range(4)],
+        names=["xmin", "ymin", "xmax", "ymax"],
     )
     extent = [float(v) for v in shapely.total_bounds(geoms)] if present.any() else None
     names = {shapely.GeometryType.POLYGON: "Polygon", shapely.GeometryType.MULTIPOLYGON: "MultiPolygon"}
@@ -286,8 +296,10 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         return len(kept)
     # the polygons a row group at a time: no whole copy of the rings or of their WKB
     present = has_ring[distinct]
-    schema = pa.schema([pa.field(name, column.type) for name, column in columns.items()]
-                       + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))])
+    schema = pa.schema(
+        [pa.field(name, column.type) for name, column in columns.items()]
+        + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))]
+    )
     schema = schema.with_metadata({b"geo": _geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
     from concurrent.futures import ThreadPoolExecutor
 
@@ -330,8 +342,9 @@ def _parquet_options(schema) -> dict:
     statistics = [name for name in schema.names if name not in ("geometry", "bbox")]
     if "bbox" in schema.names:
         statistics += [f"bbox.{k}" for k in ("xmin", "ymin", "xmax", "ymax")]
-    return dict(compression="zstd", compression_level=1, use_dictionary=properties or False,
-                write_statistics=statistics)
+    return dict(
+        compression="zstd", compression_level=1, use_dictionary=properties or False, write_statistics=statistics
+    )
 
 
 def _BBOX_TYPE(pa):

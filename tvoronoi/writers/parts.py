@@ -64,8 +64,7 @@ def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str
     return name
 
 
-def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem: str, format: str,
-                         crs=None) -> str:
+def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem: str, format: str, crs=None) -> str:
     """Write one task's Delaunay triangles ((k, 3) input rows, their places (k, 3, 2)); return the part's name.
 
     The columns are those of the whole-diagram writers: GeoParquet ``sites`` (three input rows),
@@ -81,8 +80,9 @@ def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem:
 
         pa = require_pyarrow()
         ring_offsets = np.arange(0, 4 * len(triangles) + 1, 4, dtype=np.int64)
-        geometry, bbox, extent = _polygons(pa, np.ascontiguousarray(closed.reshape(-1, 2)), ring_offsets,
-                                           np.ones(len(triangles), bool))
+        geometry, bbox, extent = _polygons(
+            pa, np.ascontiguousarray(closed.reshape(-1, 2)), ring_offsets, np.ones(len(triangles), bool)
+        )
         sites = pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(triangles, np.int64).ravel(), pa.int64()), 3)
         table = pa.table({"sites": sites, "geometry": geometry, "bbox": bbox})
         table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
@@ -90,8 +90,11 @@ def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem:
         return name
     with open_output(path, overwrite=False) as stream:
         for tri, ring in zip(np.asarray(triangles).tolist(), closed.tolist()):
-            feature = {"type": "Feature", "geometry": {"type": "Polygon", "coordinates": [ring]},
-                       "properties": {"sites": tri}}
+            feature = {
+                "type": "Feature",
+                "geometry": {"type": "Polygon", "coordinates": [ring]},
+                "properties": {"sites": tri},
+            }
             stream.write(RS + orjson.dumps(feature) + b"\n")
     return name
 
@@ -119,12 +122,17 @@ def _write_geojsonseq_part(frame, geoms: np.ndarray, path: str) -> None:
     with open_output(path, overwrite=False) as stream:
         for k, geom in enumerate(geoms):
             properties = {name: values[k] for name, values in zip(names, columns)}
-            feature = {"type": "Feature", "geometry": None if geom is None else geom.__geo_interface__,
-                       "properties": properties}
+            feature = {
+                "type": "Feature",
+                "geometry": None if geom is None else geom.__geo_interface__,
+                "properties": properties,
+            }
             try:
                 stream.write(RS + orjson.dumps(feature, option=orjson.OPT_SERIALIZE_NUMPY) + b"\n")
             except orjson.JSONEncodeError as exc:
-                raise TvoronoiError(f"the properties of site {properties['site']} cannot be written as JSON: {exc}") from None
+                raise TvoronoiError(
+                    f"the properties of site {properties['site']} cannot be written as JSON: {exc}"
+                ) from None
 
 
 def finish_directory(directory, names: list[str], format: str, crs=None) -> None:
@@ -150,8 +158,11 @@ def finish_directory(directory, names: list[str], format: str, crs=None) -> None
         types.update(geo["geometry_types"])
         if "bbox" in geo:
             box = geo["bbox"]
-            extent = box if extent is None else [min(extent[0], box[0]), min(extent[1], box[1]),
-                                                 max(extent[2], box[2]), max(extent[3], box[3])]
+            extent = (
+                box
+                if extent is None
+                else [min(extent[0], box[0]), min(extent[1], box[1]), max(extent[2], box[2]), max(extent[3], box[3])]
+            )
     schema = metas[0].schema.to_arrow_schema()
     schema = schema.with_metadata({b"geo": _geo_metadata(extent, sorted(types), crs)})
     pq.write_metadata(schema, os.path.join(directory, COMMON_METADATA))

@@ -235,8 +235,9 @@ def output_file(out, *, overwrite: bool = True) -> AtomicFile | DirectFile | Std
     if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
         return DirectFile(out)
     if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
-        raise OSError(errno.EINVAL, f"is {_kind(mode)}; tvoronoi writes files, character devices and pipes",
-                      os.fspath(out))
+        raise OSError(
+            errno.EINVAL, f"is {_kind(mode)}; tvoronoi writes files, character devices and pipes", os.fspath(out)
+        )
     return AtomicFile(out, overwrite=overwrite)
 
 
