@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from tvoronoi.trace import IncrementalStep
 from tvoronoi.tui.dots import DOT_COLS, DOT_ROWS
 from tvoronoi.tui.viewport import View
 
@@ -52,14 +53,14 @@ def focus_box(step, points: np.ndarray, bbox) -> tuple[float, float, float, floa
 def _event_points(step, points: np.ndarray):
     """The anchor of the step's event (the site, or the new vertex) and the points whose box is its
     region; None for a step with no event."""
-    kind = getattr(step, "kind", None)
-    if kind is None:  # an insertion: the new site, its cavity and the walk that found it
+    if isinstance(step, IncrementalStep):  # an insertion: the new site, its cavity and the walk that found it
         if step.site < 0:
             return None
         site = points[step.site]
         corners = points[np.asarray(step.conflict, np.int64).ravel()]
         walked = np.asarray(step.walk, np.int64).ravel()
         return site, np.vstack([site[None], corners, points[walked[walked >= 0]]])
+    kind = step.kind
     if kind == "circle":  # the circle that emptied
         vx, vy = step.vertex
         r = step.sweep_y - vy
