@@ -1,7 +1,7 @@
 """The command palette lists the app's own actions and runs them."""
 
 import numpy as np
-from textual.command import CommandPalette
+from textual.command import CommandList, CommandPalette
 
 from test_tui import SIZE, make_app, pilot_test
 from tvoronoi.relax import lloyd
@@ -32,7 +32,12 @@ async def test_relax_from_the_palette():
         await pilot.pause()
         assert isinstance(app.screen, CommandPalette)
         await pilot.press(*"relax")
-        await pilot.pause(0.3)
+        hits = app.screen.query_one(CommandList)
+        for _ in range(100):  # the palette searches in a worker: wait for its hits, not for a set time
+            await pilot.pause()
+            if hits.option_count and "Relax" in str(hits.get_option_at_index(0).prompt):
+                break
+        assert "Relax" in str(hits.get_option_at_index(0).prompt)
         await pilot.press("enter")
         await pilot.pause()
         assert np.array_equal(app.built.points, lloyd(start, 1, bbox=box, engine=engine))
