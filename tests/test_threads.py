@@ -123,41 +123,18 @@ def test_kernels_split_on_every_family(name):
     # the new points written into the dual's room after the vertices: the same points and rings
     roomy = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, 2, parallel_min=1, clip_room=True)
     room = roomy["vertex_room"]
-    got = clip.clip_cells(
-        s.xs,
-        s.ys,
-        roomy["vertices"],
-        roomy["he_origin"],
-        roomy["he_twin"],
-        roomy["he_face"],
-        roomy["face_edge"],
-        active,
-        box,
-        e,
-        2,
-        parallel_min=1,
-        room=room,
-    )
+
+    def clip_into(buffer):
+        keys = ("vertices", "he_origin", "he_twin", "he_face", "face_edge")
+        return clip.clip_cells(s.xs, s.ys, *(roomy[k] for k in keys), active, box, e, 2, parallel_min=1, room=buffer)
+
+    got = clip_into(room)
     assert np.shares_memory(got[0], room)
     for x, y in zip(got[:3], cells[0][:3]):
         assert np.array_equal(x, y)
     # room that does not start with the vertices, or is too small: a copy, the same result
     for other in (room.copy(), room[: len(roomy["vertices"]) + 3]):
-        got = clip.clip_cells(
-            s.xs,
-            s.ys,
-            roomy["vertices"],
-            roomy["he_origin"],
-            roomy["he_twin"],
-            roomy["he_face"],
-            roomy["face_edge"],
-            active,
-            box,
-            e,
-            2,
-            parallel_min=1,
-            room=other,
-        )
+        got = clip_into(other)
         assert not np.shares_memory(got[0], other)
         for x, y in zip(got[:3], cells[0][:3]):
             assert np.array_equal(x, y)
