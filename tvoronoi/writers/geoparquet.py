@@ -128,7 +128,7 @@ def _typed_column(pa, values: list):
         return pa.array([None if v is None else orjson.dumps(v).decode() for v in values], pa.string())
 
 
-def _geo_metadata(column_bbox, geometry_types: list[str], crs) -> bytes:
+def geo_metadata(column_bbox, geometry_types: list[str], crs) -> bytes:
     import orjson
 
     meta = {
@@ -174,7 +174,7 @@ def _wkb_polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray):
     return pa.Array.from_buffers(kind, len(counts), [None, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)])
 
 
-def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray):
+def polygon_columns(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray):
     """WKB and bbox columns of closed single-ring polygons; rows where ``present`` is False are null."""
     n_rings = len(ring_offsets) - 1
     mins = np.full((len(present), 2), np.nan)
@@ -203,7 +203,7 @@ def _polygons(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.ndarray)
     return wkb, bbox, extent
 
 
-def _shapely_cells(pa, geoms: np.ndarray):
+def shapely_cell_columns(pa, geoms: np.ndarray):
     """WKB and bbox columns, the extent and the geometry types of shapely cells (None: a null row)."""
     import shapely
 
@@ -230,7 +230,7 @@ def _duplicates_column(pa, diagram, kept: np.ndarray):
     return pa.array([repeats.get(i) for i in kept.tolist()], kind)
 
 
-def _write(pa, table, out, overwrite: bool) -> None:
+def write_table(pa, table, out, overwrite: bool) -> None:
     import pyarrow.parquet as pq
 
     with open_output(out, overwrite=overwrite) as stream:
@@ -288,11 +288,11 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     columns["duplicates"] = _duplicates_column(pa, diagram, kept)
     if getattr(diagram, "clipped", None) is not None:
         # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
-        geometry, bbox, extent, types = _shapely_cells(pa, diagram.clipped[distinct])
+        geometry, bbox, extent, types = shapely_cell_columns(pa, diagram.clipped[distinct])
         columns["geometry"] = geometry
         columns["bbox"] = bbox
-        table = pa.table(columns).replace_schema_metadata({b"geo": _geo_metadata(extent, types, crs)})
-        _write(pa, table, out, overwrite)
+        table = pa.table(columns).replace_schema_metadata({b"geo": geo_metadata(extent, types, crs)})
+        write_table(pa, table, out, overwrite)
         return len(kept)
     # the polygons a row group at a time: no whole copy of the rings or of their WKB
     present = has_ring[distinct]
@@ -300,7 +300,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         [pa.field(name, column.type) for name, column in columns.items()]
         + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))]
     )
-    schema = schema.with_metadata({b"geo": _geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
+    schema = schema.with_metadata({b"geo": geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
     from concurrent.futures import ThreadPoolExecutor
 
     import pyarrow.parquet as pq
@@ -310,7 +310,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         ra, rb = int(kept[a]), int(kept[b - 1]) + 1
         xy, first, last = closed_rings(diagram, ra, rb, has_ring[ra:rb])
         ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
-        geometry, bbox, _ = _polygons(pa, xy, ring_offsets, present[a:b])
+        geometry, bbox, _ = polygon_columns(pa, xy, ring_offsets, present[a:b])
         group = {name: column.slice(a, b - a) for name, column in columns.items()}
         group["geometry"], group["bbox"] = geometry, bbox
         return pa.table(group, schema=schema)
@@ -373,9 +373,9 @@ def write_delaunay_parquet(diagram, out, *, overwrite: bool = True, crs=None) ->
     triangles = np.asarray(diagram.triangles, dtype=np.int64).reshape(-1, 3)
     xy = np.take(diagram.sites, triangles[:, [0, 1, 2, 0]].ravel(), axis=0)
     ring_offsets = np.arange(0, 4 * len(triangles) + 1, 4, dtype=np.int64)
-    geometry, bbox, extent = _polygons(pa, xy, ring_offsets, np.ones(len(triangles), bool))
+    geometry, bbox, extent = polygon_columns(pa, xy, ring_offsets, np.ones(len(triangles), bool))
     sites = pa.FixedSizeListArray.from_arrays(pa.array(triangles.ravel(), pa.int64()), 3)
     table = pa.table({"sites": sites, "geometry": geometry, "bbox": bbox})
-    table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
-    _write(pa, table, out, overwrite)
+    table = table.replace_schema_metadata({b"geo": geo_metadata(extent, ["Polygon"], crs)})
+    write_table(pa, table, out, overwrite)
     return len(triangles)

@@ -76,17 +76,17 @@ def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem:
     path = os.path.join(str(directory), name)
     closed = np.concatenate([xy, xy[:, :1]], axis=1)
     if format == "parquet":
-        from tvoronoi.writers.geoparquet import _geo_metadata, _polygons, _write, require_pyarrow
+        from tvoronoi.writers.geoparquet import geo_metadata, polygon_columns, require_pyarrow, write_table
 
         pa = require_pyarrow()
         ring_offsets = np.arange(0, 4 * len(triangles) + 1, 4, dtype=np.int64)
-        geometry, bbox, extent = _polygons(
+        geometry, bbox, extent = polygon_columns(
             pa, np.ascontiguousarray(closed.reshape(-1, 2)), ring_offsets, np.ones(len(triangles), bool)
         )
         sites = pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(triangles, np.int64).ravel(), pa.int64()), 3)
         table = pa.table({"sites": sites, "geometry": geometry, "bbox": bbox})
-        table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, ["Polygon"], crs)})
-        _write(pa, table, path, overwrite=False)
+        table = table.replace_schema_metadata({b"geo": geo_metadata(extent, ["Polygon"], crs)})
+        write_table(pa, table, path, overwrite=False)
         return name
     with open_output(path, overwrite=False) as stream:
         for tri, ring in zip(np.asarray(triangles).tolist(), closed.tolist()):
@@ -100,20 +100,20 @@ def write_triangles_part(triangles: np.ndarray, xy: np.ndarray, directory, stem:
 
 
 def _write_parquet_part(frame, geoms, path: str, crs) -> None:
-    from tvoronoi.writers.geoparquet import _geo_metadata, _shapely_cells, _write, require_pyarrow
+    from tvoronoi.writers.geoparquet import geo_metadata, require_pyarrow, shapely_cell_columns, write_table
 
     pa = require_pyarrow()
     if isinstance(geoms, tuple):
-        from tvoronoi.writers.geoparquet import _polygons
+        from tvoronoi.writers.geoparquet import polygon_columns
 
-        geometry, bbox, extent = _polygons(pa, *geoms)
+        geometry, bbox, extent = polygon_columns(pa, *geoms)
         types = ["Polygon"]
     else:
-        geometry, bbox, extent, types = _shapely_cells(pa, geoms)
+        geometry, bbox, extent, types = shapely_cell_columns(pa, geoms)
     table = pa.Table.from_pandas(frame, preserve_index=False)
     table = table.append_column("geometry", geometry).append_column("bbox", bbox)
-    table = table.replace_schema_metadata({b"geo": _geo_metadata(extent, types or ["Polygon"], crs)})
-    _write(pa, table, path, overwrite=False)
+    table = table.replace_schema_metadata({b"geo": geo_metadata(extent, types or ["Polygon"], crs)})
+    write_table(pa, table, path, overwrite=False)
 
 
 def _write_geojsonseq_part(frame, geoms: np.ndarray, path: str) -> None:
@@ -147,7 +147,7 @@ def finish_directory(directory, names: list[str], format: str, crs=None) -> None
         return
     import pyarrow.parquet as pq
 
-    from tvoronoi.writers.geoparquet import _geo_metadata
+    from tvoronoi.writers.geoparquet import geo_metadata
 
     directory = str(directory)
     metas = [pq.read_metadata(os.path.join(directory, name)) for name in names]
@@ -164,7 +164,7 @@ def finish_directory(directory, names: list[str], format: str, crs=None) -> None
                 else [min(extent[0], box[0]), min(extent[1], box[1]), max(extent[2], box[2]), max(extent[3], box[3])]
             )
     schema = metas[0].schema.to_arrow_schema()
-    schema = schema.with_metadata({b"geo": _geo_metadata(extent, sorted(types), crs)})
+    schema = schema.with_metadata({b"geo": geo_metadata(extent, sorted(types), crs)})
     pq.write_metadata(schema, os.path.join(directory, COMMON_METADATA))
     if any(not meta.schema.equals(metas[0].schema) for meta in metas[1:]):
         return
