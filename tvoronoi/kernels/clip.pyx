@@ -84,7 +84,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int T = threads if n >= parallel_min and threads > 1 else 1
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
-        for v in range(m):
+        for v in prange(m, num_threads=T, schedule="static"):
             x = vertices[v, 0]
             y = vertices[v, 1]
             if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
@@ -112,7 +112,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         # two new points)
         # (each half-edge on its own: its end is where the next one of its cell starts, and the twin
         # reaches the same verdict)
-        for h in range(n_he):
+        for h in prange(n_he, num_threads=T, schedule="static"):
             o = he_origin[h]
             d = he_origin[next_in_cell(h, n_he, &he_face[0], &face_edge[0])]
             if o >= 0 and d >= 0 and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
@@ -149,8 +149,10 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
         # clip each edge that is not whole once, along the half-edge of smaller index; its twin runs the
         # other way
         for h in range(n_he if n_cross > 0 else 0):
+            if flags[h] != 0:
+                continue                # whole, or the twin of an edge clipped already
             tw = he_twin[h]
-            if tw < h or flags[h] != 0:
+            if tw < h:
                 continue
             o = he_origin[h]
             d = he_origin[tw]
