@@ -162,6 +162,7 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
             here = time.process_time() - c0
             cpu1 = client.run(_worker_cpu)
             written = sum(1 for p in result.parts if p)
+            size = sum(f.stat().st_size for f in (Path(tmp) / "cells").rglob("*") if f.is_file())
         peaks = client.run(_worker_peak)
     finally:
         cluster = client.cluster
@@ -177,6 +178,7 @@ def on_cluster(n: int, workers: int, tiles: int | None) -> dict:
         "rounds": result.rounds,
         "pending_after": list(result.pending_after),
         "parts": written,
+        "bytes_written": size,
         "worker_peak_mib": sorted(round(v, 1) for v in peaks.values()),
     }
 
@@ -209,8 +211,9 @@ cells, WKB and the Arrow table of its part), and builds about {rate:,.0f} sites 
 - Rounds: with the first halo of 4 spacings, uniform data finishes in 2 rounds: the second rebuilds
   each group of leftover cells (box corners and edges) with just the sites their disks reach, a few
   thousand per group.
-- 10^8 here (not run): ~100 tiles of 10^6, peak ~{mem_gib:.1f} GiB per worker as above (goal < 4 GB), and
-  about {h8:.1f} hours on these 2 cores; the input (2.4 GB of x/y/row) never sits in one process.
+- 10^8 here, predicted from this run: ~100 tiles of 10^6, peak ~{mem_gib:.1f} GiB per task (goal < 4 GB),
+  about {h8:.1f} hours on these 2 cores; the input (2.4 GB of x/y/row) never sits in one process. Measured:
+  cluster_1e8.md (`--cluster-n 100M --no-one-process`).
 """
 
 
@@ -240,6 +243,26 @@ def report(
             f"| two tiles in two Python threads (build_tile, threads=1 each; "
             f"{threads['tiles_pending']} cells left for a second round) | {threads['tiles_in_2_threads']:.3f} | "
             f"{tiles_ratio:.2f} |",
+            "",
+        ]
+    if cluster and n and not one:
+        lines += [
+            f"## {n:,} uniform sites out of core: {workers} Dask workers, no one-process run",
+            "",
+            "The sites are generated in partitions of 10^6 by the workers; no process ever holds them all, and",
+            "each task writes its own GeoParquet part.",
+            "",
+            "| run | seconds | peak memory per worker | sites per second per core | CPU seconds |",
+            "| --- | --- | --- | --- | --- |",
+            f"| LocalCluster, {workers} worker processes, {cluster['tiles']} tiles, {cluster['rounds']} rounds "
+            f"(cells left after each: {cluster['pending_after']}), {cluster['parts']} parts written "
+            f"({cluster.get('bytes_written', 0) / 2**30:.1f} GiB) | {cluster['seconds']:,.1f} | "
+            f"{' / '.join(f'{v:,.0f}' for v in cluster['worker_peak_mib'])} MiB | "
+            f"{n / cluster['seconds'] / workers:,.0f} | workers "
+            f"{' + '.join(f'{v:,.1f}' for v in cluster['worker_cpu'])}, scheduler and client "
+            f"{cluster['scheduler_client_cpu']:.1f} |",
+            "",
+            f"Load average (1 min) before / after: {cluster['load_before']:.1f} / {cluster['load_after']:.1f}.",
             "",
         ]
     if one and cluster and n:
@@ -295,6 +318,11 @@ def main(argv=None) -> int:
     parser.add_argument("--cluster-n", default="10M", help="0 to skip the cluster run")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--tiles", type=int, default=None)
+    parser.add_argument(
+        "--no-one-process",
+        action="store_true",
+        help="skip the one-process run (for sizes one process cannot hold, such as 10^8: the out-of-core run)",
+    )
     parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "results" / "cluster"))
     parser.add_argument("--report-only", action="store_true", help="rewrite OUT.md from OUT.json (no run)")
     args = parser.parse_args(argv)
@@ -315,8 +343,9 @@ def main(argv=None) -> int:
     n = parse_sizes(args.cluster_n)[0] if args.cluster_n != "0" else None
     one = cluster = None
     if n:
-        one = one_process(n)
-        print(json.dumps(one), flush=True)
+        if not args.no_one_process:
+            one = one_process(n)
+            print(json.dumps(one), flush=True)
         cluster = on_cluster(n, args.workers, args.tiles)
         print(json.dumps(cluster), flush=True)
     out = Path(args.out)
