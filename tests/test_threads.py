@@ -94,6 +94,11 @@ def test_kernels_split_on_every_family(name):
         return  # collinear sites: parallel strips, no triangles and nothing split
     s = t.sites
     outs = [dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1) for threads in (1, 2, 3)]
+    # the walks in runs of 1 to 5 sites: a run's lookups into the runs before it wait for the pass after
+    outs += [
+        dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, walk_chunk=chunk)
+        for threads, chunk in ((2, 1), (2, 3), (3, 2), (2, 5))
+    ]
     for out in outs[1:]:
         for key in outs[0]:
             assert np.array_equal(outs[0][key], out[key]), key

@@ -20,6 +20,7 @@ cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
     BLOCK = 1 << 18     # parallel loops run in blocks of this many, signals polled between
     PARALLEL_MIN_SITES = 1 << 15    # fewer sites: one thread (waking the others costs more than it saves)
+    WALK_CHUNK = 1 << 12    # sites walked by one thread in a row (neighbouring cells share cache lines)
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
@@ -44,7 +45,8 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
-                          int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False):
+                          int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False,
+                          int walk_chunk=WALK_CHUNK):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -65,6 +67,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         returned in the user's unit, each coordinate correctly rounded.
     threads : int, threads for the circumcentres and the cocircular test (the result is the same
         for any count), when there are at least parallel_min sites.
+    walk_chunk : int, sites walked in a row by one thread (tests make it small, so that most lookups
+        wait for the pass after the walks).
     clip_room : bool, leave room after the vertices for the points clip.clip_cells adds on the box
         (at most two per edge, and four corners), so that it writes them there instead of copying the
         vertices: address space only, as rows never written cost no memory.
@@ -80,8 +84,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int n = xs.shape[0], inf = n
     cdef int n_he_d = tv.shape[0], n_tri = n_he_d // 3
     cdef int32_t[::1] first_e = np.full(n, -1, np.int32)     # where each site's walk starts
-    cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # triangle -> vertex; -2 infinite, -1 not yet
-    cdef int32_t[::1] vor = np.full(n_he_d, -1, np.int32)     # Delaunay half-edge -> Voronoi half-edge
+    cdef int32_t[::1] h_first = np.zeros(n + 1, np.int32)    # the cell's first half-edge (a count first)
+    cdef int32_t[::1] v_first = np.zeros(n + 1, np.int32)    # the number of its first vertex (a count first)
+    cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # finite triangle -> its vertex
+    cdef int32_t[::1] vor = np.empty(n_he_d, np.int32)        # Delaunay half-edge -> Voronoi half-edge
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
@@ -89,74 +95,97 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
     cdef double[:, ::1] centre
     cdef int32_t[:, ::1] tri
-    cdef int t, e, e0, o, a, b, c, d, h = 0, h0, m = 0, n_finite = 0, vr, vl, g, merges = 0, k
+    cdef int t, e, a, b, c, h = 0, m = 0, n_finite = 0, g, k, lo, hi, count
+
+    if n < parallel_min:
+        threads = 1
 
     with nogil:
-        # which triangles are finite, and where each site's walk starts: any half-edge out of it, or
-        # for a hull site the one whose dual comes from infinity (the twin of a hull edge p->q of an
-        # infinite triangle starts at q)
+        # which triangles are finite, and where each site's walk starts: any half-edge out of it, or for
+        # a hull site the one whose dual comes from infinity (the twin of a hull edge p->q of an
+        # infinite triangle starts at q). On more than one thread, also what each walk will emit, so
+        # that the walks can run apart: one half-edge per Delaunay edge out of the site (counted in
+        # h_first), and the vertices of the finite triangles whose smallest site it is (v_first)
         for t in range(n_tri):
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             if a == inf or b == inf or c == inf:
-                vid[t] = -2
                 for e in range(3 * t, 3 * t + 3):
                     if tv[e] != inf and tv[nxt(e)] != inf:
                         first_e[tv[nxt(e)]] = opp[e]
+                        if threads > 1:
+                            h_first[tv[e]] += 1
             else:
-                vid[t] = -1
                 n_finite += 1
                 for e in range(3 * t, 3 * t + 3):
                     if first_e[tv[e]] < 0:
                         first_e[tv[e]] = e
+                if threads > 1:
+                    h_first[a] += 1; h_first[b] += 1; h_first[c] += 1
+                    v_first[smallest(a, b, c)] += 1
+        if threads > 1:
+            # counts -> offsets: a site's half-edges and vertices follow those of the sites before it
+            for a in range(n):
+                count = h_first[a]
+                h_first[a] = h
+                h += count
+                count = v_first[a]
+                v_first[a] = m
+                m += count
+            h_first[n] = h
     # (an edge is dual to a Delaunay edge between two sites, n_he_d bounds twice their number)
     centre_buf = np.empty((n_finite + (n_he_d + 4 if clip_room else 0), 2), np.float64)
     centre = centre_buf
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
-    cdef int n_zero = 0, lo, hi
-    if n < parallel_min:
-        threads = 1
+    cdef int n_zero = 0
+    cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
+    cdef Walk w
+    w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
+    w.vor = &vor[0]; w.vid = &vid[0]; w.tri = tri_rows
+    w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
 
     with nogil:
-        # the walk: half-edges cell by cell, each triangle's vertex numbered when first met
-        for a in range(n):
-            if (a & POLL_MASK) == 0:
+        # the walks: one per site, in the sites' order, each making its cell's half-edges and numbering
+        # the vertices it meets first; on one thread, one after the other
+        if threads == 1:
+            h = 0
+            m = 0
+            for a in range(n):
+                if (a & POLL_MASK) == 0:
+                    poll_signals()
+                if a + AHEAD < n and first_e[a + AHEAD] >= 0:
+                    prefetch(&tv[first_e[a + AHEAD]])
+                    prefetch(&opp[first_e[a + AHEAD]])
+                h_first[a] = h
+                h, m = walk_site(&w, a, h, m, 0)
+            h_first[n] = h
+        else:
+            # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; an
+            # origin or twin that another run may not have made yet is left as its Delaunay triangle or
+            # half-edge and looked up once every walk is done (the arrays are the same for any count)
+            lo = 0
+            while lo < n:
                 poll_signals()
-            if a + AHEAD < n and first_e[a + AHEAD] >= 0:
-                e = first_e[a + AHEAD]
-                prefetch(&tv[e])
-                prefetch(&opp[e])
-                prefetch(&vid[e // 3])
-            e0 = first_e[a]
-            if e0 < 0:
-                continue                # a repeated site, or none of the triangles (no cell)
-            h0 = h
-            e = e0
-            while True:
-                b = tv[nxt(e)]
-                if b != inf:
-                    # the dual of a->b runs from the triangle on its right to the one on its left
-                    o = opp[e]
-                    t = o // 3
-                    vr = vid[t]
-                    if vr == -1:
-                        vr = m
-                        vid[t] = m
-                        tri[m, 0] = tv[3 * t]; tri[m, 1] = tv[3 * t + 1]; tri[m, 2] = tv[3 * t + 2]
-                        m += 1
-                    vor[e] = h
-                    he_origin[h] = vr if vr >= 0 else -1
-                    he_face[h] = a
-                    g = vor[o]
-                    if g >= 0:
-                        he_twin[h] = g
-                        he_twin[g] = h
-                    h += 1
-                e = opp[prv(e)]
-                if e == e0:
-                    break
-            if h > h0:
-                face_edge[a] = h0
+                hi = lo + BLOCK if lo + BLOCK < n else n
+                for a in prange(lo, hi, num_threads=threads, schedule="static", chunksize=walk_chunk):
+                    if a + AHEAD < n and first_e[a + AHEAD] >= 0:
+                        prefetch(&tv[first_e[a + AHEAD]])
+                        prefetch(&opp[first_e[a + AHEAD]])
+                    walk_site(&w, a, h_first[a], v_first[a], a - (a - lo) % walk_chunk)
+                lo = hi
+            lo = 0
+            while lo < h:
+                poll_signals()
+                hi = lo + BLOCK if lo + BLOCK < h else h
+                for g in prange(lo, hi, num_threads=threads, schedule="static"):
+                    if he_origin[g] < -1:
+                        he_origin[g] = vid[-2 - he_origin[g]]
+                    if he_twin[g] < 0:
+                        he_twin[g] = vor[-1 - he_twin[g]]
+                lo = hi
+        for a in range(n):
+            if h_first[a + 1] > h_first[a]:
+                face_edge[a] = h_first[a]
 
         # every vertex: the correctly rounded circumcentre of its triangle (construct.circumcentre);
         # in blocks, so that signals are seen between them
@@ -196,6 +225,89 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     if clip_room:
         out["vertex_room"] = centre_buf
     return out
+
+
+cdef inline int smallest(int a, int b, int c) noexcept nogil:
+    if b < a:
+        a = b
+    return c if c < a else a
+
+
+cdef struct Walk:
+    # what the walks read (the triangulation, where each starts) and write (the Voronoi arrays)
+    const int32_t* tv
+    const int32_t* opp
+    const int32_t* first_e
+    int inf
+    int32_t* vor
+    int32_t* vid
+    int32_t* tri
+    int32_t* he_origin
+    int32_t* he_twin
+    int32_t* he_face
+
+
+cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) noexcept nogil:
+    """The cell of site a, counter-clockwise from first_e[a]; returns the next free half-edge and vertex.
+
+    One half-edge per Delaunay edge a->b with b finite, from h on: its origin is the vertex of the
+    triangle on the right of a->b (-1 if that is infinite), its twin the half-edge of b->a. The finite
+    triangles whose smallest site is a are numbered from m on, as met. Sites from done_from up to a
+    have been walked: a vertex or twin of an earlier site is looked up; one of a site before done_from
+    (another thread's) is left as -2 - triangle or -1 - Delaunay half-edge, looked up later. The
+    triangle on the right of a->b is the one the walk left at the step before.
+    """
+    # (locals, so that the stores below do not make the compiler read the struct again)
+    cdef const int32_t* tv = w.tv
+    cdef const int32_t* opp = w.opp
+    cdef int32_t* vor = w.vor
+    cdef int32_t* vid = w.vid
+    cdef int32_t* tri = w.tri
+    cdef int32_t* he_origin = w.he_origin
+    cdef int32_t* he_twin = w.he_twin
+    cdef int32_t* he_face = w.he_face
+    cdef int e0 = w.first_e[a], e, b, t, r0, r1, r2, x0, x1, x2, base, low, o, g, tl, k, inf = w.inf
+    if e0 < 0:
+        return h, m             # a repeated site, or none of the triangles (no cell)
+    t = opp[e0] // 3
+    r0 = tv[3 * t]; r1 = tv[3 * t + 1]; r2 = tv[3 * t + 2]
+    e = e0
+    while True:
+        tl = e // 3
+        base = 3 * tl
+        x0 = tv[base]; x1 = tv[base + 1]; x2 = tv[base + 2]
+        k = e - base
+        b = x1 if k == 0 else (x2 if k == 1 else x0)      # the head of e
+        if b != inf:
+            vor[e] = h
+            if r0 == inf or r1 == inf or r2 == inf:
+                he_origin[h] = -1
+            else:
+                low = smallest(r0, r1, r2)
+                if low == a:
+                    vid[t] = m
+                    tri[3 * m] = r0; tri[3 * m + 1] = r1; tri[3 * m + 2] = r2
+                    he_origin[h] = m
+                    m += 1
+                elif low >= done_from:
+                    he_origin[h] = vid[t]
+                else:
+                    he_origin[h] = -2 - t
+            o = opp[e]
+            if done_from <= b < a:
+                g = vor[o]
+                he_twin[h] = g
+                he_twin[g] = h
+            else:
+                he_twin[h] = -1 - o
+            he_face[h] = a
+            h += 1
+        t = tl
+        r0 = x0; r1 = x1; r2 = x2
+        e = opp[base + (2 if k == 0 else k - 1)]     # the twin of the edge into a: the next edge out
+        if e == e0:
+            break
+    return h, m
 
 
 cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
