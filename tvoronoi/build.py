@@ -81,7 +81,7 @@ def assemble(
     cell_of_row = np.full(n, -1, np.int32)  # engine site whose cell row r shows
     firsts = np.flatnonzero(first)
     cell_of_row[owner[firsts]] = firsts
-    cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row)
+    cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row, threads)
     del ring, offsets, cell_of_row
 
     face_edge = np.full(n, -1, np.int32)

@@ -441,13 +441,16 @@ cdef void release(CellEdges* C) noexcept nogil:
         free(C.start); free(C.end); free(C.entry); free(C.exit_); free(C.has); free(C.nbx); free(C.nby)
 
 
-def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int32_t[::1] cell_of_row):
+def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int32_t[::1] cell_of_row,
+                 int threads=1):
     """Rings gathered into input-row order: row r shows cell cell_of_row[r] (-1: no cell).
 
-    Returns (cell_offsets (rows + 1,) int64, cell_vertices (K,) int32), the CSR of Diagram.
+    Returns (cell_offsets (rows + 1,) int64, cell_vertices (K,) int32), the CSR of Diagram. The rings
+    are copied on ``threads`` threads (the same arrays for any count).
     """
     cdef Py_ssize_t rows = cell_of_row.shape[0], r
     cdef int64_t c, total = 0
+    cdef int T = threads if rows >= PARALLEL_MIN_CELLS and threads > 1 else 1
     cell_offsets_arr = np.empty(rows + 1, np.int64)
     cdef int64_t[::1] cell_offsets = cell_offsets_arr
     with nogil:
@@ -459,13 +462,13 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
         cell_offsets[rows] = total
     vertices_arr = np.empty(total, np.int32)
     cdef int32_t[::1] out = vertices_arr
+    cdef int32_t* out_p = &out[0] if total > 0 else NULL
     with nogil:
-        for r in range(rows):
+        for r in prange(rows, num_threads=T, schedule="static"):
             c = cell_of_row[r]
             if c >= 0 and offsets[c + 1] > offsets[c]:
-                memcpy(&out[cell_offsets[r]], &ring[offsets[c]], (offsets[c + 1] - offsets[c]) * sizeof(int32_t))
+                memcpy(out_p + cell_offsets[r], &ring[offsets[c]], (offsets[c + 1] - offsets[c]) * sizeof(int32_t))
     return cell_offsets_arr, vertices_arr
-
 
 
 def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
