@@ -14,12 +14,19 @@ from tvoronoi.kernels.clipper cimport (
     finish_ring, first_right_turn, turn, convex_ring,
 )
 
+cdef extern from *:
+    """
+    #define TV_CLIP_PREFETCH(p) __builtin_prefetch((const void*)(p))
+    """
+    void prefetch "TV_CLIP_PREFETCH"(const void* p) noexcept nogil
+
 cdef enum:
     HAS = 1
     ENTRY = 2
     EXIT = 4
     WHOLE = 8       # the whole edge, both ends vertices in the closed box (the interior walk reads only flags)
     PARALLEL_MIN_CELLS = 1 << 15    # fewer cells are clipped on one thread
+    GATHER_AHEAD = 16   # cells_by_row: how many rows ahead a cell's offsets start loading
 
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
@@ -463,11 +470,21 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
     vertices_arr = np.empty(total, np.int32)
     cdef int32_t[::1] out = vertices_arr
     cdef int32_t* out_p = &out[0] if total > 0 else NULL
+    cdef int64_t k, lo, hi
     with nogil:
+        # rows in input order are cells in random engine order: each cell's offsets are loaded GATHER_AHEAD
+        # rows ahead and its ring half as far ahead, so that a copy seldom waits for memory
         for r in prange(rows, num_threads=T, schedule="static"):
+            if r + GATHER_AHEAD < rows and cell_of_row[r + GATHER_AHEAD] >= 0:
+                prefetch(&offsets[cell_of_row[r + GATHER_AHEAD]])
+            if r + GATHER_AHEAD // 2 < rows and cell_of_row[r + GATHER_AHEAD // 2] >= 0:
+                prefetch(&ring[offsets[cell_of_row[r + GATHER_AHEAD // 2]]])
             c = cell_of_row[r]
-            if c >= 0 and offsets[c + 1] > offsets[c]:
-                memcpy(out_p + cell_offsets[r], &ring[offsets[c]], (offsets[c + 1] - offsets[c]) * sizeof(int32_t))
+            if c >= 0:
+                lo = offsets[c]
+                hi = offsets[c + 1]
+                for k in range(hi - lo):
+                    out_p[cell_offsets[r] + k] = ring[lo + k]
     return cell_offsets_arr, vertices_arr
 
 
