@@ -51,14 +51,11 @@ def assemble(
     n = len(pts)
     dup = out["dup"]
     first = dup < 0 if present is None else (dup < 0) & present
-    # the cell of a repeated point belongs to the first input row at that place
-    root = np.where(dup >= 0, dup, np.arange(n, dtype=np.int32))
+    first8 = first.view(np.int8)
     owner = perm.astype(np.int32)  # engine site -> input row owning its cell (a copy)
     if first_row_holds and (dup >= 0).any():
-        np.minimum.at(owner, root, perm)
-    site_of = np.empty(n, np.int32)
-    site_of[perm] = owner[root]
-
+        # the cell of a repeated point belongs to the first input row at that place
+        np.minimum.at(owner, np.where(dup >= 0, dup, np.arange(n, dtype=np.int32)), perm)
     points, offsets, ring, status = clip.clip_cells(
         exs,
         eys,
@@ -67,7 +64,7 @@ def assemble(
         out["he_twin"],
         out["he_face"],
         out["face_edge"],
-        first.astype(np.int8),
+        first8,
         box,
         e,
         threads,
@@ -76,16 +73,21 @@ def assemble(
     if status != 0:
         raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
 
+    # row maps: the row holding each row's cell, the engine site each row shows, its first half-edge
+    site_of, cell_of_row, face_edge = clip.rows_of_cells(
+        owner,
+        np.ascontiguousarray(perm, np.int32),
+        np.ascontiguousarray(dup, np.int32),
+        first8,
+        np.ascontiguousarray(out["face_edge"], np.int32),
+        threads,
+    )
+
     # cells to input rows (CSR gather; the clipper works in engine order, where a cell's edges and
     # vertices lie near its neighbours' in memory)
-    cell_of_row = np.full(n, -1, np.int32)  # engine site whose cell row r shows
-    firsts = np.flatnonzero(first)
-    cell_of_row[owner[firsts]] = firsts
     cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row, threads)
     del ring, offsets, cell_of_row
 
-    face_edge = np.full(n, -1, np.int32)
-    face_edge[owner[firsts]] = out["face_edge"][firsts]
     # engine sites to input rows in place (out is this build's own), and the vertices are the first
     # rows of the clipper's points (the same doubles): no second copy of either
     he_face = clip.relabel(owner, out["he_face"], threads)

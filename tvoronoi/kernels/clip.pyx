@@ -471,6 +471,7 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
     cdef int32_t[::1] out = vertices_arr
     cdef int32_t* out_p = &out[0] if total > 0 else NULL
     cdef int64_t k, lo, hi
+    cdef const int32_t* ring_p = &ring[0] if ring.shape[0] > 0 else NULL     # (a prefetch never faults)
     with nogil:
         # rows in input order are cells in random engine order: each cell's offsets are loaded GATHER_AHEAD
         # rows ahead and its ring half as far ahead, so that a copy seldom waits for memory
@@ -478,14 +479,40 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
             if r + GATHER_AHEAD < rows and cell_of_row[r + GATHER_AHEAD] >= 0:
                 prefetch(&offsets[cell_of_row[r + GATHER_AHEAD]])
             if r + GATHER_AHEAD // 2 < rows and cell_of_row[r + GATHER_AHEAD // 2] >= 0:
-                prefetch(&ring[offsets[cell_of_row[r + GATHER_AHEAD // 2]]])
+                prefetch(ring_p + offsets[cell_of_row[r + GATHER_AHEAD // 2]])
             c = cell_of_row[r]
             if c >= 0:
                 lo = offsets[c]
                 hi = offsets[c + 1]
                 for k in range(hi - lo):
-                    out_p[cell_offsets[r] + k] = ring[lo + k]
+                    out_p[cell_offsets[r] + k] = ring_p[lo + k]
     return cell_offsets_arr, vertices_arr
+
+
+def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32_t[::1] dup,
+                  const signed char[::1] first, const int32_t[::1] face_edge, int threads=1):
+    """The Diagram's row maps from engine order, in one pass: site k is input row perm[k], its cell is
+    held by row owner[k] (a repeated site k: by the owner of dup[k]), first[k] says it has a cell.
+
+    Returns (site_of, cell_of_row, row_face_edge), each (n,) int32: the row holding each row's cell; the
+    engine site whose cell each row shows (-1: none); each row's first half-edge (-1: none). The same
+    arrays for any thread count (perm and the owners of first sites are one-to-one).
+    """
+    cdef Py_ssize_t n = perm.shape[0], k
+    cdef int T = threads if n >= PARALLEL_MIN_CELLS and threads > 1 else 1
+    cdef int r
+    site_of_arr = np.empty(n, np.int32)
+    cell_of_row_arr = np.full(n, -1, np.int32)
+    face_edge_arr = np.full(n, -1, np.int32)
+    cdef int32_t[::1] site_of = site_of_arr, cell_of_row = cell_of_row_arr, row_face_edge = face_edge_arr
+    with nogil:
+        for k in prange(n, num_threads=T, schedule="static"):
+            r = dup[k] if dup[k] >= 0 else <int> k
+            site_of[perm[k]] = owner[r]
+            if first[k]:
+                cell_of_row[owner[k]] = <int32_t> k
+                row_face_edge[owner[k]] = face_edge[k]
+    return site_of_arr, cell_of_row_arr, face_edge_arr
 
 
 def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
