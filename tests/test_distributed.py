@@ -131,6 +131,15 @@ def test_a_clip_region_equals_one_process(client):
     assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
 
 
+def test_local_workers_run_without_the_nannys_malloc_trim_threshold(client):
+    # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers unless told not to; local_client's run as
+    # this process does (the value here, normally none)
+    import os
+
+    got = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
+    assert len(got) == 2 and set(got.values()) == {os.environ.get("MALLOC_TRIM_THRESHOLD_")}
+
+
 def test_a_dask_array_and_a_user_box(client):
     pts = generate("gaussian", N_SMALL, seed=7)
     bbox = (-1.0, -1.0, 2.0, 2.0)
