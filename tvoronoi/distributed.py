@@ -282,7 +282,10 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
     want = own[built]
     diagram = build(pts, bbox=plan.box, engine=job.engine, threads=1) if want.any() else None
     cells_out = tris_out = left_cells = left_tris = None
-    if kind in (BOTH, CELLS):
+    if kind in (BOTH, CELLS) and job.to is not None and job.format == "parquet" and job.clip is None:
+        # written: the certified cells go from the diagram to the part a row group at a time
+        cells_out, left_cells = _write_cells(sites, ids, built, pts, want, region, everything, diagram, job, name)
+    elif kind in (BOTH, CELLS):
         cells = build_tile(
             pts, ids[built], want, region, plan.box, everything=everything, engine=job.engine, diagram=diagram
         )
@@ -308,6 +311,26 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
             tri, left_tris = got.triangles, (got.pending, got.reaches)
         tris_out = _triangles_out(tri, ids[built], pts, job, name)
     return cells_out, tris_out, left_cells, left_tris
+
+
+def _write_cells(sites, ids, built, pts, want, region, everything: bool, diagram, job: Job, name: str):
+    """A task's certified cells written as a GeoParquet part: (the part's name, (pending cells, their
+    reaches)). ``built`` are the rows of ``sites`` the diagram holds (at ``pts``), ``want`` (over them)
+    those it emits."""
+    import pandas as pd
+
+    from tvoronoi.tiles import certify_cells
+    from tvoronoi.writers.parts import write_cells_part
+
+    if diagram is None:
+        return "", (np.empty(0, np.int64), np.empty((0, 4)))
+    verdict = certify_cells(diagram, pts, want, region, everything=everything)
+    rows = built[verdict.kept]
+    out = {SITE: ids[rows]}
+    for column in job.properties:
+        out[job.renames.get(column, column)] = sites[column].to_numpy()[rows]
+    part = write_cells_part(pd.DataFrame(out), diagram, verdict.kept, job.to, name, job.crs)
+    return part, (ids[built[verdict.failed]], verdict.reaches)
 
 
 def _triangles_out(tri: np.ndarray, ids: np.ndarray, pts: np.ndarray, job: Job, name: str):
@@ -339,9 +362,6 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
 
     lengths = np.diff(cells.offsets)
     has = lengths >= 3  # fewer points: no area (a cell touching the box)
-    if job.to is not None and job.format == "parquet" and job.clip is None:
-        # rings straight to WKB in bulk (writers.geoparquet), no shapely geometry per cell
-        return _rings_frame(sites, ids, cells, has, job)
     geoms = np.full(len(cells.ids), None, object)
     if has.any():
         keep = np.repeat(has, lengths)
@@ -364,27 +384,6 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
     wkb = shapely.to_wkb(geoms[order]) if len(order) else np.empty(0, object)
     out[GEOMETRY] = pd.array(wkb, dtype=_binary_dtype())
     return pd.DataFrame(out)
-
-
-def _rings_frame(sites, ids: np.ndarray, cells, has: np.ndarray, job: Job):
-    """(frame, rings): the frame as ``_cells_frame`` writes it, and the cells as closed rings
-    ``(xy, ring_offsets, present)`` for ``writers.geoparquet``'s bulk WKB (cells.ids is ascending)."""
-    import pandas as pd
-
-    lengths = np.diff(cells.offsets)
-    keep = np.repeat(has, lengths)
-    ring = cells.ring_xy[keep]
-    kept = lengths[has]
-    stops = np.cumsum(kept)
-    starts = stops - kept
-    xy = np.insert(ring, stops, ring[starts], axis=0)  # each ring's first point again at its end
-    ring_offsets = np.zeros(len(kept) + 1, np.int64)
-    np.cumsum(kept + 1, out=ring_offsets[1:])
-    position = np.searchsorted(ids, cells.ids)
-    out = {SITE: cells.ids}
-    for name in job.properties:
-        out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
-    return pd.DataFrame(out), (np.ascontiguousarray(xy), ring_offsets, has)
 
 
 def _binary_dtype():
