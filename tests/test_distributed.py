@@ -140,6 +140,43 @@ def test_local_workers_run_without_the_nannys_malloc_trim_threshold(client):
     assert len(got) == 2 and set(got.values()) == {os.environ.get("MALLOC_TRIM_THRESHOLD_")}
 
 
+@pytest.mark.parametrize("layout", ["uniform", "one column", "rounded", "one point"])
+def test_many_regions_select_the_rows_each_region_tests_on_every_site(layout):
+    # a partition serving many regions bins its sites first: every region still gets exactly the rows
+    # of the sites in it (closed sides, infinite sides, regions beyond the sites), ascending
+    from tvoronoi.distributed import FEW_REGIONS, _select
+    from tvoronoi.tiles import in_region
+
+    rng = np.random.default_rng(8)
+    pts = rng.random((5_000, 2))
+    if layout == "one column":
+        pts[:, 0] = 0.25
+    elif layout == "rounded":  # sites on region sides
+        pts = np.round(pts, 1)
+    elif layout == "one point":
+        pts[:] = 0.5
+    corners = np.round(rng.random((4 * FEW_REGIONS, 2, 2)) * 1.4 - 0.2, 1)
+    regions = [(float(a[0].min()), float(a[1].min()), float(a[0].max()), float(a[1].max())) for a in corners]
+    regions += [
+        (-np.inf, -np.inf, 0.3, np.inf),
+        (0.5, -np.inf, np.inf, 0.5),
+        (2.0, 2.0, 3.0, 3.0),
+        (0.25, 0.5, 0.25, 0.5),
+    ]
+    part = pd.DataFrame({"x": pts[:, 0], "y": pts[:, 1], "w": np.arange(len(pts)) * 2})
+    many = _select(part, 100, "x", "y", regions, ["w"], None)
+    for region, frame in zip(regions, many):
+        rows = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+        assert frame["__tvoronoi_site"].tolist() == (rows + 100).tolist()
+        assert (frame["w"].to_numpy() == rows * 2).all()
+        assert np.array_equal(frame["__tvoronoi_x"].to_numpy(), pts[rows, 0])
+    # the same frames as a few regions at a time (each tested on every site)
+    for k in range(0, len(regions), FEW_REGIONS):
+        few = _select(part, 100, "x", "y", regions[k : k + FEW_REGIONS], ["w"], None)
+        for a, b in zip(few, many[k : k + FEW_REGIONS]):
+            pd.testing.assert_frame_equal(a, b)
+
+
 def test_a_dask_array_and_a_user_box(client):
     pts = generate("gaussian", N_SMALL, seed=7)
     bbox = (-1.0, -1.0, 2.0, 2.0)

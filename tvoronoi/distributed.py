@@ -44,9 +44,12 @@ FORMATS = ("parquet", "geojsonseq")
 # in the kernel with it, 1.3-1.6 without. The builds hand their large arrays back themselves
 # (kernels/pages.pyx). Workers started by ``dask worker`` set it unless told not to (see the README).
 WORKER_ENVIRON_UNSET = ("MALLOC_TRIM_THRESHOLD_",)
-# a partition serving more regions than this in one round is sorted by x first (one sort, then each
-# region reads only its x range: a later round's many small groups cost little)
-SORT_ABOVE = 4
+# A partition serving at most this many regions in one round tests each region on every site (a few
+# ms per region at 10^6 sites); one serving more first puts its sites in the bins of a GRID x GRID grid
+# (one stable sort of small integers, about 20 ms at 10^6 sites), and each region tests only the sites
+# of the bins it meets: a later round's many small groups, or many tiles, cost little.
+FEW_REGIONS = 16
+GRID = 128
 
 
 def require_dask():
@@ -225,19 +228,10 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
     import pandas as pd
 
     xs, ys = _coordinates(part, x), _coordinates(part, y)
-    # many regions (the small groups of a later round): each looks only at the sites in its x range,
-    # found in the partition sorted by x once, not at the whole partition
-    sort = len(regions) > SORT_ABOVE
-    by_x = np.argsort(xs, kind="stable") if sort else np.empty(0, np.int64)
-    sorted_x = xs[by_x]
+    bins = _Bins(xs, ys) if len(regions) > FEW_REGIONS and len(xs) else None
     out = []
     for region in regions:
-        if not sort:
-            rows = np.flatnonzero(in_region(xs, ys, region))
-        else:
-            lo, hi = np.searchsorted(sorted_x, region[0], "left"), np.searchsorted(sorted_x, region[2], "right")
-            slab = by_x[lo:hi]
-            rows = np.sort(slab[(ys[slab] >= region[1]) & (ys[slab] <= region[3])])
+        rows = np.flatnonzero(in_region(xs, ys, region)) if bins is None else bins.rows_in(region)
         frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
         inside = np.ones(len(rows), bool)
         if clip is not None and len(rows):
@@ -249,6 +243,43 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
             frame[name] = part[name].to_numpy()[rows]
         out.append(frame)
     return tuple(out)
+
+
+class _Bins:
+    """A partition's sites in the bins of a GRID x GRID grid over their extent, for many regions.
+
+    A site's bin and a region's range of bins come from the same rounded arithmetic, which is monotone
+    (a larger coordinate never lands in a lower bin), so the bins a region meets hold each of its sites;
+    ``rows_in`` then tests those sites exactly.
+    """
+
+    def __init__(self, xs: np.ndarray, ys: np.ndarray):
+        self.xs, self.ys = xs, ys
+        self.x0, self.y0 = float(xs.min()), float(ys.min())
+        width, height = float(xs.max()) - self.x0, float(ys.max()) - self.y0
+        self.sx = GRID / width if width > 0 else 0.0
+        self.sy = GRID / height if height > 0 else 0.0
+        cell = (self._bins(xs, self.x0, self.sx) * GRID + self._bins(ys, self.y0, self.sy)).astype(np.int16)
+        self.order = np.argsort(cell, kind="stable")  # a radix sort: rows ascending within a bin
+        self.starts = np.zeros(GRID * GRID + 1, np.int64)
+        np.cumsum(np.bincount(cell, minlength=GRID * GRID), out=self.starts[1:])
+
+    @staticmethod
+    def _bins(values, origin: float, scale: float) -> np.ndarray:
+        if scale == 0:  # every site at one coordinate: one bin (a region's side may be infinite)
+            return np.zeros(np.shape(values), np.int16)
+        return np.clip(np.floor((np.asarray(values, np.float64) - origin) * scale), 0, GRID - 1).astype(np.int16)
+
+    def rows_in(self, region: Region) -> np.ndarray:
+        """The rows of the sites in the closed region, ascending."""
+        x0, y0, x1, y1 = region
+        gx0, gx1 = (int(v) for v in self._bins([x0, x1], self.x0, self.sx))
+        gy0, gy1 = (int(v) for v in self._bins([y0, y1], self.y0, self.sy))
+        columns = [
+            self.order[self.starts[gx * GRID + gy0] : self.starts[gx * GRID + gy1 + 1]] for gx in range(gx0, gx1 + 1)
+        ]
+        near = np.concatenate(columns) if columns else np.empty(0, np.int64)
+        return np.sort(near[in_region(self.xs[near], self.ys[near], region)])
 
 
 # ---------------------------------------------------------------------------------------------
