@@ -22,8 +22,20 @@ N = 200_000
 N_SMALL = 40_000
 
 
+# Dask's worker and nanny configuration in this process before the first local_client (which sets
+# some for its own workers only, and must leave these as they were)
+CONFIG_BEFORE: dict = {}
+WORKER_KEYS = ("distributed.worker", "distributed.nanny")
+
+
 @pytest.fixture(scope="module")
 def client():
+    import copy
+
+    import dask
+    import distributed  # noqa: F401 (its configuration's defaults)
+
+    CONFIG_BEFORE.update({key: copy.deepcopy(dask.config.get(key)) for key in WORKER_KEYS})
     c = local_client(2)
     yield c
     c.close()
@@ -131,13 +143,20 @@ def test_a_clip_region_equals_one_process(client):
     assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
 
 
-def test_local_workers_run_without_the_nannys_malloc_trim_threshold(client):
+def test_local_workers_run_without_the_nannys_malloc_trim_threshold_and_the_profiler(client):
     # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers unless told not to; local_client's run as
-    # this process does (the value here, normally none)
+    # this process does (the value here, normally none), and without the statistical profiler
     import os
+
+    import dask
 
     got = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
     assert len(got) == 2 and set(got.values()) == {os.environ.get("MALLOC_TRIM_THRESHOLD_")}
+    profiling = client.run(lambda dask_worker: dask_worker.periodic_callbacks.get("profile") is not None)
+    assert set(profiling.values()) == {False}
+    assert client.run(lambda: dask.config.get("distributed.worker.profile.enabled")) == dict.fromkeys(got, False)
+    # this process's configuration is left as it was
+    assert {key: dask.config.get(key) for key in WORKER_KEYS} == CONFIG_BEFORE
 
 
 @pytest.mark.parametrize("layout", ["uniform", "one column", "rounded", "one point"])
