@@ -42,7 +42,7 @@ FORMATS = ("parquet", "geojsonseq")
 # mmap threshold, so every block over 128 KiB (each array a task makes between the kernels' phases, a
 # row group's WKB) is mapped afresh and page-faulted again: three tiles of 10^6 sites spent 4.3-5.7 CPU s
 # in the kernel with it, 1.3-1.6 without. The builds hand their large arrays back themselves
-# (kernels/pages.pyx). Workers started by ``dask worker`` set it unless told not to (see the README).
+# (kernels/pages.pyx). Workers started by ``dask worker`` set it unless configured not to (see the README).
 WORKER_ENVIRON_UNSET = ("MALLOC_TRIM_THRESHOLD_",)
 # The Dask configuration of ``local_client``'s workers: no statistical profiler (it samples the task's
 # stack on the worker's event loop every 10 ms: 0.4 CPU s per 20 s in an idle worker, more in a busy
