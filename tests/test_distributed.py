@@ -22,8 +22,20 @@ N = 200_000
 N_SMALL = 40_000
 
 
+# Dask's worker and nanny configuration in this process before the first local_client (which sets
+# some for its own workers only, and must leave these as they were)
+CONFIG_BEFORE: dict = {}
+WORKER_KEYS = ("distributed.worker", "distributed.nanny")
+
+
 @pytest.fixture(scope="module")
 def client():
+    import copy
+
+    import dask
+    import distributed  # noqa: F401 (its configuration's defaults)
+
+    CONFIG_BEFORE.update({key: copy.deepcopy(dask.config.get(key)) for key in WORKER_KEYS})
     c = local_client(2)
     yield c
     c.close()
@@ -131,6 +143,59 @@ def test_a_clip_region_equals_one_process(client):
     assert (cells["id"].to_numpy() == cells["site"].to_numpy() * 3).all()
 
 
+def test_local_workers_run_without_the_nannys_malloc_trim_threshold_and_the_profiler(client):
+    # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers unless told not to; local_client's run as
+    # this process does (the value here, normally none), and without the statistical profiler
+    import os
+
+    import dask
+
+    got = client.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
+    assert len(got) == 2 and set(got.values()) == {os.environ.get("MALLOC_TRIM_THRESHOLD_")}
+    profiling = client.run(lambda dask_worker: dask_worker.periodic_callbacks.get("profile") is not None)
+    assert set(profiling.values()) == {False}
+    assert client.run(lambda: dask.config.get("distributed.worker.profile.enabled")) == dict.fromkeys(got, False)
+    # this process's configuration is left as it was
+    assert {key: dask.config.get(key) for key in WORKER_KEYS} == CONFIG_BEFORE
+
+
+@pytest.mark.parametrize("layout", ["uniform", "one column", "rounded", "one point"])
+def test_many_regions_select_the_rows_each_region_tests_on_every_site(layout):
+    # a partition serving many regions bins its sites first: every region still gets exactly the rows
+    # of the sites in it (closed sides, infinite sides, regions beyond the sites), ascending
+    from tvoronoi.distributed import FEW_REGIONS, _select
+    from tvoronoi.tiles import in_region
+
+    rng = np.random.default_rng(8)
+    pts = rng.random((5_000, 2))
+    if layout == "one column":
+        pts[:, 0] = 0.25
+    elif layout == "rounded":  # sites on region sides
+        pts = np.round(pts, 1)
+    elif layout == "one point":
+        pts[:] = 0.5
+    corners = np.round(rng.random((4 * FEW_REGIONS, 2, 2)) * 1.4 - 0.2, 1)
+    regions = [(float(a[0].min()), float(a[1].min()), float(a[0].max()), float(a[1].max())) for a in corners]
+    regions += [
+        (-np.inf, -np.inf, 0.3, np.inf),
+        (0.5, -np.inf, np.inf, 0.5),
+        (2.0, 2.0, 3.0, 3.0),
+        (0.25, 0.5, 0.25, 0.5),
+    ]
+    part = pd.DataFrame({"x": pts[:, 0], "y": pts[:, 1], "w": np.arange(len(pts)) * 2})
+    many = _select(part, 100, "x", "y", regions, ["w"], None)
+    for region, frame in zip(regions, many):
+        rows = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+        assert frame["__tvoronoi_site"].tolist() == (rows + 100).tolist()
+        assert (frame["w"].to_numpy() == rows * 2).all()
+        assert np.array_equal(frame["__tvoronoi_x"].to_numpy(), pts[rows, 0])
+    # the same frames as a few regions at a time (each tested on every site)
+    for k in range(0, len(regions), FEW_REGIONS):
+        few = _select(part, 100, "x", "y", regions[k : k + FEW_REGIONS], ["w"], None)
+        for a, b in zip(few, many[k : k + FEW_REGIONS]):
+            pd.testing.assert_frame_equal(a, b)
+
+
 def test_a_dask_array_and_a_user_box(client):
     pts = generate("gaussian", N_SMALL, seed=7)
     bbox = (-1.0, -1.0, 2.0, 2.0)
@@ -140,6 +205,7 @@ def test_a_dask_array_and_a_user_box(client):
 
 def test_geoparquet_directory_reads_as_one_table(client, tmp_path):
     import geopandas
+    import pyarrow as pa
     import pyarrow.dataset as ds
     import pyarrow.parquet as pq
 
@@ -158,7 +224,13 @@ def test_geoparquet_directory_reads_as_one_table(client, tmp_path):
     present = ~frame.geometry.isna().to_numpy()
     assert shapely.equals_exact(frame.geometry.to_numpy()[present], want[present], tolerance=0).all()
     # _metadata alone opens every part, and the common schema carries the dataset's geo metadata
-    assert ds.parquet_dataset(str(out / "_metadata")).to_table().num_rows == N_SMALL
+    table = ds.parquet_dataset(str(out / "_metadata")).to_table().sort_by("site")
+    assert table.num_rows == N_SMALL
+    # the parts' WKB, byte for byte, and their bbox columns: one process's cells
+    assert table["geometry"].to_pylist() == list(shapely.to_wkb(want))
+    bbox = table["bbox"].combine_chunks().filter(pa.array(present))
+    bounds = np.column_stack([bbox.field(k).to_numpy() for k in ("xmin", "ymin", "xmax", "ymax")])
+    assert np.array_equal(bounds, shapely.bounds(want[present]))
     geo = pq.read_schema(out / "_common_metadata").metadata[b"geo"]
     assert b'"geometry_types":["Polygon"]' in geo
 

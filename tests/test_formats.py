@@ -272,3 +272,32 @@ def test_geoparquet_row_groups_hold_the_same_rows(tmp_path, monkeypatch):
     assert many["duplicates"].to_pylist()[5:8] == [[40], [41], [42]]
     geo = json.loads(many.schema.metadata[b"geo"])
     assert geo["columns"]["geometry"]["bbox"] == list(shapely.total_bounds(polygons))
+
+
+def test_a_part_written_from_its_diagram_equals_the_part_of_its_shapely_cells(tmp_path, monkeypatch):
+    """A distributed task's part written straight from its diagram, a row group at a time (some rows
+    only, repeated sites and a cell that misses the box among them), reads back as the part of the
+    same rows' shapely cells: the same WKB bytes, bbox, properties and geo metadata."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    import pandas as pd
+
+    import tvoronoi
+    from tvoronoi.writers import geoparquet
+    from tvoronoi.writers.parts import write_cells_part, write_part
+
+    base = DATASETS["clustered"][:60]
+    sites = np.concatenate([base, base[[5, 6, 7]], [[1e6, 1e6]]])
+    box = (base.min() - 1, base.min() - 1, base.max() + 1, base.max() + 1)
+    d = tvoronoi.voronoi(sites, bbox=box)
+    rows = np.concatenate([np.arange(0, 60, 3), np.arange(60, len(sites))])
+    frame = pd.DataFrame({"site": rows + 1000, "name": [f"s{i}" for i in rows]})
+    monkeypatch.setattr(geoparquet, "ROW_GROUP", 5)
+    direct = write_cells_part(frame, d, rows, tmp_path, "part-direct", "EPSG:3857")
+    shapes = write_part(frame, d.to_shapely()[rows], tmp_path, "part-shapes", "parquet", "EPSG:3857")
+    got, want = pq.read_table(tmp_path / direct), pq.read_table(tmp_path / shapes)
+    assert pq.ParquetFile(tmp_path / direct).num_row_groups == -(-len(rows) // 5)
+    assert got.equals(want) and got.schema.metadata == want.schema.metadata
+    wkb = got["geometry"].to_pylist()
+    assert wkb[-4:] == [None] * 4  # the repeats and the cell outside the box
+    assert wkb[:-4] == list(shapely.to_wkb(d.to_shapely()[rows[:-4]]))
+    assert write_cells_part(frame[:0], d, rows[:0], tmp_path, "part-empty") == ""

@@ -15,7 +15,9 @@ from tvoronoi.generators import generate
 from tvoronoi.tiles import (
     build_tile,
     certified,
+    certify_cells,
     extent_of,
+    flower_box,
     group_reaches,
     grown,
     in_region,
@@ -175,6 +177,37 @@ def test_hunt_certified_cells_are_final(seed, k):
         assert len(again.pending) == 0 and sorted(again.ids.tolist()) == sorted(group.tolist())
         for i, ring in again.rings():
             assert np.array_equal(ring, full.cell_polygon(i))
+
+
+def test_certify_cells_in_chunks_agrees_with_one_pass(monkeypatch):
+    # a tile's diagram with halo sites not wanted; certified a few cells at a time, the verdict is the
+    # test of all the wanted rings at once, the kept cells are the whole diagram's and the reaches those
+    # of the failed rings
+    import tvoronoi.tiles as tiles
+
+    pts = generate("gaussian", 6_000, seed=21)
+    rects = kd_rects(pts, 4)
+    region = grown(rects[1], 0.05)
+    seen = np.flatnonzero(in_region(pts[:, 0], pts[:, 1], region))
+    want = tile_of(pts[seen, 0], pts[seen, 1], rects) == 1
+    box = (-6.0, -6.0, 6.0, 6.0)
+    d = tvoronoi.voronoi(pts[seen], bbox=box, threads=1)
+    monkeypatch.setattr(tiles, "CERTIFY_CHUNK", 37)
+    verdict = certify_cells(d, pts[seen], want, region)
+    rows = np.flatnonzero(want)
+    rings = [d.cell_polygon(i) for i in rows]
+    offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])])
+    ok = certified(np.concatenate(rings), offsets, pts[seen][rows], region)
+    assert 0 < len(verdict.failed) < len(rows)
+    assert np.array_equal(verdict.kept, rows[ok]) and np.array_equal(verdict.failed, rows[~ok])
+    for i, reach in zip(verdict.failed, verdict.reaches):
+        ring = d.cell_polygon(i)
+        assert tuple(reach) == flower_box(ring, np.repeat(pts[seen][i][None], len(ring), axis=0))
+    full = tvoronoi.voronoi(pts, bbox=box, threads=1)
+    for i in verdict.kept:
+        assert np.array_equal(d.cell_polygon(i), full.cell_polygon(seen[i]))
+    # a region holding every site certifies every wanted cell without a test
+    assert np.array_equal(certify_cells(d, pts[seen], want, region, everything=True).kept, rows)
 
 
 def test_group_reaches_keeps_far_cells_apart_and_joins_overlapping_ones():

@@ -37,9 +37,23 @@ ID, X, Y = "__tvoronoi_site", "__tvoronoi_x", "__tvoronoi_y"
 # the cell columns tvoronoi adds; a property of the same name is renamed
 SITE, GEOMETRY = "site", "geometry"
 FORMATS = ("parquet", "geojsonseq")
-# a partition serving more regions than this in one round is sorted by x first (one sort, then each
-# region reads only its x range: a later round's many small groups cost little)
-SORT_ABOVE = 4
+# What Dask's nanny sets in a worker's environment by default and ``local_client`` leaves unset:
+# MALLOC_TRIM_THRESHOLD_ (64 KiB, to hand freed memory back sooner) also turns off glibc's adaptive
+# mmap threshold, so every block over 128 KiB (each array a task makes between the kernels' phases, a
+# row group's WKB) is mapped afresh and page-faulted again: three tiles of 10^6 sites spent 4.3-5.7 CPU s
+# in the kernel with it, 1.3-1.6 without. The builds hand their large arrays back themselves
+# (kernels/pages.pyx). Workers started by ``dask worker`` set it unless configured not to (see the README).
+WORKER_ENVIRON_UNSET = ("MALLOC_TRIM_THRESHOLD_",)
+# The Dask configuration of ``local_client``'s workers: no statistical profiler (it samples the task's
+# stack on the worker's event loop every 10 ms: 0.4 CPU s per 20 s in an idle worker, more in a busy
+# one; about 1 CPU s per worker, 3% of the work, in the 10^7-site benchmark).
+LOCAL_WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
+# A partition serving at most this many regions in one round tests each region on every site (a few
+# ms per region at 10^6 sites); one serving more first puts its sites in the bins of a GRID x GRID grid
+# (one stable sort of small integers, about 20 ms at 10^6 sites), and each region tests only the sites
+# of the bins it meets: a later round's many small groups, or many tiles, cost little.
+FEW_REGIONS = 16
+GRID = 128
 
 
 def require_dask():
@@ -218,19 +232,10 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
     import pandas as pd
 
     xs, ys = _coordinates(part, x), _coordinates(part, y)
-    # many regions (the small groups of a later round): each looks only at the sites in its x range,
-    # found in the partition sorted by x once, not at the whole partition
-    sort = len(regions) > SORT_ABOVE
-    by_x = np.argsort(xs, kind="stable") if sort else np.empty(0, np.int64)
-    sorted_x = xs[by_x]
+    bins = _Bins(xs, ys) if len(regions) > FEW_REGIONS and len(xs) else None
     out = []
     for region in regions:
-        if not sort:
-            rows = np.flatnonzero(in_region(xs, ys, region))
-        else:
-            lo, hi = np.searchsorted(sorted_x, region[0], "left"), np.searchsorted(sorted_x, region[2], "right")
-            slab = by_x[lo:hi]
-            rows = np.sort(slab[(ys[slab] >= region[1]) & (ys[slab] <= region[3])])
+        rows = np.flatnonzero(in_region(xs, ys, region)) if bins is None else bins.rows_in(region)
         frame = pd.DataFrame({ID: np.int64(first_row) + rows, X: xs[rows], Y: ys[rows]})
         inside = np.ones(len(rows), bool)
         if clip is not None and len(rows):
@@ -242,6 +247,43 @@ def _select(part, first_row: int, x: str, y: str, regions: list, keep: list[str]
             frame[name] = part[name].to_numpy()[rows]
         out.append(frame)
     return tuple(out)
+
+
+class _Bins:
+    """A partition's sites in the bins of a GRID x GRID grid over their extent, for many regions.
+
+    A site's bin and a region's range of bins come from the same rounded arithmetic, which is monotone
+    (a larger coordinate never lands in a lower bin), so the bins a region meets hold each of its sites;
+    ``rows_in`` then tests those sites exactly.
+    """
+
+    def __init__(self, xs: np.ndarray, ys: np.ndarray):
+        self.xs, self.ys = xs, ys
+        self.x0, self.y0 = float(xs.min()), float(ys.min())
+        width, height = float(xs.max()) - self.x0, float(ys.max()) - self.y0
+        self.sx = GRID / width if width > 0 else 0.0
+        self.sy = GRID / height if height > 0 else 0.0
+        cell = (self._bins(xs, self.x0, self.sx) * GRID + self._bins(ys, self.y0, self.sy)).astype(np.int16)
+        self.order = np.argsort(cell, kind="stable")  # a radix sort: rows ascending within a bin
+        self.starts = np.zeros(GRID * GRID + 1, np.int64)
+        np.cumsum(np.bincount(cell, minlength=GRID * GRID), out=self.starts[1:])
+
+    @staticmethod
+    def _bins(values, origin: float, scale: float) -> np.ndarray:
+        if scale == 0:  # every site at one coordinate: one bin (a region's side may be infinite)
+            return np.zeros(np.shape(values), np.int16)
+        return np.clip(np.floor((np.asarray(values, np.float64) - origin) * scale), 0, GRID - 1).astype(np.int16)
+
+    def rows_in(self, region: Region) -> np.ndarray:
+        """The rows of the sites in the closed region, ascending."""
+        x0, y0, x1, y1 = region
+        gx0, gx1 = (int(v) for v in self._bins([x0, x1], self.x0, self.sx))
+        gy0, gy1 = (int(v) for v in self._bins([y0, y1], self.y0, self.sy))
+        columns = [
+            self.order[self.starts[gx * GRID + gy0] : self.starts[gx * GRID + gy1 + 1]] for gx in range(gx0, gx1 + 1)
+        ]
+        near = np.concatenate(columns) if columns else np.empty(0, np.int64)
+        return np.sort(near[in_region(self.xs[near], self.ys[near], region)])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -275,7 +317,10 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
     want = own[built]
     diagram = build(pts, bbox=plan.box, engine=job.engine, threads=1) if want.any() else None
     cells_out = tris_out = left_cells = left_tris = None
-    if kind in (BOTH, CELLS):
+    if kind in (BOTH, CELLS) and job.to is not None and job.format == "parquet" and job.clip is None:
+        # written: the certified cells go from the diagram to the part a row group at a time
+        cells_out, left_cells = _write_cells(sites, ids, built, pts, want, region, everything, diagram, job, name)
+    elif kind in (BOTH, CELLS):
         cells = build_tile(
             pts, ids[built], want, region, plan.box, everything=everything, engine=job.engine, diagram=diagram
         )
@@ -301,6 +346,26 @@ def _run_tile(pieces: list, t: int, region: Region, group, kind: str, job: Job, 
             tri, left_tris = got.triangles, (got.pending, got.reaches)
         tris_out = _triangles_out(tri, ids[built], pts, job, name)
     return cells_out, tris_out, left_cells, left_tris
+
+
+def _write_cells(sites, ids, built, pts, want, region, everything: bool, diagram, job: Job, name: str):
+    """A task's certified cells written as a GeoParquet part: (the part's name, (pending cells, their
+    reaches)). ``built`` are the rows of ``sites`` the diagram holds (at ``pts``), ``want`` (over them)
+    those it emits."""
+    import pandas as pd
+
+    from tvoronoi.tiles import certify_cells
+    from tvoronoi.writers.parts import write_cells_part
+
+    if diagram is None:
+        return "", (np.empty(0, np.int64), np.empty((0, 4)))
+    verdict = certify_cells(diagram, pts, want, region, everything=everything)
+    rows = built[verdict.kept]
+    out = {SITE: ids[rows]}
+    for column in job.properties:
+        out[job.renames.get(column, column)] = sites[column].to_numpy()[rows]
+    part = write_cells_part(pd.DataFrame(out), diagram, verdict.kept, job.to, name, job.crs)
+    return part, (ids[built[verdict.failed]], verdict.reaches)
 
 
 def _triangles_out(tri: np.ndarray, ids: np.ndarray, pts: np.ndarray, job: Job, name: str):
@@ -332,9 +397,6 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
 
     lengths = np.diff(cells.offsets)
     has = lengths >= 3  # fewer points: no area (a cell touching the box)
-    if job.to is not None and job.format == "parquet" and job.clip is None:
-        # rings straight to WKB in bulk (writers.geoparquet), no shapely geometry per cell
-        return _rings_frame(sites, ids, cells, has, job)
     geoms = np.full(len(cells.ids), None, object)
     if has.any():
         keep = np.repeat(has, lengths)
@@ -357,27 +419,6 @@ def _cells_frame(sites, ids: np.ndarray, cells, outside: np.ndarray, job: Job):
     wkb = shapely.to_wkb(geoms[order]) if len(order) else np.empty(0, object)
     out[GEOMETRY] = pd.array(wkb, dtype=_binary_dtype())
     return pd.DataFrame(out)
-
-
-def _rings_frame(sites, ids: np.ndarray, cells, has: np.ndarray, job: Job):
-    """(frame, rings): the frame as ``_cells_frame`` writes it, and the cells as closed rings
-    ``(xy, ring_offsets, present)`` for ``writers.geoparquet``'s bulk WKB (cells.ids is ascending)."""
-    import pandas as pd
-
-    lengths = np.diff(cells.offsets)
-    keep = np.repeat(has, lengths)
-    ring = cells.ring_xy[keep]
-    kept = lengths[has]
-    stops = np.cumsum(kept)
-    starts = stops - kept
-    xy = np.insert(ring, stops, ring[starts], axis=0)  # each ring's first point again at its end
-    ring_offsets = np.zeros(len(kept) + 1, np.int64)
-    np.cumsum(kept + 1, out=ring_offsets[1:])
-    position = np.searchsorted(ids, cells.ids)
-    out = {SITE: cells.ids}
-    for name in job.properties:
-        out[job.renames.get(name, name)] = sites[name].to_numpy()[position]
-    return pd.DataFrame(out), (np.ascontiguousarray(xy), ring_offsets, has)
 
 
 def _binary_dtype():
@@ -676,8 +717,13 @@ def local_client(workers: int | None = None, *, quiet: bool = False):
     """A LocalCluster on this machine (one single-threaded worker process per core by default) and its client.
 
     ``quiet`` keeps the cluster's own log lines (a task's failure, told again by the exception) off stderr.
+    The workers run without the ``MALLOC_TRIM_THRESHOLD_`` Dask's nanny sets by default (see
+    ``WORKER_ENVIRON_UNSET``; one set in this process's environment is kept) and without Dask's
+    statistical profiler (``LOCAL_WORKER_CONFIG``): the dashboard's profile stays empty.
     """
     import logging
+
+    import dask
 
     distributed = require_dask()
     if workers is None:
@@ -685,13 +731,16 @@ def local_client(workers: int | None = None, *, quiet: bool = False):
             workers = len(os.sched_getaffinity(0))
         except AttributeError:
             workers = os.cpu_count() or 1
-    cluster = distributed.LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        silence_logs=logging.CRITICAL if quiet else logging.WARN,
-    )
+    unset = {f"distributed.nanny.pre-spawn-environ.{name}": None for name in WORKER_ENVIRON_UNSET}
+    # the nannies take the configuration in force as they start, and hand it to their workers
+    with dask.config.set({**unset, **LOCAL_WORKER_CONFIG}):
+        cluster = distributed.LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",
+            silence_logs=logging.CRITICAL if quiet else logging.WARN,
+        )
     return distributed.Client(cluster)
 
 

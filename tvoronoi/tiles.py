@@ -33,6 +33,8 @@ SAMPLE_PER_TILE = 1000
 # of the test itself (each at most 2^-53), and ulps for the rounding of a ring's point.
 CERTIFY_RELATIVE = 2.0**-40
 CERTIFY_ULPS = 2.0
+# Cells certified per numpy pass (``certify_cells``): their ring points' temporaries stay a few MiB.
+CERTIFY_CHUNK = 1 << 15
 # Rounds after which a tile sees everything: its region doubles each round, so this bounds nothing
 # in practice; it guards against a region that stops growing (a halo of 0).
 MAX_ROUNDS = 64
@@ -275,36 +277,77 @@ def build_tile(
     """
     from tvoronoi.api import voronoi
 
-    rows = np.flatnonzero(want)
-    if len(rows) == 0:
+    if not want.any():
         empty = np.empty(0, np.int64)
         return TileCells(empty, np.zeros(1, np.int64), np.empty((0, 2)), empty)
     d = voronoi(pts, bbox=box, engine=engine, threads=threads) if diagram is None else diagram
-    # the wanted cells' rings (a mask over the CSR points: cheaper than an index when most are wanted)
+    verdict = certify_cells(d, pts, want, region, everything=everything)
+    kept = verdict.kept
+    # the kept cells' rings (a mask over the CSR points: cheaper than an index when most are kept)
     all_lengths = np.diff(d.cell_offsets)
-    lengths = all_lengths[rows]
-    offsets = np.zeros(len(rows) + 1, np.int64)
-    np.cumsum(lengths, out=offsets[1:])
-    vertices = d.cell_vertices if len(rows) == len(pts) else d.cell_vertices[np.repeat(want, all_lengths)]
-    ring_xy = d.cell_points[vertices]
-    ok = np.ones(len(rows), bool) if everything else certified(ring_xy, offsets, pts[rows], region)
-    if ok.all():
-        return TileCells(ids[rows].astype(np.int64), offsets, ring_xy, np.empty(0, np.int64))
-    keep = np.flatnonzero(ok)
-    k_off = np.zeros(len(keep) + 1, np.int64)
-    np.cumsum(lengths[keep], out=k_off[1:])
-    failed = np.flatnonzero(~ok)
-    reaches = np.empty((len(failed), 4))
-    for j, k in enumerate(failed.tolist()):
-        a, b = offsets[k], offsets[k + 1]
-        reaches[j] = flower_box(ring_xy[a:b], np.repeat(pts[rows[k]][None], b - a, axis=0))
+    offsets = np.zeros(len(kept) + 1, np.int64)
+    np.cumsum(all_lengths[kept], out=offsets[1:])
+    if len(kept) == len(pts):
+        vertices = d.cell_vertices
+    else:
+        mask = np.zeros(len(pts), bool)
+        mask[kept] = True
+        vertices = d.cell_vertices[np.repeat(mask, all_lengths)]
     return TileCells(
-        ids[rows[keep]].astype(np.int64),
-        k_off,
-        ring_xy[np.repeat(ok, lengths)],
-        ids[rows[failed]].astype(np.int64),
-        reaches,
+        ids[kept].astype(np.int64),
+        offsets,
+        np.take(d.cell_points, vertices, axis=0),
+        ids[verdict.failed].astype(np.int64),
+        verdict.reaches,
     )
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Which wanted cells of a tile's diagram are certified: ``kept`` and ``failed`` are rows of the
+    diagram (ascending); ``reaches`` (f, 4) the box each failed cell needs seen (``flower_box``)."""
+
+    kept: np.ndarray
+    failed: np.ndarray
+    reaches: np.ndarray
+
+
+def certify_cells(diagram, pts: np.ndarray, want: np.ndarray, region: Region, *, everything: bool = False) -> Verdict:
+    """Certify the cells of the ``want`` rows of a tile's diagram (as ``build_tile``, without gathering
+    their rings: a writer takes the kept cells from the diagram a row group at a time).
+
+    The rings are read ``CERTIFY_CHUNK`` cells at a time, so the test's temporaries stay a few MiB that
+    the heap reuses, instead of a dozen arrays the size of every ring point mapped and faulted afresh.
+    """
+    rows = np.flatnonzero(want)
+    if everything or len(rows) == 0:
+        return Verdict(rows, np.empty(0, np.int64), np.empty((0, 4)))
+    offsets = diagram.cell_offsets
+    ok = np.empty(len(rows), bool)
+    for a in range(0, len(rows), CERTIFY_CHUNK):
+        chunk = rows[a : a + CERTIFY_CHUNK]
+        first, last = int(chunk[0]), int(chunk[-1]) + 1
+        ring_xy, chunk_offsets = _rings_of(diagram, first, last, want[first:last])
+        ok[a : a + len(chunk)] = certified(ring_xy, chunk_offsets, pts[chunk], region)
+    failed = rows[~ok]
+    reaches = np.empty((len(failed), 4))
+    for j, i in enumerate(failed.tolist()):
+        ring = diagram.cell_points[diagram.cell_vertices[offsets[i] : offsets[i + 1]]]
+        reaches[j] = flower_box(ring, np.repeat(pts[i][None], len(ring), axis=0))
+    return Verdict(rows[ok], failed, reaches)
+
+
+def _rings_of(diagram, first: int, last: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rings of the rows first..last-1 of a diagram where ``keep`` holds: (ring_xy, offsets)."""
+    all_offsets = diagram.cell_offsets[first : last + 1]
+    lengths = np.diff(all_offsets)
+    vertices = diagram.cell_vertices[all_offsets[0] : all_offsets[-1]]
+    if not keep.all():
+        vertices = vertices[np.repeat(keep, lengths)]
+        lengths = lengths[keep]
+    offsets = np.zeros(len(lengths) + 1, np.int64)
+    np.cumsum(lengths, out=offsets[1:])
+    return np.take(diagram.cell_points, vertices, axis=0), offsets
 
 
 def group_reaches(pending: np.ndarray, reaches: np.ndarray, margin: float) -> list[tuple[np.ndarray, Region]]:

@@ -261,7 +261,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         If writing fails (an existing file at ``out`` is then left untouched).
     """
     pa = require_pyarrow()
-    from tvoronoi.writers.geojson_diagram import MIN_RING_POINTS, closed_rings, property_renames
+    from tvoronoi.writers.geojson_diagram import MIN_RING_POINTS, property_renames
 
     n_sites = diagram.n_sites
     rows = np.arange(n_sites)
@@ -294,8 +294,23 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
         table = pa.table(columns).replace_schema_metadata({b"geo": geo_metadata(extent, types, crs)})
         write_table(pa, table, out, overwrite)
         return len(kept)
-    # the polygons a row group at a time: no whole copy of the rings or of their WKB
-    present = has_ring[distinct]
+    write_cell_rows(pa, out, columns, diagram, kept, has_ring[distinct], crs=crs, overwrite=overwrite)
+    return len(kept)
+
+
+def write_cell_rows(
+    pa, out, columns: dict, diagram, rows: np.ndarray, present: np.ndarray, *, crs=None, overwrite: bool = True
+) -> None:
+    """Write a GeoParquet table of ``columns`` (Arrow arrays, one value per row) and the cells of the
+    diagram's ``rows`` (ascending) as ``geometry`` and ``bbox``: null where ``present`` is False.
+
+    The polygons are laid out a row group at a time from the diagram (no whole copy of the rings or of
+    their WKB), and a row group is encoded and compressed in a second thread while the next is made.
+    """
+    import pyarrow.parquet as pq
+
+    has_ring = np.zeros(diagram.n_sites, bool)
+    has_ring[rows[present]] = True
     schema = pa.schema(
         [pa.field(name, column.type) for name, column in columns.items()]
         + [pa.field("geometry", pa.binary()), pa.field("bbox", _BBOX_TYPE(pa))]
@@ -303,11 +318,11 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     schema = schema.with_metadata({b"geo": geo_metadata(_rings_extent(diagram, has_ring), ["Polygon"], crs)})
     from concurrent.futures import ThreadPoolExecutor
 
-    import pyarrow.parquet as pq
+    from tvoronoi.writers.geojson_diagram import closed_rings
 
     def row_group(a: int, b: int):
-        # rows ra..rb-1 hold the kept rows a..b-1 and the repeats between them (no ring)
-        ra, rb = int(kept[a]), int(kept[b - 1]) + 1
+        # diagram rows ra..rb-1 hold the rows a..b-1 and those between them (not written)
+        ra, rb = int(rows[a]), int(rows[b - 1]) + 1
         xy, first, last = closed_rings(diagram, ra, rb, has_ring[ra:rb])
         ring_offsets = np.append(first, last[-1] + 1 if len(last) else 0).astype(np.int64)
         geometry, bbox, _ = polygon_columns(pa, xy, ring_offsets, present[a:b])
@@ -317,19 +332,18 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
 
     with open_output(out, overwrite=overwrite) as stream, ThreadPoolExecutor(1) as pool:
         with pq.ParquetWriter(pa.PythonFile(stream, mode="w"), schema, **_parquet_options(schema)) as writer:
-            if not len(kept):
+            if not len(rows):
                 writer.write_table(schema.empty_table())
             # a row group is encoded and compressed (without the GIL) while the next one is made
             pending = None
-            for a in range(0, len(kept), ROW_GROUP):
-                group = row_group(a, min(a + ROW_GROUP, len(kept)))
+            for a in range(0, len(rows), ROW_GROUP):
+                group = row_group(a, min(a + ROW_GROUP, len(rows)))
                 if pending is not None:
                     pending.result()
                 pending = pool.submit(writer.write_table, group)
                 del group
             if pending is not None:
                 pending.result()
-    return len(kept)
 
 
 def _parquet_options(schema) -> dict:

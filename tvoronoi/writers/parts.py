@@ -49,7 +49,7 @@ def remove_directory(path) -> None:
 
 def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str:
     """Write one task's cells (a frame of ``site`` and properties, and the cells: shapely geometries or
-    None, or for GeoParquet closed rings ``(xy, ring_offsets, present)``); return the part's name.
+    None); return the part's name.
 
     Returns "" for a task without rows (no empty part is written).
     """
@@ -61,6 +61,28 @@ def write_part(frame, geoms, directory, stem: str, format: str, crs=None) -> str
         _write_parquet_part(frame, geoms, path, crs)
     else:
         _write_geojsonseq_part(frame, geoms, path)
+    return name
+
+
+def write_cells_part(frame, diagram, rows: np.ndarray, directory, stem: str, crs=None) -> str:
+    """Write one task's cells straight from its diagram as a GeoParquet part; return the part's name.
+
+    ``frame`` holds ``site`` and the properties of the diagram's ``rows`` (ascending), a row each; a
+    cell of fewer than three points (it misses the box, or a repeated point's) is a null geometry. The
+    rings go to WKB a row group at a time (``writers.geoparquet.write_cell_rows``, as one process writes
+    a whole diagram), never all at once. Returns "" for a task without rows (no empty part is written).
+    """
+    if len(frame) == 0:
+        return ""
+    from tvoronoi.writers.geojson_diagram import MIN_RING_POINTS
+    from tvoronoi.writers.geoparquet import require_pyarrow, write_cell_rows
+
+    pa = require_pyarrow()
+    name = stem + SUFFIXES["parquet"]
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    columns = dict(zip(table.column_names, table.columns))
+    present = np.diff(diagram.cell_offsets)[rows] >= MIN_RING_POINTS
+    write_cell_rows(pa, os.path.join(str(directory), name), columns, diagram, rows, present, crs=crs, overwrite=False)
     return name
 
 
@@ -103,13 +125,7 @@ def _write_parquet_part(frame, geoms, path: str, crs) -> None:
     from tvoronoi.writers.geoparquet import geo_metadata, require_pyarrow, shapely_cell_columns, write_table
 
     pa = require_pyarrow()
-    if isinstance(geoms, tuple):
-        from tvoronoi.writers.geoparquet import polygon_columns
-
-        geometry, bbox, extent = polygon_columns(pa, *geoms)
-        types = ["Polygon"]
-    else:
-        geometry, bbox, extent, types = shapely_cell_columns(pa, geoms)
+    geometry, bbox, extent, types = shapely_cell_columns(pa, geoms)
     table = pa.Table.from_pandas(frame, preserve_index=False)
     table = table.append_column("geometry", geometry).append_column("bbox", bbox)
     table = table.replace_schema_metadata({b"geo": geo_metadata(extent, types or ["Polygon"], crs)})
