@@ -13,6 +13,7 @@ from typing import Iterator
 
 import numpy as np
 
+from tvoronoi.arrow_arrays import float64_values
 from tvoronoi.fileio import gc_paused
 
 from ..errors import InputFileError
@@ -447,7 +448,8 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
         if layout.delimiter == ";":
             text = pc.replace_substring(text, ",", ".", memory_pool=pool)  # decimal commas
         try:
-            xy[:, k] = pc.cast(text, pa.float64(), memory_pool=pool).to_numpy()
+            # from the buffers: to_numpy() would import pandas
+            xy[:, k] = float64_values(pc.cast(text, pa.float64(), memory_pool=pool))
         except (pa.ArrowInvalid, pa.ArrowTypeError):
             return None
     columns: list = []
