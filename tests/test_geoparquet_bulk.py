@@ -193,3 +193,28 @@ def test_batch_to_geoparquet_does_not_import_pandas(tmp_path):
     table = pq.read_table(tmp_path / "c.parquet")
     assert table["count"].type == pa.int64() and table["share"].type == pa.float64()
     assert table["count"].to_pylist() == list(range(40_000))
+
+
+def test_column_options_reach_every_column(tmp_path):
+    """Per-column options name Parquet's column paths (an option under another name is silently
+    ignored): the geometry and the nested duplicates compressed, the cells' bbox not, a
+    dictionary for the property that repeats and none for the one that does not."""
+    import pyarrow.parquet as pq
+
+    from tvoronoi.readers import PointSet
+
+    xy = _sites(3, 3000, 5, 0)
+    d = tvoronoi.voronoi(xy)
+    kinds = ["shop", "park", "school"]
+    columns = {"name": [f"site {i}" for i in range(len(xy))], "kind": [kinds[i % 3] for i in range(len(xy))]}
+    geoparquet.write_cells_parquet(d, PointSet(xy, "t.csv", columns), str(tmp_path / "c.parquet"))
+    meta = pq.read_metadata(tmp_path / "c.parquet")
+    group = meta.row_group(0)
+    chunks = {group.column(k).path_in_schema: group.column(k) for k in range(group.num_columns)}
+    assert list(chunks) == geoparquet._leaf_paths(pq.read_schema(tmp_path / "c.parquet"))
+    assert "duplicates.list.element" in chunks
+    for path, chunk in chunks.items():
+        assert chunk.compression == ("UNCOMPRESSED" if path.startswith("bbox.") else "ZSTD"), path
+    assert "RLE_DICTIONARY" in chunks["kind"].encodings
+    assert "RLE_DICTIONARY" not in chunks["name"].encodings
+    assert pq.read_table(tmp_path / "c.parquet")["name"].to_pylist()[:2] == ["site 0", "site 1"]
