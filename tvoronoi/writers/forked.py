@@ -19,6 +19,7 @@ import threading
 from typing import BinaryIO, Callable
 
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.fileio import WRITEBACK_BYTES, start_writeback
 
 # outputs of fewer features are written by one process: a fork costs a few milliseconds
 MIN_FEATURES = 100_000
@@ -145,10 +146,15 @@ def _copy(part: BinaryIO, stream: BinaryIO) -> None:
         shutil.copyfileobj(part, stream, WRITE_BUFFER)
         return
     stream.flush()
+    try:
+        start = os.lseek(fd, 0, os.SEEK_CUR)
+    except OSError:  # a pipe: nothing to write back
+        start = None
     offset = 0
     while offset < size:
         try:
-            sent = os.sendfile(fd, part.fileno(), offset, size - offset)
+            # a run at a time, each handed to the disk while the next is copied
+            sent = os.sendfile(fd, part.fileno(), offset, min(size - offset, WRITEBACK_BYTES))
         except OSError as e:
             if offset or e.errno not in (errno.EINVAL, errno.ENOSYS):
                 raise
@@ -157,4 +163,6 @@ def _copy(part: BinaryIO, stream: BinaryIO) -> None:
             return
         if sent == 0:
             raise OSError(f"the output took no more bytes after {offset} of {size}")
+        if start is not None:
+            start_writeback(fd, start + offset, sent)
         offset += sent
