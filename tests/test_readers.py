@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from tvoronoi import readers
 from tvoronoi.errors import InputFileError, TvoronoiError
 from tvoronoi.readers import PointSet, read_points
+from tvoronoi.readers.text_column import TextColumn
 
 
 def write(tmp_path: Path, name: str, content: str | bytes) -> str:
@@ -580,6 +581,14 @@ def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line,
     assert other is not None, "Arrow read a table the bulk reader refuses"
     np.testing.assert_array_equal(arrow[0], other[0])
     assert arrow[1] == other[1]
+    # a text column that keeps Arrow's layout reads, writes and converts as the bulk reader's
+    for ours, theirs in zip(arrow[1], other[1]):
+        if isinstance(theirs, TextColumn):
+            assert isinstance(ours, TextColumn) and len(ours) == len(theirs)
+            assert ours.to_arrow().equals(theirs.to_arrow())
+            assert ours.json_plain == theirs.json_plain
+            assert ours.utf8(0, len(ours)) == theirs.utf8(0, len(theirs))
+            assert ours[1:] == theirs[1:]
     # and both as the row walk reads the table
     slow = readers.slow_table(text, "t", "csv", layout)
     np.testing.assert_array_equal(arrow[0], slow.xy)

@@ -17,7 +17,7 @@ from tvoronoi.arrow_arrays import float64_values
 from tvoronoi.fileio import gc_paused
 
 from ..errors import InputFileError
-from .bulk_csv import bulk_columns, typed_column
+from .bulk_csv import bulk_columns, typed_packed_column
 from .columns import (
     LAT_NAMES,
     LON_NAMES,
@@ -457,12 +457,13 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
         if j in (layout.ix, layout.iy):
             columns.append([])
             continue
-        # the column's bytes and offsets, typed as the bulk reader types a column
+        # the column's bytes and offsets, typed as the bulk reader types a column; a text column
+        # keeps Arrow's buffers
         values = table.column(j).combine_chunks(memory_pool=pool)
         offsets = np.frombuffer(values.buffers()[1], np.int32)[values.offset : values.offset + len(values) + 1]
         data = values.buffers()[2]
         raw = np.frombuffer(data, np.uint8) if data is not None and data.size else np.zeros(1, np.uint8)
-        columns.append(typed_column(raw, offsets[:-1].astype(np.int64), offsets[1:].astype(np.int64), plain))
+        columns.append(typed_packed_column(raw, offsets, plain))
     return xy, columns
 
 
