@@ -313,7 +313,8 @@ def polygon_columns(pa, xy: np.ndarray, ring_offsets: np.ndarray, present: np.nd
     bbox = _bbox_column(pa, mins, maxs, present)
     extent = None
     if n_rings:
-        extent = [*mins[present].min(axis=0), *maxs[present].max(axis=0)]
+        kept_mins, kept_maxs = mins[present], maxs[present]
+        extent = [kept_mins[:, 0].min(), kept_mins[:, 1].min(), kept_maxs[:, 0].max(), kept_maxs[:, 1].max()]
     return wkb, bbox, extent
 
 
@@ -534,7 +535,7 @@ def _points_extent(diagram, has_ring: np.ndarray) -> list[float] | None:
     used = np.zeros(len(diagram.cell_points), bool)
     used[ring] = True
     xy = diagram.cell_points if used.all() else diagram.cell_points[used]
-    return [*xy.min(axis=0).tolist(), *xy.max(axis=0).tolist()]
+    return [float(xy[:, 0].min()), float(xy[:, 1].min()), float(xy[:, 0].max()), float(xy[:, 1].max())]
 
 
 def write_delaunay_parquet(diagram, out, *, overwrite: bool = True, crs=None) -> int:
