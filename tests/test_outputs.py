@@ -161,3 +161,47 @@ def test_start_writeback_on_this_system(tmp_path):
         start_writeback(f.fileno(), 0, 10_000)
         start_writeback(-1, 0, 10)  # a bad descriptor: ignored
     assert path.read_bytes() == b"x" * 10_000
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the forked part is made on Linux")
+@pytest.mark.parametrize("kind", ["file", "stream"])
+def test_the_forked_part_is_appended_while_it_is_written(tmp_path, monkeypatch, kind):
+    """The parent copies what the child has written so far while the child still writes (the
+    child here pauses between runs); a stream that is not a descriptor gets it all at the end."""
+    import io
+    import time
+
+    from tvoronoi.writers import forked
+
+    rng = np.random.default_rng(8)
+    runs = [rng.bytes(int(k)) for k in rng.integers(1, 300_000, 6)]
+
+    def write_part(file) -> int:
+        for run in runs:
+            file.write(run)
+            file.flush()
+            time.sleep(0.03)
+        return len(runs)
+
+    out = targets.output_file(str(tmp_path / "out.bin")) if kind == "file" else None
+    stream = out.file if out is not None else io.BytesIO()
+    stream.write(b"head|")
+    steps: list[int] = []
+    step = forked._Appender.step
+
+    def counted(self) -> None:
+        step(self)
+        steps.append(self.copied)
+
+    monkeypatch.setattr(forked._Appender, "step", counted)
+    part = forked.ForkedPart(stream, write_part)
+    assert part.append_to(stream) == len(runs)
+    expected = b"head|" + b"".join(runs)
+    if out is not None:
+        out.commit()
+        assert (tmp_path / "out.bin").read_bytes() == expected
+        # runs were copied before the child had written them all
+        assert any(0 < copied < len(expected) - 5 for copied in steps)
+    else:
+        assert stream.getvalue() == expected
+        assert not any(steps)
