@@ -1041,3 +1041,40 @@ def test_each_site_knows_its_line(tmp_path, content, rows_lines):
     points = read(tmp_path, "p.csv", content)
     for row, line in rows_lines:
         assert points.place(row) == f"line {line}"
+
+
+@pytest.mark.parametrize("bom", [b"", b"\xef\xbb\xbf"])
+@pytest.mark.parametrize("arrow", [True, False])
+def test_file_bytes_given_to_the_bulk_readers_read_as_the_text(tmp_path, monkeypatch, bom, arrow):
+    """read_points hands a UTF-8 file's own bytes (without its BOM) to the bulk readers instead of
+    encoding the decoded text again: the same sites and columns, with non-ASCII text in the header
+    (the rows start at another byte than character) and in the rows."""
+    from tvoronoi.readers import tabular
+
+    if arrow:
+        pytest.importorskip("pyarrow")
+    else:
+        monkeypatch.setattr(tabular, "ARROW_MIN_CHARS", 1 << 62)
+    rng = np.random.default_rng(6)
+    xy = rng.random((30_000, 2)) * 100
+    lines = ["x,y,nöm,n"] + [f"{a!r},{b!r},café {i} ünïcode,{i}" for i, (a, b) in enumerate(xy.tolist())]
+    path = tmp_path / "p.csv"
+    path.write_bytes(bom + ("\n".join(lines) + "\n").encode())
+    read_by_arrow: list[bool] = []
+    arrow_columns = tabular._arrow_columns
+
+    def spy(*args, **kwargs):
+        result = arrow_columns(*args, **kwargs)
+        read_by_arrow.append(result is not None)
+        return result
+
+    monkeypatch.setattr(tabular, "_arrow_columns", spy)
+    points = read_points(path)
+    assert read_by_arrow == ([True] if arrow else [])
+    text = path.read_bytes().decode("utf-8-sig")
+    reference = readers.read_table(text, str(path), "csv", None, None)  # encodes the text itself
+    np.testing.assert_array_equal(points.xy, xy)
+    np.testing.assert_array_equal(points.xy, reference.xy)
+    assert points.columns == reference.columns
+    assert points.columns["nöm"][29_999] == "café 29999 ünïcode"
+    assert points.columns["n"][:3] == [0, 1, 2]

@@ -31,8 +31,11 @@ _ASCII_SPACE = np.zeros(256, bool)
 _ASCII_SPACE[[0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x1C, 0x1D, 0x1E, 0x1F, 0x20]] = True
 
 
-def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0) -> tuple[np.ndarray, list] | None:
-    """The sites and the other columns of the CSV rows in ``text[start:]`` (the text after the header).
+def bulk_columns(
+    text: str, layout, n_cols: int, *, plain: bool, start: int = 0, encoded: bytes | None = None
+) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of the CSV rows in ``text[start:]`` (the text after the header);
+    ``encoded``: the UTF-8 bytes of ``text``, when the caller has them.
 
     Returns (xy, columns): ``columns[j]`` is the JSON-ready column j (a :class:`TextColumn`
     or a list, see :func:`convert_column`), empty for the x and y columns. None when a row
@@ -42,7 +45,8 @@ def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0)
     delimiter = layout.delimiter
     if len(text) <= start or len(delimiter) != 1 or not delimiter.isascii() or delimiter in '"\r\n':
         return None
-    encoded = text.encode()
+    if encoded is None:
+        encoded = text.encode()
     if b"\0" in encoded:
         return None
     begin = start if len(encoded) == len(text) else len(text[:start].encode())
