@@ -215,6 +215,7 @@ def test_column_options_reach_every_column(tmp_path):
     assert "duplicates.list.element" in chunks
     for path, chunk in chunks.items():
         assert chunk.compression == ("UNCOMPRESSED" if path.startswith("bbox.") else "ZSTD"), path
+    assert "DELTA_BINARY_PACKED" in chunks["site"].encodings
     assert "RLE_DICTIONARY" in chunks["kind"].encodings
     assert "RLE_DICTIONARY" not in chunks["name"].encodings
     assert pq.read_table(tmp_path / "c.parquet")["name"].to_pylist()[:2] == ["site 0", "site 1"]
