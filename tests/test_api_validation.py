@@ -126,3 +126,88 @@ def test_unknown_engine_and_order():
     ):
         with pytest.raises(tvoronoi.TvoronoiError, match="unknown engine 'qhull'"):
             call()
+
+
+def _reference_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
+    """default_bbox as first written: reductions along axis 0."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    side = float(max(hi[0] - lo[0], hi[1] - lo[1]))
+    if side > 0:
+        margin = 0.1 * side
+    else:
+        top = float(np.abs(pts).max())
+        margin = 0.1 * top if top > 0 else 1.0
+    low = np.minimum(lo - margin, np.nextafter(lo, -np.inf))
+    high = np.maximum(hi + margin, np.nextafter(hi, np.inf))
+    return (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
+
+
+@pytest.mark.parametrize(
+    "pts",
+    [
+        [[0.0, -0.0], [-0.0, 0.0]],
+        [[5e-324, 0.0], [1e-323, -5e-324]],
+        [[3.0, 4.0]],
+        [[1e300, -1e300], [-1e300, 1e300]],
+        [[1.0, 2.0], [1.0 + 2**-52, 2.0]],
+    ],
+)
+def test_default_bbox_by_columns_is_the_reference(pts):
+    from tvoronoi.api import BBOX_MARGIN, default_bbox
+
+    assert BBOX_MARGIN == 0.1
+    pts = np.asarray(pts, np.float64)
+    assert default_bbox(pts) == _reference_bbox(pts)
+
+
+def test_default_bbox_of_random_sites_is_the_reference():
+    from tvoronoi.api import default_bbox
+
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        n = int(rng.integers(1, 50))
+        pts = rng.normal(size=(n, 2)) * 10.0 ** rng.integers(-300, 300) + rng.choice([0.0, 1e6])
+        assert default_bbox(pts) == _reference_bbox(pts)
+
+
+def test_first_non_finite_point_is_named():
+    pts = np.ones((1000, 2))
+    pts[[700, 900], [1, 0]] = [np.inf, np.nan]
+    with pytest.raises(tvoronoi.TvoronoiError, match=r"point 700 is \(1\.0, inf\).*\(2 such point"):
+        tvoronoi.voronoi(pts)
+
+
+def _reference_range_fault(pts: np.ndarray, e: int):
+    """check_range's verdict as first written: every value's magnitude compared (None: no fault)."""
+    from tvoronoi.api import RANGE_BITS
+
+    mag = np.abs(pts)
+    low = 2.0 ** (e - RANGE_BITS)
+    high = 2.0 ** (e + RANGE_BITS) if e + RANGE_BITS < 1024 else np.inf
+    bad = (pts != 0) & ((mag < low) | (mag > high))
+    return None if not bad.any() else tuple(int(v) for v in np.argwhere(bad)[0])
+
+
+def test_check_range_fast_path_agrees_with_every_value_compared():
+    """Zeros, values just inside and just outside 2^170 of the scale, either sign, any row."""
+    from tvoronoi.api import RANGE_BITS, check_range
+    from tvoronoi.errors import CoordinateRangeError
+
+    rng = np.random.default_rng(4)
+    for trial in range(300):
+        e = int(rng.integers(-900, 900))
+        pts = rng.random((int(rng.integers(1, 30)), 2)) * 2.0**e * rng.choice([-1, 1], (1, 2))
+        for _ in range(int(rng.integers(0, 3))):
+            i, j = rng.integers(0, len(pts)), rng.integers(0, 2)
+            pts[i, j] = rng.choice(
+                [0.0, -0.0, 2.0 ** (e - RANGE_BITS), -(2.0 ** (e - RANGE_BITS - 1)), 2.0 ** (e - RANGE_BITS - 3)]
+            )
+        if trial % 5 == 0:
+            pts[rng.integers(0, len(pts)), rng.integers(0, 2)] = 2.0 ** min(e + RANGE_BITS + 1, 1023)
+        expected = _reference_range_fault(pts, e)
+        if expected is None:
+            check_range(pts, e)
+        else:
+            with pytest.raises(CoordinateRangeError) as info:
+                check_range(pts, e)
+            assert info.value.rows[0] == expected[0]

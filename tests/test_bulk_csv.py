@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from tvoronoi import readers
 from tvoronoi.errors import InputFileError
+from tvoronoi.readers import bulk_csv
 from tvoronoi.readers.bulk_csv import bulk_columns, parse_floats
 from tvoronoi.readers.text_column import TextColumn
 
@@ -176,6 +177,37 @@ def test_text_column_to_arrow_matches_pyarrow():
     pa = pytest.importorskip("pyarrow")
     values = ["a", None, 'é, "q"', "", "line\nbreak", "z", None]
     assert TextColumn.from_strings(values).to_arrow().equals(pa.array(values, pa.string()))
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        ["a", "", " ", "\u3000", "é", " b ", "\x1c", "x y", "\u00a0z\u2003", ""],
+        ["", "", " "],
+        ["", "12", " 3"],
+        ["007", "1"],
+        ["1.5", "", "2"],
+        ["line\nbreak", 'q"uote'],
+    ],
+)
+def test_packed_text_column_types_and_reads_as_the_gathered_one(values):
+    """A column in Arrow's layout (values one after the other, offsets not from 0) is typed,
+    blanked and read as the same column gathered with line breaks."""
+    encoded = [v.encode() for v in values]
+    joined = b"pad" + b"".join(encoded)
+    offsets = np.concatenate([[3], 3 + np.cumsum([len(v) for v in encoded])]).astype(np.int32)
+    packed = bulk_csv.typed_packed_column(np.frombuffer(joined, np.uint8), offsets, plain=True)
+    raw = np.frombuffer(b"\n".join(encoded), np.uint8)
+    starts = np.concatenate([[0], np.cumsum([len(v) + 1 for v in encoded])[:-1]]).astype(np.int64)
+    gathered = bulk_csv.typed_column(raw, starts, starts + [len(v) for v in encoded], plain=True)
+    assert type(packed) is type(gathered)
+    assert packed == gathered
+    if isinstance(gathered, TextColumn):
+        assert packed.utf8(0, len(values)) == gathered.utf8(0, len(values))
+        assert packed.json_plain == gathered.json_plain
+        pa = pytest.importorskip("pyarrow")
+        assert packed.to_arrow().equals(gathered.to_arrow())
+        assert packed.to_arrow().equals(pa.array([v if v.strip() else None for v in values], pa.string()))
 
 
 @pytest.mark.parametrize("layout", ["collection", "seq", "lines"])

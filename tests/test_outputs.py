@@ -120,3 +120,88 @@ def test_a_reader_leaving_early_ends_the_run_quietly(tmp_path):
 
 def test_dev_null_may_take_both_outputs(points, capsys):
     assert cli.main(["batch", str(points), "-o", "/dev/null", "--delaunay", "/dev/null", "-q"]) == 0
+
+
+def test_a_regular_file_is_handed_to_the_disk_as_it_is_written(tmp_path, monkeypatch):
+    """The write-back is started for consecutive runs of the file, its own writes and those
+    appended through the descriptor (a forked part's sendfile) alike; the content is the same."""
+    from tvoronoi import fileio
+    from tvoronoi.writers import forked
+
+    calls: list[tuple[int, int]] = []
+    monkeypatch.setattr(fileio, "WRITEBACK_BYTES", 1000)
+    monkeypatch.setattr(forked, "WRITEBACK_BYTES", 1000)
+    monkeypatch.setattr(fileio, "_sync_range_looked_up", True)
+    monkeypatch.setattr(fileio, "_sync_range", lambda fd, offset, length, flags: calls.append((offset, length)) or 0)
+    rng = np.random.default_rng(2)
+    pieces = [rng.bytes(int(k)) for k in rng.integers(1, 3000, 40)]
+    part = tmp_path / "part"
+    part.write_bytes(b"".join(pieces[20:]))
+    out = targets.output_file(str(tmp_path / "out.bin"))
+    for piece in pieces[:20]:
+        out.file.write(piece)
+    with open(part, "rb") as source:
+        forked._copy(source, out.file)
+    out.commit()
+    assert (tmp_path / "out.bin").read_bytes() == b"".join(pieces)
+    assert calls and calls[0][0] == 0
+    assert all(a + n == b for (a, n), (b, _) in zip(calls, calls[1:]))  # consecutive runs
+    total = sum(map(len, pieces))
+    assert total - 2 * 1000 <= calls[-1][0] + calls[-1][1] <= total
+
+
+def test_start_writeback_on_this_system(tmp_path):
+    """The real call (sync_file_range on Linux, nothing elsewhere) leaves the data as written."""
+    from tvoronoi.fileio import start_writeback
+
+    path = tmp_path / "f"
+    with open(path, "wb") as f:
+        f.write(b"x" * 10_000)
+        f.flush()
+        start_writeback(f.fileno(), 0, 10_000)
+        start_writeback(-1, 0, 10)  # a bad descriptor: ignored
+    assert path.read_bytes() == b"x" * 10_000
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the forked part is made on Linux")
+@pytest.mark.parametrize("kind", ["file", "stream"])
+def test_the_forked_part_is_appended_while_it_is_written(tmp_path, monkeypatch, kind):
+    """The parent copies what the child has written so far while the child still writes (the
+    child here pauses between runs); a stream that is not a descriptor gets it all at the end."""
+    import io
+    import time
+
+    from tvoronoi.writers import forked
+
+    rng = np.random.default_rng(8)
+    runs = [rng.bytes(int(k)) for k in rng.integers(1, 300_000, 6)]
+
+    def write_part(file) -> int:
+        for run in runs:
+            file.write(run)
+            file.flush()
+            time.sleep(0.03)
+        return len(runs)
+
+    out = targets.output_file(str(tmp_path / "out.bin")) if kind == "file" else None
+    stream = out.file if out is not None else io.BytesIO()
+    stream.write(b"head|")
+    steps: list[int] = []
+    step = forked._Appender.step
+
+    def counted(self) -> None:
+        step(self)
+        steps.append(self.copied)
+
+    monkeypatch.setattr(forked._Appender, "step", counted)
+    part = forked.ForkedPart(stream, write_part)
+    assert part.append_to(stream) == len(runs)
+    expected = b"head|" + b"".join(runs)
+    if out is not None:
+        out.commit()
+        assert (tmp_path / "out.bin").read_bytes() == expected
+        # runs were copied before the child had written them all
+        assert any(0 < copied < len(expected) - 5 for copied in steps)
+    else:
+        assert stream.getvalue() == expected
+        assert not any(steps)

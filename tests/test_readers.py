@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from tvoronoi import readers
 from tvoronoi.errors import InputFileError, TvoronoiError
 from tvoronoi.readers import PointSet, read_points
+from tvoronoi.readers.text_column import TextColumn
 
 
 def write(tmp_path: Path, name: str, content: str | bytes) -> str:
@@ -580,6 +581,14 @@ def test_arrow_reader_agrees_with_the_others(xy, n_extra, delimiter, blank_line,
     assert other is not None, "Arrow read a table the bulk reader refuses"
     np.testing.assert_array_equal(arrow[0], other[0])
     assert arrow[1] == other[1]
+    # a text column that keeps Arrow's layout reads, writes and converts as the bulk reader's
+    for ours, theirs in zip(arrow[1], other[1]):
+        if isinstance(theirs, TextColumn):
+            assert isinstance(ours, TextColumn) and len(ours) == len(theirs)
+            assert ours.to_arrow().equals(theirs.to_arrow())
+            assert ours.json_plain == theirs.json_plain
+            assert ours.utf8(0, len(ours)) == theirs.utf8(0, len(theirs))
+            assert ours[1:] == theirs[1:]
     # and both as the row walk reads the table
     slow = readers.slow_table(text, "t", "csv", layout)
     np.testing.assert_array_equal(arrow[0], slow.xy)
@@ -1032,3 +1041,40 @@ def test_each_site_knows_its_line(tmp_path, content, rows_lines):
     points = read(tmp_path, "p.csv", content)
     for row, line in rows_lines:
         assert points.place(row) == f"line {line}"
+
+
+@pytest.mark.parametrize("bom", [b"", b"\xef\xbb\xbf"])
+@pytest.mark.parametrize("arrow", [True, False])
+def test_file_bytes_given_to_the_bulk_readers_read_as_the_text(tmp_path, monkeypatch, bom, arrow):
+    """read_points hands a UTF-8 file's own bytes (without its BOM) to the bulk readers instead of
+    encoding the decoded text again: the same sites and columns, with non-ASCII text in the header
+    (the rows start at another byte than character) and in the rows."""
+    from tvoronoi.readers import tabular
+
+    if arrow:
+        pytest.importorskip("pyarrow")
+    else:
+        monkeypatch.setattr(tabular, "ARROW_MIN_CHARS", 1 << 62)
+    rng = np.random.default_rng(6)
+    xy = rng.random((30_000, 2)) * 100
+    lines = ["x,y,nöm,n"] + [f"{a!r},{b!r},café {i} ünïcode,{i}" for i, (a, b) in enumerate(xy.tolist())]
+    path = tmp_path / "p.csv"
+    path.write_bytes(bom + ("\n".join(lines) + "\n").encode())
+    read_by_arrow: list[bool] = []
+    arrow_columns = tabular._arrow_columns
+
+    def spy(*args, **kwargs):
+        result = arrow_columns(*args, **kwargs)
+        read_by_arrow.append(result is not None)
+        return result
+
+    monkeypatch.setattr(tabular, "_arrow_columns", spy)
+    points = read_points(path)
+    assert read_by_arrow == ([True] if arrow else [])
+    text = path.read_bytes().decode("utf-8-sig")
+    reference = readers.read_table(text, str(path), "csv", None, None)  # encodes the text itself
+    np.testing.assert_array_equal(points.xy, xy)
+    np.testing.assert_array_equal(points.xy, reference.xy)
+    assert points.columns == reference.columns
+    assert points.columns["nöm"][29_999] == "café 29999 ünïcode"
+    assert points.columns["n"][:3] == [0, 1, 2]

@@ -36,10 +36,15 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
     if pts.size == 0:
         return
     pts = pts.reshape(len(pts), -1)
-    mag = np.abs(pts)
     # 2^(e+170) may exceed the double range: then nothing is too large
     low = math.ldexp(1.0, e - RANGE_BITS)
     high = math.ldexp(1.0, e + RANGE_BITS) if e + RANGE_BITS < 1024 else math.inf
+    # the common case in a few passes without a float temporary: nothing above the range, and
+    # the values below it all zeros
+    if max(float(pts.max()), -float(pts.min())) <= high:
+        if np.count_nonzero((pts > -low) & (pts < low)) == np.count_nonzero(pts == 0):
+            return
+    mag = np.abs(pts)
     bad = (pts != 0) & ((mag < low) | (mag > high))
     if bad.any():
         row, col = (int(v) for v in np.argwhere(bad)[0])
@@ -82,8 +87,8 @@ def as_points(points) -> np.ndarray:
         return np.empty((0, 2), np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise TvoronoiError(f"points must have shape (n, 2), got {pts.shape}")
-    bad = ~np.isfinite(pts).all(axis=1)
-    if bad.any():
+    if not np.isfinite(pts).all():  # (a reduction over all values: ~30 times faster than by rows)
+        bad = ~np.isfinite(pts).all(axis=1)
         row = int(np.flatnonzero(bad)[0])
         raise TvoronoiError(
             f"point {row} is ({float(pts[row, 0])!r}, {float(pts[row, 1])!r}): coordinates must be finite "
@@ -103,8 +108,9 @@ def default_bbox(pts: np.ndarray) -> tuple[float, float, float, float]:
     """
     if len(pts) == 0:
         return (0.0, 0.0, 1.0, 1.0)
-    lo = pts.min(axis=0)
-    hi = pts.max(axis=0)
+    # a column at a time: numpy reduces an (n, 2) array along axis 0 row by row, 30 times slower
+    lo = np.array([pts[:, 0].min(), pts[:, 1].min()])
+    hi = np.array([pts[:, 0].max(), pts[:, 1].max()])
     side = float(max(hi[0] - lo[0], hi[1] - lo[1]))
     if side > 0:
         margin = BBOX_MARGIN * side

@@ -138,8 +138,10 @@ def read_points(
     if fmt == "geojson":
         return read_geojson(data, source, x, y, _loads_json)
     text = _decode(data, source)
-    del data  # the bytes are not needed once decoded (a large file is not held twice)
-    return read_table(text, source, fmt, x, y, delimiter)
+    # a UTF-8 file's bytes are the text's: the bulk readers take them rather than encode it again
+    encoded = _utf8_of(data)
+    del data  # other bytes are not needed once decoded (a large file is not held twice)
+    return read_table(text, source, fmt, x, y, delimiter, encoded=encoded)
 
 
 def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
@@ -241,6 +243,14 @@ def _decode(data: bytes, source: str) -> str:
         raise InputFileError(
             f"{source}, line {line}: byte 0x{data[e.start]:02x} is not valid {name}; save the file as UTF-8"
         ) from None
+
+
+def _utf8_of(data: bytes) -> bytes | None:
+    """The UTF-8 bytes of the text :func:`_decode` made of ``data``: ``data`` itself without its
+    byte order mark (decoding and encoding again gives the same bytes); None for UTF-16."""
+    if _encoding(data) != "utf-8-sig":
+        return None
+    return data[len(codecs.BOM_UTF8) :] if data.startswith(codecs.BOM_UTF8) else data
 
 
 def _loads_json(data: bytes, source: str):

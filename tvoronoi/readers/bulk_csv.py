@@ -31,8 +31,11 @@ _ASCII_SPACE = np.zeros(256, bool)
 _ASCII_SPACE[[0x09, 0x0A, 0x0B, 0x0C, 0x0D, 0x1C, 0x1D, 0x1E, 0x1F, 0x20]] = True
 
 
-def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0) -> tuple[np.ndarray, list] | None:
-    """The sites and the other columns of the CSV rows in ``text[start:]`` (the text after the header).
+def bulk_columns(
+    text: str, layout, n_cols: int, *, plain: bool, start: int = 0, encoded: bytes | None = None
+) -> tuple[np.ndarray, list] | None:
+    """The sites and the other columns of the CSV rows in ``text[start:]`` (the text after the header);
+    ``encoded``: the UTF-8 bytes of ``text``, when the caller has them.
 
     Returns (xy, columns): ``columns[j]`` is the JSON-ready column j (a :class:`TextColumn`
     or a list, see :func:`convert_column`), empty for the x and y columns. None when a row
@@ -42,7 +45,8 @@ def bulk_columns(text: str, layout, n_cols: int, *, plain: bool, start: int = 0)
     delimiter = layout.delimiter
     if len(text) <= start or len(delimiter) != 1 or not delimiter.isascii() or delimiter in '"\r\n':
         return None
-    encoded = text.encode()
+    if encoded is None:
+        encoded = text.encode()
     if b"\0" in encoded:
         return None
     begin = start if len(encoded) == len(text) else len(text[:start].encode())
@@ -187,30 +191,48 @@ def typed_column(raw: np.ndarray, starts: np.ndarray, stops: np.ndarray, plain: 
     return convert_column(column.tolist(), plain)
 
 
-def _blank(data: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """Whether each field (laid out as :func:`_gather` gives them) is empty or white space
-    only (what ``str.strip`` empties)."""
-    lengths = np.diff(offsets) - 1
+def typed_packed_column(data: np.ndarray, offsets: np.ndarray, plain: bool):
+    """:func:`typed_column` of values laid out as Arrow lays out strings (see
+    :meth:`TextColumn.from_packed`): a text column keeps that layout, with no copy."""
+    blank = _blank(data, offsets, separator=0)
+    first = np.flatnonzero(~blank)[:1]
+    if len(first):
+        i = int(first[0])
+        if _is_text((data[offsets[i] : offsets[i + 1]].tobytes().decode(),)):
+            return TextColumn.from_packed(data, offsets, ~blank)
+    return convert_column(TextColumn.from_packed(data, offsets).tolist(), plain)
+
+
+def _blank(data: np.ndarray, offsets: np.ndarray, separator: int = 1) -> np.ndarray:
+    """Whether each field is empty or white space only (what ``str.strip`` empties): fields
+    laid out as :func:`_gather` gives them, each followed by its line break, or with
+    ``separator=0`` one after the other (Arrow's layout)."""
+    lengths = np.diff(offsets) - separator
     if not len(data):
         return lengths == 0
     # a field that opens with a printable ASCII byte is not blank: look closer only at the others
     starts = offsets[:-1]
-    first = data[starts]  # an empty field's is its line break
+    # an empty field's first byte is its line break, or the next field's (any byte will do)
+    first = data[np.minimum(starts, len(data) - 1)]
     maybe = np.flatnonzero((lengths == 0) | _ASCII_SPACE[first] | (first >= 0x80))
     blank = np.zeros(len(lengths), bool)
     if not len(maybe):
         return blank
-    ends = offsets[1:][maybe] - 1
+    ends = offsets[1:][maybe] - separator
     starts = starts[maybe]
     # among those, a field with a printable ASCII byte is not blank either
-    # (reduceat over start, end pairs sums each field; its every other sum is a gap)
+    # (reduceat over start, end pairs sums each field; its every other sum is a gap; a byte
+    # past the data stands for an end at its end)
     pairs = np.stack([starts, ends], axis=1).ravel()
-    solid = ~_ASCII_SPACE[data] & (data < 0x80)
+    solid = np.zeros(len(data) + 1, bool)
+    solid[:-1] = ~_ASCII_SPACE[data] & (data < 0x80)
     counts = np.add.reduceat(solid, pairs, dtype=np.int64)[::2]
     blank[maybe] = (ends == starts) | (counts == 0)
-    non_ascii = np.add.reduceat(data >= 0x80, pairs, dtype=np.int64)[::2] > 0
+    wide = np.zeros(len(data) + 1, bool)
+    wide[:-1] = data >= 0x80
+    non_ascii = np.add.reduceat(wide, pairs, dtype=np.int64)[::2] > 0
     for i in maybe[non_ascii & (ends > starts) & blank[maybe]].tolist():
-        blank[i] = not data[offsets[i] : offsets[i + 1] - 1].tobytes().decode().strip()
+        blank[i] = not data[offsets[i] : offsets[i + 1] - separator].tobytes().decode().strip()
     return blank
 
 

@@ -13,10 +13,11 @@ from typing import Iterator
 
 import numpy as np
 
+from tvoronoi.arrow_arrays import float64_values
 from tvoronoi.fileio import gc_paused
 
 from ..errors import InputFileError
-from .bulk_csv import bulk_columns, typed_column
+from .bulk_csv import bulk_columns, typed_packed_column
 from .columns import (
     LAT_NAMES,
     LON_NAMES,
@@ -59,7 +60,11 @@ class _Layout:
     candidates: tuple[str, ...] = ()  # the numeric columns, when x and y were taken by position among more
 
 
-def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = None) -> PointSet:
+def read_table(
+    text: str, source: str, kind: str, x, y, delimiter: str | None = None, *, encoded: bytes | None = None
+) -> PointSet:
+    """The sites and columns of a CSV or text table; ``encoded``: the text's UTF-8 bytes, when the
+    caller has them (the bulk readers work on bytes)."""
     # the header and the first data row are near the top: look there first, so that
     # a large file is not scanned for them
     head = text
@@ -77,7 +82,7 @@ def read_table(text: str, source: str, kind: str, x, y, delimiter: str | None = 
     offset = line_offset(head, layout.header_lines)
     try:
         # CSV in bulk, from the text as it is (no copy of the rows); else the other fast paths
-        fast = _bulk_table(text, offset, layout) if kind == "csv" else None
+        fast = _bulk_table(text, offset, layout, encoded) if kind == "csv" else None
         if fast is None:
             fast = fast_table(text[offset:], kind, layout, bulk=False)
     except (ValueError, csv.Error):
@@ -327,9 +332,10 @@ def _unique_names(names: list[str]) -> list[str]:
 # the rows: in bulk, else one by one
 
 
-def _bulk_table(text: str, offset: int, layout: _Layout):
+def _bulk_table(text: str, offset: int, layout: _Layout, encoded: bytes | None = None):
     """The rows of a CSV text from ``offset`` on read by :func:`bulk_columns`, as :func:`fast_table`
-    gives them; None when they need the csv module, ValueError at a value that is not a number."""
+    gives them; None when they need the csv module, ValueError at a value that is not a number.
+    ``encoded``: the text's UTF-8 bytes, if known."""
     names, ix, iy = layout.names, layout.ix, layout.iy
     if len(names) == 2 and layout.delimiter != ";":
         return None  # only coordinates: numpy's loadtxt
@@ -337,9 +343,9 @@ def _bulk_table(text: str, offset: int, layout: _Layout):
     with gc_paused():
         bulk = None
         if len(text) - offset >= ARROW_MIN_CHARS and "pyarrow" in sys.modules:
-            bulk = _arrow_columns(text[offset:], layout, len(names), plain)
+            bulk = _arrow_columns(text, layout, len(names), plain, start=offset, encoded=encoded)
         if bulk is None:
-            bulk = bulk_columns(text, layout, len(names), plain=plain, start=offset)
+            bulk = bulk_columns(text, layout, len(names), plain=plain, start=offset, encoded=encoded)
     if bulk is None:
         return None
     xy, typed = bulk
@@ -400,7 +406,9 @@ def _coordinates(columns, layout: _Layout) -> np.ndarray:
     return xy
 
 
-def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tuple[np.ndarray, list] | None:
+def _arrow_columns(
+    body: str, layout: _Layout, n_cols: int, plain: bool, *, start: int = 0, encoded: bytes | None = None
+) -> tuple[np.ndarray, list] | None:
     """What :func:`bulk_columns` gives, read by pyarrow's CSV reader (on every core) when
     pyarrow is already loaded (a GeoParquet output loads it first); None when it is not, or the
     text needs a closer look. Loading pyarrow only to read would cost more memory (its libraries)
@@ -410,8 +418,14 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
     bytes as the bulk reader types them; the coordinates are converted by Arrow, which accepts
     a subset of what ``float`` accepts (no spaces or "_"), with the same correctly rounded
     result: a value it refuses sends the file to the other paths, which read it or name its line.
+    The rows are ``body[start:]``; ``encoded``: the UTF-8 bytes of ``body``, if known.
     """
-    if "pyarrow" not in sys.modules or QUOTE in body or "\0" in body or "\r" in body or not layout.delimiter.isascii():
+    if "pyarrow" not in sys.modules or not layout.delimiter.isascii():
+        return None
+    if encoded is None:
+        encoded = body.encode()
+    begin = start if len(encoded) == len(body) else len(body[:start].encode())
+    if any(encoded.find(byte, begin) >= 0 for byte in (b'"', b"\0", b"\r")):
         return None
     import pyarrow as pa
     import pyarrow.compute as pc
@@ -422,7 +436,7 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
     pool = pa.system_memory_pool()
     try:
         table = pacsv.read_csv(
-            pa.py_buffer(body.encode()),
+            pa.py_buffer(memoryview(encoded)[begin:]),
             read_options=pacsv.ReadOptions(column_names=names),
             parse_options=pacsv.ParseOptions(
                 delimiter=layout.delimiter,
@@ -447,7 +461,8 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
         if layout.delimiter == ";":
             text = pc.replace_substring(text, ",", ".", memory_pool=pool)  # decimal commas
         try:
-            xy[:, k] = pc.cast(text, pa.float64(), memory_pool=pool).to_numpy()
+            # from the buffers: to_numpy() would import pandas
+            xy[:, k] = float64_values(pc.cast(text, pa.float64(), memory_pool=pool))
         except (pa.ArrowInvalid, pa.ArrowTypeError):
             return None
     columns: list = []
@@ -455,12 +470,13 @@ def _arrow_columns(body: str, layout: _Layout, n_cols: int, plain: bool) -> tupl
         if j in (layout.ix, layout.iy):
             columns.append([])
             continue
-        # the column's bytes and offsets, typed as the bulk reader types a column
+        # the column's bytes and offsets, typed as the bulk reader types a column; a text column
+        # keeps Arrow's buffers
         values = table.column(j).combine_chunks(memory_pool=pool)
         offsets = np.frombuffer(values.buffers()[1], np.int32)[values.offset : values.offset + len(values) + 1]
         data = values.buffers()[2]
         raw = np.frombuffer(data, np.uint8) if data is not None and data.size else np.zeros(1, np.uint8)
-        columns.append(typed_column(raw, offsets[:-1].astype(np.int64), offsets[1:].astype(np.int64), plain))
+        columns.append(typed_packed_column(raw, offsets, plain))
     return xy, columns
 
 

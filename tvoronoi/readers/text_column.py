@@ -33,15 +33,65 @@ class TextColumn(Sequence):
         bool per value, False where the value is None; None when no value is.
     """
 
-    __slots__ = ("data", "offsets", "valid", "_plain", "_multiline")
+    __slots__ = ("_data", "_offsets", "_packed", "valid", "_plain", "_multiline_flag")
 
     def __init__(self, data: np.ndarray, offsets: np.ndarray, valid: np.ndarray | None = None):
-        self.data = data
-        self.offsets = offsets
+        self._data: np.ndarray | None = data
+        self._offsets: np.ndarray | None = offsets
+        # Arrow's layout of the values, when the column came from it (see from_packed)
+        self._packed: tuple[np.ndarray, np.ndarray] | None = None
         self.valid = None if valid is None or valid.all() else valid
         self._plain: bool | None = None
-        # a value that holds a line break itself (a quoted CSV field over lines)
-        self._multiline = int(np.count_nonzero(data == LF)) != len(self)
+        self._multiline_flag: bool | None = None
+
+    @classmethod
+    def from_packed(cls, data: np.ndarray, offsets: np.ndarray, valid: np.ndarray | None = None) -> TextColumn:
+        """A column of values laid out as Arrow lays out strings, one after the other without a
+        separator: value ``i`` is ``data[offsets[i]:offsets[i + 1]]`` (``offsets`` int32 or int64,
+        not necessarily from 0). The layout with line breaks is made only when a value is asked
+        for; :meth:`to_arrow` hands the buffers back as they are."""
+        column = cls.__new__(cls)
+        column._data = column._offsets = None
+        column._packed = (data, offsets)
+        column.valid = None if valid is None or valid.all() else valid
+        column._plain = None
+        column._multiline_flag = None
+        return column
+
+    @property
+    def data(self) -> np.ndarray:
+        if self._data is None:
+            self._unpack()
+        assert self._data is not None
+        return self._data
+
+    @property
+    def offsets(self) -> np.ndarray:
+        if self._offsets is None:
+            if self._packed is not None and self._data is None:
+                self._unpack()
+        assert self._offsets is not None
+        return self._offsets
+
+    def _unpack(self) -> None:
+        """The line-break layout from the packed one: a line break inserted after each value."""
+        assert self._packed is not None
+        data, offsets = self._packed
+        first = int(offsets[0])
+        ends = offsets[1:].astype(np.int64) - first
+        self._data = np.insert(data[first : int(offsets[-1])], ends, np.uint8(LF))
+        self._offsets = np.concatenate([[0], ends + np.arange(1, len(ends) + 1)])
+
+    @property
+    def _multiline(self) -> bool:
+        """Whether a value holds a line break itself (a quoted CSV field over lines)."""
+        if self._multiline_flag is None:
+            if self._packed is not None:
+                data, offsets = self._packed
+                self._multiline_flag = bool((data[int(offsets[0]) : int(offsets[-1])] == LF).any())
+            else:
+                self._multiline_flag = int(np.count_nonzero(self.data == LF)) != len(self)
+        return self._multiline_flag
 
     @classmethod
     def from_strings(cls, values) -> TextColumn:
@@ -53,6 +103,8 @@ class TextColumn(Sequence):
         return cls(np.frombuffer(b"".join(parts), np.uint8), offsets, valid)
 
     def __len__(self) -> int:
+        if self._packed is not None:
+            return len(self._packed[1]) - 1
         return len(self.offsets) - 1
 
     @overload
@@ -132,18 +184,21 @@ class TextColumn(Sequence):
         (no object per value)."""
         import pyarrow as pa
 
-        # the values without their line breaks, and offsets to match
-        keep = np.ones(len(self.data), bool)
-        keep[self.offsets[1:] - 1] = False
-        data = self.data[keep]
-        offsets = self.offsets - np.arange(len(self.offsets), dtype=np.int64)
+        if self._packed is not None:
+            data, offsets = self._packed
+        else:
+            # the values without their line breaks, and offsets to match
+            keep = np.ones(len(self.data), bool)
+            keep[self.offsets[1:] - 1] = False
+            data = self.data[keep]
+            offsets = self.offsets - np.arange(len(self.offsets), dtype=np.int64)
         validity = None
         if self.valid is not None:
             validity = pa.py_buffer(np.packbits(self.valid, bitorder="little"))
-        kind, index = (pa.string(), np.int32) if len(data) < 2**31 else (pa.large_string(), np.int64)
+        kind, index = (pa.string(), np.int32) if int(offsets[-1]) < 2**31 else (pa.large_string(), np.int64)
         return pa.Array.from_buffers(
             kind,
             len(self),
-            [validity, pa.py_buffer(offsets.astype(index)), pa.py_buffer(data)],
+            [validity, pa.py_buffer(offsets.astype(index, copy=False)), pa.py_buffer(data)],
             null_count=-1 if validity is not None else 0,
         )

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import os
+import select
 import shutil
 import signal
 import stat
@@ -19,10 +20,13 @@ import threading
 from typing import BinaryIO, Callable
 
 from tvoronoi.errors import TvoronoiError
+from tvoronoi.fileio import WRITEBACK_BYTES, start_writeback
 
 # outputs of fewer features are written by one process: a fork costs a few milliseconds
 MIN_FEATURES = 100_000
 WRITE_BUFFER = 1 << 20
+# how long the parent waits for the child's report before copying what the child wrote since
+POLL_SECONDS = 0.005
 # what the child reports on its pipe: "ok COUNT", or the kind of error and its message
 _OK, _TVORONOI, _OS = b"ok", b"tvoronoi", b"os"
 
@@ -85,7 +89,13 @@ class ForkedPart:
         self.pid, self.reports = pid, read_end
 
     def append_to(self, stream: BinaryIO) -> int:
-        """Wait for the child, append its part to ``stream``; return its count. Raise its error."""
+        """Append the child's part to ``stream`` as the child writes it, then the rest once it has
+        reported; return its count. Raise its error (what was appended is then incomplete)."""
+        appender = _Appender(self.part, stream)
+        # while the child works, what it has written so far (its writes reach the file a
+        # megabyte at a time): the copy overlaps the wait
+        while not select.select([self.reports], [], [], POLL_SECONDS)[0]:
+            appender.step()
         report = self._wait()
         kind, _, rest = report.partition(b" ")
         if kind == _OS:
@@ -94,7 +104,7 @@ class ForkedPart:
         if kind != _OK:
             raise TvoronoiError(rest.decode(errors="replace"))
         try:
-            _copy(self.part, stream)
+            appender.finish()
         finally:
             self.part.close()
         return int(rest)
@@ -134,27 +144,56 @@ def _directory_of(stream) -> str | None:
 
 def _copy(part: BinaryIO, stream: BinaryIO) -> None:
     """Append the whole of ``part`` to ``stream``: in the kernel when both are descriptors."""
-    part.seek(0, os.SEEK_END)
-    size = part.tell()
-    part.seek(0)
-    try:
-        fd = stream.fileno()
-    except (OSError, AttributeError, ValueError):
-        fd = None
-    if fd is None:
-        shutil.copyfileobj(part, stream, WRITE_BUFFER)
-        return
-    stream.flush()
-    offset = 0
-    while offset < size:
+    copier = _Appender(part, stream)
+    copier.step()
+    copier.finish()
+
+
+class _Appender:
+    """Appends a growing file (a part a child is still writing) to a stream, as it grows:
+    ``step`` copies what is there so far, ``finish`` the rest (once it has stopped growing)."""
+
+    def __init__(self, part: BinaryIO, stream: BinaryIO):
+        self.part, self.stream, self.copied = part, stream, 0
         try:
-            sent = os.sendfile(fd, part.fileno(), offset, size - offset)
-        except OSError as e:
-            if offset or e.errno not in (errno.EINVAL, errno.ENOSYS):
-                raise
-            # a descriptor sendfile does not write to
-            shutil.copyfileobj(part, stream, WRITE_BUFFER)
+            self.fd: int | None = stream.fileno()
+        except (OSError, AttributeError, ValueError):
+            self.fd = None
+        self.start: int | None = None
+        if self.fd is not None:
+            stream.flush()
+            try:
+                self.start = os.lseek(self.fd, 0, os.SEEK_CUR)
+            except OSError:  # a pipe: nothing to write back
+                self.start = None
+
+    def step(self) -> None:
+        """Copy what the part holds beyond what was copied, in the kernel (nothing when the stream
+        is not a descriptor sendfile writes to: then all of it at the end)."""
+        if self.fd is None:
             return
-        if sent == 0:
-            raise OSError(f"the output took no more bytes after {offset} of {size}")
-        offset += sent
+        size = os.fstat(self.part.fileno()).st_size
+        while self.copied < size:
+            try:
+                # a run at a time, each handed to the disk while the next is copied
+                sent = os.sendfile(self.fd, self.part.fileno(), self.copied, min(size - self.copied, WRITEBACK_BYTES))
+            except OSError as e:
+                if self.copied or e.errno not in (errno.EINVAL, errno.ENOSYS):
+                    raise
+                self.fd = None  # a descriptor sendfile does not write to
+                return
+            if sent == 0:
+                raise OSError(f"the output took no more bytes after {self.copied} of {size}")
+            if self.start is not None:
+                start_writeback(self.fd, self.start + self.copied, sent)
+            self.copied += sent
+
+    def finish(self) -> None:
+        """Copy the rest of the part (complete now)."""
+        if self.fd is None:
+            self.part.seek(self.copied)
+            shutil.copyfileobj(self.part, self.stream, WRITE_BUFFER)
+            return
+        self.step()
+        if self.fd is None:  # sendfile refused the descriptor at its first run
+            self.finish()

@@ -567,7 +567,8 @@ def write_delaunay(
             used = np.zeros(diagram.n_sites, bool)
             used[triangles.ravel()] = True
             corners = diagram.sites[used]
-            bbox = _bbox_member(_rounded(np.array([*corners.min(axis=0), *corners.max(axis=0)]), precision))
+            extent = [corners[:, 0].min(), corners[:, 1].min(), corners[:, 0].max(), corners[:, 1].max()]
+            bbox = _bbox_member(_rounded(np.array(extent), precision))
         frame = _Framing(stream, layout, bbox)
         if progress is not None:
             progress(0, total)

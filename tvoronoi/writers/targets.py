@@ -13,6 +13,7 @@ nothing.
 from __future__ import annotations
 
 import errno
+import io
 import os
 import re
 import secrets
@@ -21,7 +22,7 @@ import sys
 from contextlib import contextmanager
 from typing import BinaryIO, Iterator
 
-from tvoronoi.fileio import STDIO
+from tvoronoi.fileio import STDIO, WritebackFile
 
 __all__ = ["STDIO", "TEMP_SUFFIX", "AtomicFile", "DirectFile", "StdoutFile", "open_output", "output_file"]
 
@@ -75,7 +76,8 @@ class AtomicFile:
             except FileExistsError:  # a name another run holds: draw again
                 continue
             break
-        self.file: BinaryIO = os.fdopen(fd, "wb", buffering=WRITE_BUFFER)
+        # its data goes to disk as it is written, so that commit's fsync waits for little
+        self.file: BinaryIO = io.BufferedWriter(WritebackFile(fd), WRITE_BUFFER)
 
     def _check_target(self) -> None:
         if os.path.isdir(self.target):
