@@ -56,20 +56,22 @@ def points(dist: str, n: int) -> np.ndarray:
 
 
 def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
-    """One build to bounded cells, phase by phase (seconds)."""
+    """One build to bounded cells, phase by phase (seconds), as tvoronoi.build.build_diagram makes it."""
     box = default_bbox(pts)
-    t0 = time.perf_counter()
-    e = engines.scale_exponent(pts)
-    s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e)
-    t1 = time.perf_counter()
-    t = engines.triangulate(s, engine=engine)
-    t2 = time.perf_counter()
-    out = t.voronoi(threads)
-    del t
-    t3 = time.perf_counter()
-    d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
-    t4 = time.perf_counter()
-    assert d.cell_offsets[-1] > 0
+    with build.build_arrays():
+        t0 = time.perf_counter()
+        e = engines.scale_exponent(pts)
+        s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
+        t1 = time.perf_counter()
+        t = engines.triangulate(s, engine=engine)
+        t2 = time.perf_counter()
+        out = t.voronoi(threads, clip_room=True)
+        del t
+        t3 = time.perf_counter()
+        d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+        t4 = time.perf_counter()
+        assert d.cell_offsets[-1] > 0
+        del d, out
     return {"order": t1 - t0, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3}
 
 
