@@ -262,6 +262,24 @@ async def test_time_spent_paused_does_not_count():
 
 
 @pilot_test
+async def test_a_tick_while_closing_is_ignored():
+    """The playback timer may tick once more after the app's last screen is gone (the app closing while
+    it plays): the tick finds no timeline and does nothing, where it raised ScreenStackError."""
+    app = make_app()
+    clock = FakeClock(100.0)
+    app.playback.clock = clock
+    async with app.run_test(size=SIZE) as pilot:
+        player = await start_playback(app, pilot)
+        await pilot.press("space")
+        assert player.playing
+    assert not app.timeline_on_screen()  # no screen left
+    index = player.index
+    clock.now += 10.0
+    app.playback.tick()
+    assert player.index == index
+
+
+@pilot_test
 async def test_playing_advances_in_real_time():
     """Without the hook the clock is the real one: wait (at most 10 s) for the first step, not a set time."""
     app = make_app()

@@ -19,7 +19,7 @@ from typing import Any, Callable, Iterable
 import numpy as np
 from rich.text import Text
 from textual import on
-from textual.app import App, ComposeResult, SystemCommand
+from textual.app import App, ComposeResult, ScreenStackError, SystemCommand
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
@@ -400,7 +400,11 @@ class VoronoiApp(App[int]):
 
     def timeline_on_screen(self) -> bool:
         """The timeline is on the screen shown (no dialog over it, the app not closing)."""
-        return bool(self.screen.query("#timeline"))
+        try:
+            screen = self.screen
+        except ScreenStackError:  # before the first screen, or after the last (a timer's tick while closing)
+            return False
+        return bool(screen.query("#timeline"))
 
     def inspect(self) -> None:
         """Show the cell under the cursor or pointer now."""
