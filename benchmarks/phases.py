@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import resource
 import statistics
 import subprocess
 import sys
@@ -59,6 +60,7 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
     """One build to bounded cells, phase by phase (seconds), as tvoronoi.build.build_diagram makes it."""
     box = default_bbox(pts)
     with build.build_arrays():
+        k0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         t0 = time.perf_counter()
         e = engines.scale_exponent(pts)
         s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
@@ -70,9 +72,10 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         t3 = time.perf_counter()
         d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
         t4 = time.perf_counter()
+        k1 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         assert d.cell_offsets[-1] > 0
         del d, out
-    return {"order": t1 - t0, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3}
+    return {"order": t1 - t0, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3, "system": k1 - k0}
 
 
 def others(pts: np.ndarray, geos_max: int) -> dict:
@@ -176,19 +179,20 @@ def main(argv=None) -> None:
             for (engine, threads), reps in runs.items():
                 med = {p: statistics.median(r[p] for r in reps) for p in PHASES}
                 med["total"] = statistics.median(sum(r[p] for p in PHASES) for r in reps)
+                med["system"] = statistics.median(r["system"] for r in reps)
                 rows.append(
                     {
                         "n": n_pts,
                         "dist": dist,
                         "tool": f"tvoronoi {engine}",
                         "threads": threads,
-                        **{p: med[p] for p in (*PHASES, "total")},
+                        **{p: med[p] for p in (*PHASES, "total", "system")},
                         "peak_mib": build_peak(dist, n, engine, threads),
                     }
                 )
                 print(
                     f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
-                    + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total")),
+                    + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total", "system")),
                     flush=True,
                 )
             for tool, seconds in others(pts, args.geos_max).items():
@@ -209,7 +213,10 @@ def report(rows: list[dict], info: dict) -> str:
         "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells. The other tools are "
         "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
         "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
-        "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process.",
+        "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process. System: the "
+        "kernel's time within a build (all threads, ms), mostly first touches of fresh memory: on a "
+        "virtual machine whose host takes back freed memory it varies from run to run, and explains "
+        "most of the swings of the phases.",
         "",
     ]
     for n in sorted({r["n"] for r in rows}):
@@ -218,19 +225,23 @@ def report(rows: list[dict], info: dict) -> str:
             lines += [
                 f"## {dist}, n = {n:,}",
                 "",
-                "| build | threads | order | tri | dual | cells | total | peak MiB |",
-                "|---|---:|---:|---:|---:|---:|---:|---:|",
+                "| build | threads | order | tri | dual | cells | total | system ms | peak MiB |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             for r in sub:
                 if "order" in r:
                     lines.append(
                         f"| {r['tool']} | {r['threads']} | "
                         + " | ".join(fmt_ns(r[p], n) for p in PHASES)
-                        + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | {r['peak_mib']:.0f} |"
+                        + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | "
+                        + (f"{r['system'] * 1e3:.0f}" if "system" in r else "")
+                        + f" | {r['peak_mib']:.0f} |"
                     )
             for r in sub:
                 if "order" not in r:
-                    lines.append(f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | |")
+                    lines.append(
+                        f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | | |"
+                    )
             lines.append("")
     return "\n".join(lines)
 
