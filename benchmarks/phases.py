@@ -5,7 +5,8 @@ cells are timed one after the other, in interleaved repeats (the median is repor
 
   order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
   tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep)
-  dual      the Voronoi half-edge structure and its correctly rounded vertices
+  dual      sites and triangles renumbered along a Z-curve, then the Voronoi half-edge structure and
+            its correctly rounded vertices
   cells     clipping every cell to the box and gathering the cells into input order
 
 and, on the same points, whole calls of other tools: Shewchuk's Triangle (`triangle.voronoi`: vertices
@@ -67,7 +68,8 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         t1 = time.perf_counter()
         t = engines.triangulate(s, engine=engine)
         t2 = time.perf_counter()
-        out = t.voronoi(threads, clip_room=True)
+        t = engines.spatial(t, threads)
+        s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t
         t3 = time.perf_counter()
         d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)

@@ -66,7 +66,7 @@ def test_a_build_equals_one_made_with_the_default_allocator_and_no_room():
     pts = generate("clustered", 30_000, seed=4)
     box = default_bbox(pts)
     e = engines.scale_exponent(pts)
-    t = engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
+    t = engines.spatial(engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e))
     out = t.voronoi(1)
     assert "vertex_room" not in out
     plain = assemble(pts, box, e, t.sites.perm, t.sites.xs, t.sites.ys, out, engine="incremental")

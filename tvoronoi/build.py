@@ -24,6 +24,7 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
         t = engines.run(
             pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
         )
+        t = engines.spatial(t, threads)  # the dual and the clipper walk the sites in this order
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.kernels import dual, fortune, incremental, order
+from tvoronoi.kernels import dual, fortune, incremental, order, renumber
 
 # Box sides in the sites' scaled unit. From above, the exact products split a box coordinate into
 # halves by multiplying it with 2^27 + 1 (Dekker), which must not overflow: about 2^997, a little
@@ -183,6 +183,24 @@ class Triangulation:
         out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room)
         out["dup"] = self.dup
         return out
+
+
+def spatial(t: Triangulation, threads: int = 1) -> Triangulation:
+    """The same triangulation with its sites and triangles renumbered along a Z-curve (kernels/renumber.pyx),
+    so that the dual and the clipper, which walk the sites in order, find neighbours near in memory.
+
+    Only the numbering changes (``sites.perm`` still maps each site to its input row); the result is the
+    same for any thread count. A flat triangulation is returned as it is.
+    """
+    if t.flat:
+        return t
+    s = t.sites
+    new_to_old, old_to_new, tv, opp = renumber.spatial_order(s.xs, s.ys, t.tv, t.opp, threads)
+    dup = t.dup[new_to_old]
+    repeats = dup >= 0
+    dup[repeats] = old_to_new[dup[repeats]]
+    sites = Sites(s.exponent, s.perm[new_to_old], s.xs[new_to_old], s.ys[new_to_old])
+    return Triangulation(t.engine, sites, tv, opp, dup)
 
 
 def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triangulation:

@@ -1,0 +1,141 @@
+"""The spatial renumbering of a triangulation (kernels/renumber.pyx, engines.spatial): the same
+triangulation in new numbers, the same cells, and neighbours near in memory."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from conftest import DATASETS
+from tests import adversarial
+from tvoronoi import build, engines
+from tvoronoi.api import as_bbox, default_bbox
+from tvoronoi.generators import generate
+from tvoronoi.kernels import renumber
+
+ENGINES = ("incremental", "fortune")
+
+
+def triangulation(pts: np.ndarray, engine: str) -> engines.Triangulation:
+    return engines.run(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), engine=engine)
+
+
+def check_renumbered(t: engines.Triangulation, r: engines.Triangulation) -> None:
+    """r is t with its sites and triangles renumbered: a permutation of both, nothing else changed."""
+    n = len(t.sites)
+    if t.flat:
+        assert r is t
+        return
+    new_to_old = np.empty(n, np.int64)
+    for k, row in enumerate(r.sites.perm):  # input rows are one-to-one with sites
+        new_to_old[k] = int(np.flatnonzero(t.sites.perm == row)[0])
+    assert np.array_equal(np.sort(new_to_old), np.arange(n))
+    assert np.array_equal(r.sites.xs, t.sites.xs[new_to_old])
+    assert np.array_equal(r.sites.ys, t.sites.ys[new_to_old])
+    assert r.sites.exponent == t.sites.exponent
+    old_to_new = np.empty(n + 1, np.int64)
+    old_to_new[new_to_old] = np.arange(n)
+    old_to_new[n] = n
+
+    # the twins: an involution, each half-edge a->b paired with b->a
+    tv, opp = r.tv.astype(np.int64), r.opp.astype(np.int64)
+    h = np.arange(len(tv))
+    assert np.array_equal(opp[opp], h)
+    head = tv[3 * (h // 3) + (h % 3 + 1) % 3]
+    assert np.array_equal(tv[opp], head) and np.array_equal(head[opp], tv)
+
+    # the same triangles, each in the same rotation
+    def rotations(tri):
+        tri = tri.reshape(-1, 3)
+        k = np.argmin(tri, axis=1)
+        return sorted(map(tuple, np.stack([tri[np.arange(len(tri)), (k + j) % 3] for j in range(3)], 1).tolist()))
+
+    assert rotations(old_to_new[t.tv]) == rotations(tv)
+
+    # repeated sites: each names the new number of a site at the same place that is not itself a repeat
+    assert np.array_equal(r.dup < 0, (t.dup < 0)[new_to_old])
+    rep = np.flatnonzero(r.dup >= 0)
+    assert np.all(r.dup[r.dup[rep]] < 0)
+    assert np.array_equal(r.sites.xs[r.dup[rep]], r.sites.xs[rep])
+    assert np.array_equal(r.sites.ys[r.dup[rep]], r.sites.ys[rep])
+
+
+def cells(t: engines.Triangulation, pts: np.ndarray, box) -> list:
+    s = t.sites
+    d = build.assemble(pts, box, s.exponent, s.perm, s.xs, s.ys, t.voronoi(1), engine=t.engine)
+    return [d.cell_polygon(i).tolist() for i in range(len(pts))]
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("name", sorted(DATASETS))
+def test_the_same_triangulation_and_cells_on_every_data_set(name, engine):
+    pts = DATASETS[name]
+    t = triangulation(pts, engine)
+    r = engines.spatial(t)
+    check_renumbered(t, r)
+    box = as_bbox(default_bbox(pts))
+    assert cells(r, pts, box) == cells(t, pts, box)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("family", sorted(adversarial.FAMILIES))
+def test_the_same_cells_on_the_adversarial_families(family, engine):
+    case = adversarial.make(family)
+    pts = case.points
+    t = triangulation(pts, engine)
+    r = engines.spatial(t)
+    if len(pts) <= 3000:
+        check_renumbered(t, r)
+    box = as_bbox(case.bbox if case.bbox is not None else default_bbox(pts))
+    assert cells(r, pts, box) == cells(t, pts, box)
+
+
+@settings(max_examples=60)
+@given(
+    st.lists(
+        st.tuples(st.integers(-6, 6), st.integers(-6, 6)).map(lambda p: (p[0] * 0.5, p[1] * 0.25)),
+        min_size=1,
+        max_size=60,
+    ),
+    st.sampled_from(ENGINES),
+)
+def test_small_inputs_with_repeats_and_ties(points, engine):
+    pts = np.array(points, float)
+    t = triangulation(pts, engine)
+    r = engines.spatial(t)
+    check_renumbered(t, r)
+    box = as_bbox(default_bbox(pts))
+    assert cells(r, pts, box) == cells(t, pts, box)
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_the_same_numbering_on_any_thread_count(threads):
+    pts = generate("clustered", 60_000, seed=21)  # over 2^16 triangles: the rewrite runs on threads
+    t = triangulation(pts, "incremental")
+    one = renumber.spatial_order(t.sites.xs, t.sites.ys, t.tv, t.opp, 1)
+    many = renumber.spatial_order(t.sites.xs, t.sites.ys, t.tv, t.opp, threads)
+    for a, b in zip(one, many, strict=True):
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_neighbours_are_near_in_memory(engine):
+    """What the renumbering is for: the triangles on either side of an edge, and consecutive sites, lie
+    close together (20,000 uniform sites: the incremental engine's own slots are scattered)."""
+    pts = generate("uniform", 20_000, seed=22)
+    t = triangulation(pts, engine)
+    r = engines.spatial(t)
+    n_tri = len(r.tv) // 3
+    gap = np.abs(np.arange(len(r.opp)) // 3 - r.opp // 3)
+    assert np.median(gap) < 0.02 * n_tri
+    step = np.hypot(np.diff(r.sites.xs), np.diff(r.sites.ys))
+    assert np.median(step) < 3.0 / np.sqrt(len(pts)) * (np.ptp(r.sites.xs) + np.ptp(r.sites.ys))
+
+
+def test_grid_bits_give_about_one_site_a_cell():
+    assert renumber.grid_bits(0) == 0
+    assert renumber.grid_bits(1) == 0
+    assert renumber.grid_bits(4) == 1
+    assert renumber.grid_bits(5) == 2
+    assert renumber.grid_bits(1_000_000) == 10
+    assert renumber.grid_bits(10**9) == 11  # capped: the count array stays small

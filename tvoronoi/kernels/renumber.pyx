@@ -1,0 +1,155 @@
+"""A triangulation renumbered in a spatial order: sites along a Z-curve of a grid, triangles by their first site.
+
+The incremental engine numbers its sites in insertion order (BRIO: rounds that each sweep the whole
+plane) and reuses the slots of destroyed triangles, so the triangles around one site lie far apart in
+memory, and so do those of consecutive sites. The dual (dual.pyx) walks around every site in site
+order and the clipper reads cells in that order: both are bound by those cache misses. Renumbering
+once, in one linear pass, makes consecutive sites neighbours in the plane and stores the triangles
+around them together (the dual at 10^6 uniform sites: 0.37 s -> 0.17 s on one thread).
+
+The order is a heuristic for memory locality only: no geometric decision depends on it, and every
+later phase gives the same cells for any numbering (rings start at a canonical point). It is a
+function of the coordinates and the given numbering alone, so every thread count gives the same one.
+"""
+
+import numpy as np
+
+from cython.parallel cimport prange
+from libc.stdint cimport int32_t, uint32_t
+
+cdef enum:
+    MAX_GRID_BITS = 11      # at most 2^11 x 2^11 grid cells (a 16 MiB count array); more sites share cells
+    PARALLEL_MIN_TRIANGLES = 1 << 16    # fewer triangles are rewritten on one thread
+
+
+cdef inline uint32_t spread(uint32_t v) noexcept nogil:
+    # the bits of v (up to 16) moved to the even positions: the Z-curve (Morton) interleave
+    v &= 0x0000FFFF
+    v = (v | (v << 8)) & 0x00FF00FF
+    v = (v | (v << 4)) & 0x0F0F0F0F
+    v = (v | (v << 2)) & 0x33333333
+    v = (v | (v << 1)) & 0x55555555
+    return v
+
+
+cdef inline int cell_index(double v, double lo, double scale, int top) noexcept nogil:
+    # the grid column (or row) of coordinate v: floor((v - lo) * scale), kept in [0, top] (a scale that
+    # overflowed to inf, for a span of a few subnormals, gives inf or NaN here: NaN counts as 0)
+    cdef double q = (v - lo) * scale
+    if not q > 0.0:
+        return 0
+    if q >= top:
+        return top
+    return <int> q
+
+
+cdef inline int32_t first_site(const int32_t* corners, const int32_t* old_to_new, int inf) noexcept nogil:
+    # the smallest new number among a triangle's finite corners (every triangle has one)
+    cdef int32_t low = inf, a
+    cdef int k
+    for k in range(3):
+        a = corners[k]
+        if a != inf and old_to_new[a] < low:
+            low = old_to_new[a]
+    return low
+
+
+def grid_bits(Py_ssize_t n):
+    """Bits per axis of the grid the sites are ordered on: about one site a cell, at most MAX_GRID_BITS."""
+    cdef int b = 0
+    while b < MAX_GRID_BITS and (<Py_ssize_t> 1 << (2 * b)) < n:
+        b += 1
+    return b
+
+
+def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
+                  int threads=1):
+    """Sites and triangles renumbered so that neighbours in the plane are neighbours in memory.
+
+    Sites are sorted (stably, by a counting sort) by the Z-curve index of their cell in a grid of about
+    one cell per site over their bounding box; a triangle goes with the smallest new number among its
+    finite sites (stably too), so the triangles around consecutive sites are stored together.
+
+    Parameters
+    ----------
+    xs, ys : (n,) float64, the sites.
+    tv, opp : (3 * n_tri,) int32, a triangulation of them (vertex n is the vertex at infinity) and its
+        twin half-edges, as incremental.triangulate or fortune.sweep return them.
+    threads : int, threads for the keys and the rewrite (the result is the same for any count).
+
+    Returns
+    -------
+    new_to_old : (n,) int32, new site k is old site new_to_old[k].
+    old_to_new : (n,) int32, its inverse.
+    tv2, opp2 : (3 * n_tri,) int32, the same triangulation in the new numbers: new triangle T is an old
+        one with its corners in the same rotation, sites and half-edges renumbered.
+    """
+    cdef Py_ssize_t n = xs.shape[0], n_he = tv.shape[0], n_tri = n_he // 3, k, t
+    cdef int b = grid_bits(n), top = (1 << b) - 1, inf = <int> n, key, a, T, o
+    cdef Py_ssize_t n_cells = <Py_ssize_t> 1 << (2 * b)
+    new_to_old_arr = np.empty(n, np.int32)
+    old_to_new_arr = np.empty(n, np.int32)
+    tv2_arr = np.empty(n_he, np.int32)
+    opp2_arr = np.empty(n_he, np.int32)
+    cdef int32_t[::1] new_to_old = new_to_old_arr, old_to_new = old_to_new_arr
+    cdef int32_t[::1] tv2 = tv2_arr, opp2 = opp2_arr
+    cdef int32_t[::1] keys = np.empty(max(n, n_tri), np.int32)      # each site's cell, then each triangle's site
+    cdef int32_t[::1] start = np.zeros(max(n_cells, n) + 1, np.int32)
+    cdef int32_t[::1] tri_new = np.empty(max(n_tri, 1), np.int32)
+    cdef double xlo, xhi, ylo, yhi, sx, sy
+    cdef int T_threads = threads if n_tri >= PARALLEL_MIN_TRIANGLES and threads > 1 else 1
+    if n == 0:
+        return new_to_old_arr, old_to_new_arr, tv2_arr, opp2_arr
+
+    with nogil:
+        # the grid over the sites' bounding box (an axis of zero extent is one column)
+        xlo = xhi = xs[0]
+        ylo = yhi = ys[0]
+        for k in range(1, n):
+            if xs[k] < xlo:
+                xlo = xs[k]
+            elif xs[k] > xhi:
+                xhi = xs[k]
+            if ys[k] < ylo:
+                ylo = ys[k]
+            elif ys[k] > yhi:
+                yhi = ys[k]
+        sx = (top + 1) / (xhi - xlo) if xhi > xlo else 0.0
+        sy = (top + 1) / (yhi - ylo) if yhi > ylo else 0.0
+
+        # sites: a counting sort by the Z-curve index of their cell (sites in one cell keep their order)
+        for k in prange(n, num_threads=T_threads, schedule="static"):
+            keys[k] = <int32_t> (spread(<uint32_t> cell_index(xs[k], xlo, sx, top))
+                                 | (spread(<uint32_t> cell_index(ys[k], ylo, sy, top)) << 1))
+        for k in range(n):
+            start[keys[k] + 1] += 1
+        for k in range(n_cells):
+            start[k + 1] += start[k]
+        for k in range(n):
+            key = keys[k]
+            new_to_old[start[key]] = <int32_t> k
+            old_to_new[k] = start[key]
+            start[key] += 1
+
+        # triangles: a counting sort by their smallest new site (every triangle has a finite one)
+        for k in range(n + 1):
+            start[k] = 0
+        for t in prange(n_tri, num_threads=T_threads, schedule="static"):
+            keys[t] = first_site(&tv[3 * t], &old_to_new[0], inf)
+        for t in range(n_tri):
+            start[keys[t] + 1] += 1
+        for k in range(n):
+            start[k + 1] += start[k]
+        for t in range(n_tri):
+            tri_new[t] = start[keys[t]]
+            start[keys[t]] += 1
+
+        # the triangles rewritten in their new places, sites and twins renumbered
+        for t in prange(n_tri, num_threads=T_threads, schedule="static"):
+            T = tri_new[t]
+            for k in range(3):
+                a = tv[3 * t + k]
+                tv2[3 * T + k] = old_to_new[a] if a != inf else inf
+                o = opp[3 * t + k]
+                opp2[3 * T + k] = 3 * tri_new[o // 3] + o % 3
+    return new_to_old_arr, old_to_new_arr, tv2_arr, opp2_arr
