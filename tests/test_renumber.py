@@ -1,4 +1,4 @@
-"""The spatial renumbering of a triangulation (kernels/renumber.pyx, engines.spatial): the same
+"""The spatial renumbering of a triangulation (kernels/renumber.pyx, engines.renumbered): the same
 triangulation in new numbers, the same cells, and neighbours near in memory."""
 
 import numpy as np
@@ -71,7 +71,7 @@ def cells(t: engines.Triangulation, pts: np.ndarray, box) -> list:
 def test_the_same_triangulation_and_cells_on_every_data_set(name, engine):
     pts = DATASETS[name]
     t = triangulation(pts, engine)
-    r = engines.spatial(t)
+    r = engines.renumbered(t)
     check_renumbered(t, r)
     box = as_bbox(default_bbox(pts))
     assert cells(r, pts, box) == cells(t, pts, box)
@@ -83,7 +83,7 @@ def test_the_same_cells_on_the_adversarial_families(family, engine):
     case = adversarial.make(family)
     pts = case.points
     t = triangulation(pts, engine)
-    r = engines.spatial(t)
+    r = engines.renumbered(t)
     if len(pts) <= 3000:
         check_renumbered(t, r)
     box = as_bbox(case.bbox if case.bbox is not None else default_bbox(pts))
@@ -102,7 +102,7 @@ def test_the_same_cells_on_the_adversarial_families(family, engine):
 def test_small_inputs_with_repeats_and_ties(points, engine):
     pts = np.array(points, float)
     t = triangulation(pts, engine)
-    r = engines.spatial(t)
+    r = engines.renumbered(t)
     check_renumbered(t, r)
     box = as_bbox(default_bbox(pts))
     assert cells(r, pts, box) == cells(t, pts, box)
@@ -124,7 +124,7 @@ def test_neighbours_are_near_in_memory(engine):
     close together (20,000 uniform sites: the incremental engine's own slots are scattered)."""
     pts = generate("uniform", 20_000, seed=22)
     t = triangulation(pts, engine)
-    r = engines.spatial(t)
+    r = engines.renumbered(t)
     n_tri = len(r.tv) // 3
     gap = np.abs(np.arange(len(r.opp)) // 3 - r.opp // 3)
     assert np.median(gap) < 0.02 * n_tri
@@ -139,3 +139,11 @@ def test_grid_bits_give_about_one_site_a_cell():
     assert renumber.grid_bits(5) == 2
     assert renumber.grid_bits(1_000_000) == 10
     assert renumber.grid_bits(10**9) == 11  # capped: the count array stays small
+
+
+def test_builds_renumber_the_incremental_engine_only():
+    pts = generate("uniform", 2_000, seed=23)
+    inc, fort = triangulation(pts, "incremental"), triangulation(pts, "fortune")
+    assert engines.spatial(fort) is fort
+    r = engines.spatial(inc)
+    assert r is not inc and np.array_equal(r.sites.perm, engines.renumbered(inc).sites.perm)

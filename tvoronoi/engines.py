@@ -186,8 +186,18 @@ class Triangulation:
 
 
 def spatial(t: Triangulation, threads: int = 1) -> Triangulation:
-    """The same triangulation with its sites and triangles renumbered along a Z-curve (kernels/renumber.pyx),
-    so that the dual and the clipper, which walk the sites in order, find neighbours near in memory.
+    """The triangulation the dual and the clipper read best: they walk the sites in order, so neighbours
+    should be near in memory.
+
+    The incremental engine's is renumbered (``renumbered``); Fortune's is returned as it is: its sites
+    come in sweep order and its triangles are stored as the sweep makes them, next to their sites
+    already (renumbering it cost 50 ms more than it saved at 10^6 sites).
+    """
+    return renumbered(t, threads) if t.engine == "incremental" else t
+
+
+def renumbered(t: Triangulation, threads: int = 1) -> Triangulation:
+    """The same triangulation with its sites and triangles renumbered along a Z-curve (kernels/renumber.pyx).
 
     Only the numbering changes (``sites.perm`` still maps each site to its input row); the result is the
     same for any thread count. A flat triangulation is returned as it is.
