@@ -130,6 +130,21 @@ def test_input_from_stdin(capsys, monkeypatch, tmp_path):
     check_cells_document(load(out), sites, grown_box(sites))
 
 
+def test_semicolon_csv_from_stdin_is_recognised(capsys, monkeypatch, tmp_path):
+    """A spreadsheet's export piped in, with no name to tell its format: its semicolons are found."""
+    sites = DATASETS["uniform"][:30]
+    text = "name;lon;lat\n" + "".join(
+        f"s{i};{x!r};{y!r}\n".replace(".", ",") for i, (x, y) in enumerate(sites.tolist())
+    )
+    monkeypatch.setattr(sys, "stdin", FakeStdin(text.encode()))
+    out = tmp_path / "cells.geojson"
+    status, _, stderr = run(capsys, "batch", "-", "-o", out)
+    assert status == 0, stderr
+    doc = load(out)
+    check_cells_document(doc, sites, grown_box(sites))
+    assert {f["properties"]["name"] for f in doc["features"]} == {f"s{i}" for i in range(30)}
+
+
 def test_columns_chosen_with_x_and_y(capsys, tmp_path):
     path = tmp_path / "t.txt"
     sites = DATASETS["clustered"][:40]

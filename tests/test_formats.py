@@ -140,6 +140,28 @@ def test_lonlat_default_box_stays_on_the_globe(tmp_path):
     assert geo["crs"]["id"] == {"authority": "OGC", "code": "CRS84"}
 
 
+@pytest.mark.parametrize(
+    ("rows", "culprit", "count"),
+    [
+        ("-170,10\n170,20\n0,95\n10,-80\n", "line 4: latitude 95 lies beyond", 1),
+        ("500,10\n170,20\n0,-95\n10,-80\n", "line 2: longitude 500 lies beyond", 2),
+        ("-180,90\n180,-90\n0,0\n", None, 0),  # the edges of the range are on the globe
+    ],
+)
+def test_lonlat_beyond_the_globe_warns_with_the_line(tmp_path, capsys, rows, culprit, count):
+    path = tmp_path / "p.csv"
+    path.write_text("lon,lat\n" + rows)
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "c.geojson")]) == 0
+    err = capsys.readouterr().err
+    if culprit is None:
+        assert "warning" not in err
+    else:
+        assert f"p.csv, {culprit} [-180, 180] x [-90, 90]" in err
+        assert ("more sites" in err) == (count > 1)
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "q.geojson"), "-q"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 def test_non_wgs84_geojson_input_warns_for_geojson_output(tmp_path, capsys):
     doc = {
         "type": "FeatureCollection",
@@ -301,3 +323,36 @@ def test_a_part_written_from_its_diagram_equals_the_part_of_its_shapely_cells(tm
     assert wkb[-4:] == [None] * 4  # the repeats and the cell outside the box
     assert wkb[:-4] == list(shapely.to_wkb(d.to_shapely()[rows[:-4]]))
     assert write_cells_part(frame[:0], d, rows[:0], tmp_path, "part-empty") == ""
+
+
+@pytest.mark.parametrize("name", ["cells.gpkg", "cells.shp", "cells.csv", "CELLS.KML"])
+def test_an_output_named_for_a_format_not_written_is_refused(tmp_path, points_csv, capsys, name):
+    assert run(points_csv, "-o", tmp_path / name) == 2
+    err = capsys.readouterr().err
+    assert name in err and "does not write" in err and "--to" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [points_csv.name]  # nothing written
+
+
+@pytest.mark.parametrize(
+    ("cells", "triangles", "to", "refused"),
+    [
+        ("c.geojson", "t.parquet", "geojsonl", "t.parquet"),  # text into a .parquet file
+        ("c.geojson", None, "parquet", "c.geojson"),  # Parquet into a GeoJSON name
+        ("c.json", None, "geojsonl", None),  # within the GeoJSON family, --to decides
+        ("c.dat", "t.parquet", "parquet", None),
+        ("c.csv", None, "geojson", None),  # --to says what a foreign name holds
+    ],
+)
+def test_to_against_the_extension(tmp_path, points_csv, capsys, cells, triangles, to, refused):
+    args = [points_csv, "-o", tmp_path / cells, "--to", to]
+    if triangles:
+        args += ["--delaunay", tmp_path / triangles]
+    status = run(*args)
+    err = capsys.readouterr().err
+    if refused:
+        assert status == 2 and f"{refused}: --to {to}" in err
+        assert sorted(p.name for p in tmp_path.iterdir()) == [points_csv.name]
+    else:
+        assert status == 0, err
+        head = (tmp_path / cells).read_bytes()[:4]
+        assert (head == b"PAR1") == (to == "parquet")

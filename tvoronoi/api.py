@@ -90,9 +90,9 @@ def as_points(points) -> np.ndarray:
     if not np.isfinite(pts).all():  # (a reduction over all values: ~30 times faster than by rows)
         bad = ~np.isfinite(pts).all(axis=1)
         row = int(np.flatnonzero(bad)[0])
+        more = "" if bad.sum() == 1 else f" ({int(bad.sum())} such points)"
         raise TvoronoiError(
-            f"point {row} is ({float(pts[row, 0])!r}, {float(pts[row, 1])!r}): coordinates must be finite "
-            f"({int(bad.sum())} such point(s))"
+            f"point {row} is ({float(pts[row, 0])!r}, {float(pts[row, 1])!r}): coordinates must be finite{more}"
         )
     check_range(pts, scale_exponent(pts))
     return np.ascontiguousarray(pts)

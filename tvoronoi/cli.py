@@ -384,6 +384,16 @@ def _batch_run(args, phases: Phases) -> int:
                 f"{', '.join(geojson_out)}: RFC 7946 GeoJSON has no CRS and is read as lon/lat, but the "
                 f"coordinates are {crs_name(crs)}; write GeoParquet (.parquet) to keep the CRS"
             )
+        if lonlat and not args.quiet:
+            beyond = _beyond_lonlat(points.xy)
+            if beyond is not None:
+                row, what, count = beyond
+                others = "" if count == 1 else f" (and {count - 1:,} more sites)"
+                phases.warn(
+                    f"{points.locate(row)}: {what} lies beyond [-180, 180] x [-90, 90], the range of "
+                    f"{crs_name(crs)}{others}; the cells are built in the plane as given: check the "
+                    "columns (--x/--y) or give the CRS with --crs"
+                )
         if bbox is None and lonlat and region is None:
             # lon/lat: the default box stops at the antimeridian and the poles
             options["bbox"] = _lonlat_box(points.xy)
@@ -468,11 +478,57 @@ def _batch_run(args, phases: Phases) -> int:
 _CRS_CODE = re.compile(r"[A-Za-z]+:[A-Za-z0-9]+")
 
 
+# extensions of formats tvoronoi does not write: an output named so is refused, not filled with GeoJSON
+FOREIGN_OUTPUTS = {
+    ".gpkg": "GeoPackage",
+    ".shp": "shapefile",
+    ".fgb": "FlatGeobuf",
+    ".kml": "KML",
+    ".gml": "GML",
+    ".csv": "CSV",
+    ".tsv": "TSV",
+    ".xlsx": "Excel",
+}
+FORMAT_NAMES = {"geojson": "GeoJSON", "geojsonseq": "GeoJSONSeq", "geojsonl": "GeoJSON lines", "parquet": "GeoParquet"}
+
+
 def _output_format(name: str, to: str | None) -> str:
-    """The format of an output: --to, else its extension, else GeoJSON."""
+    """The format of an output: --to, else its extension, else GeoJSON.
+
+    Raises TvoronoiError for an extension of a format tvoronoi does not write, and for --to that
+    puts text into a file named .parquet, or Parquet into one named as GeoJSON.
+    """
+    suffix = "" if name == STDIO else os.path.splitext(name)[1].lower()
+    if suffix in FOREIGN_OUTPUTS and to is None:
+        raise TvoronoiError(
+            f"{name}: tvoronoi does not write {FOREIGN_OUTPUTS[suffix]}; name the output .geojson, "
+            ".geojsons, .geojsonl or .parquet (ogr2ogr converts them further), or give --to"
+        )
+    implied = OUTPUT_EXTENSIONS.get(suffix)
     if to is not None:
+        # (within the GeoJSON family a name is a convention; Parquet against text is not)
+        if implied is not None and (implied == "parquet") != (to == "parquet"):
+            raise TvoronoiError(
+                f"{name}: --to {to} would write {FORMAT_NAMES[to]} into a file named as "
+                f"{FORMAT_NAMES[implied]}; rename it or drop --to"
+            )
         return to
-    return OUTPUT_EXTENSIONS.get(os.path.splitext(name)[1].lower(), "geojson")
+    return implied or "geojson"
+
+
+def _beyond_lonlat(xy) -> tuple[int, str, int] | None:
+    """The first site of lon/lat input beyond [-180, 180] x [-90, 90], what is wrong with it, and how
+    many such sites there are (None: all within)."""
+    import numpy as np
+
+    xs, ys = xy[:, 0], xy[:, 1]
+    bad = (np.abs(xs) > 180) | (np.abs(ys) > 90)
+    count = int(np.count_nonzero(bad))
+    if count == 0:
+        return None
+    row = int(np.argmax(bad))
+    x, y = float(xs[row]), float(ys[row])
+    return row, (f"longitude {x:g}" if abs(x) > 180 else f"latitude {y:g}"), count
 
 
 def _lonlat_box(xy) -> tuple[float, float, float, float] | None:

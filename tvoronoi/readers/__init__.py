@@ -156,9 +156,13 @@ def _refuse_unsupported(data: bytes, suffix: str, source: str) -> None:
         )
     if found is not None:
         name, how = found
+        if suffix in (".shx", ".dbf"):  # the conversion takes the shapefile's .shp, beside this part
+            source_of = str(Path(source).with_suffix(".shp"))
+        else:
+            source_of = source
         raise InputFileError(
-            f"{source}: this is a {name} file, which tvoronoi does not read; convert it to GeoJSON, "
-            f"GeoParquet or CSV first, e.g. {how.format(source=source)}"
+            f"{source}: a {name}, which tvoronoi does not read; convert it to GeoJSON, "
+            f"GeoParquet or CSV first, e.g. {how.format(source=source_of)}"
         )
 
 
@@ -206,7 +210,8 @@ def _is_binary(data: bytes) -> bool:
 
 
 def _sniff_format(data: bytes) -> str:
-    """Guess the format from the first bytes: npy magic, a JSON object, a comma, else text."""
+    """Guess the format from the first bytes: npy magic, a JSON object, a comma or a semicolon (a
+    spreadsheet's export, whose delimiter tabular.sniff_delimiter then finds), else text."""
     if data.startswith(NPY_MAGIC):
         return "npy"
     if data.startswith(PARQUET_MAGIC):
@@ -218,7 +223,7 @@ def _sniff_format(data: bytes) -> str:
         line = line.strip()
         # a "#" line is a comment of a text file, whatever it holds
         if line and not line.startswith(COMMENT):
-            return "csv" if "," in line else "text"
+            return "csv" if "," in line or ";" in line else "text"
     return "text"
 
 
