@@ -383,3 +383,27 @@ def test_parts_keep_null_list_struct_and_dictionary_columns(tmp_path):
             "meta": [{"k": 1}, {"k": 2}, None, {"k": 3}],
             "kind": ["a", "b", "a", None],
         }
+
+
+def test_a_property_of_mixed_types_is_text_that_agrees_with_geojson(tmp_path):
+    """A GeoJSON property whose values mix types is a GeoParquet string column: each string as it
+    is ("01" stays "01", not '"01"'), each other value the JSON text the GeoJSON output holds."""
+    import orjson
+
+    values = [1, "01", 2.5, None, [1, "x"], {"k": 'say "hi"'}, True, 'a "quoted", word']
+    doc = {
+        "type": "FeatureCollection",
+        "features": [
+            {"type": "Feature", "geometry": {"type": "Point", "coordinates": [i % 3, i // 3]}, "properties": {"a": v}}
+            for i, v in enumerate(values)
+        ],
+    }
+    (tmp_path / "mixed.geojson").write_text(json.dumps(doc))
+    assert run(tmp_path / "mixed.geojson", "-o", tmp_path / "c.parquet") == 0
+    assert run(tmp_path / "mixed.geojson", "-o", tmp_path / "c.geojson") == 0
+    column = pq.read_table(tmp_path / "c.parquet")["a"]
+    assert column.type == pa.string()
+    assert column.to_pylist()[:4] == ["1", "01", "2.5", None]
+    written = [p["a"] for p in _features(tmp_path / "c.geojson")]
+    assert written == values
+    assert column.to_pylist() == [v if v is None or isinstance(v, str) else orjson.dumps(v).decode() for v in written]

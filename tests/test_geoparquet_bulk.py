@@ -125,7 +125,8 @@ def test_extent_of_cells_some_of_which_miss_the_box():
         [0.5, float("nan"), None, -0.0, float("inf")],
         [1, 2.5],  # mixed: pyarrow's own inference
         [True, False, None],
-        ["a", 1],  # mixed types: JSON text
+        ["a", 1],  # mixed types: text, a string as it is, a number its JSON text
+        ["01", None, 2.5, [1, "x"], {"k": "v"}, True, 'say "hi"'],
         [],
     ],
 )
@@ -134,7 +135,7 @@ def test_number_columns_as_pyarrow_makes_them(values):
     try:
         theirs = pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
-        theirs = pa.array([None if v is None else json_text(v) for v in values], pa.string())
+        theirs = pa.array([v if v is None or isinstance(v, str) else json_text(v) for v in values], pa.string())
     assert ours.type == theirs.type
     assert ours.null_count == theirs.null_count
     assert ours.to_pylist() == theirs.to_pylist() or _same_with_nan(ours.to_pylist(), theirs.to_pylist())
@@ -247,3 +248,10 @@ def test_column_options_reach_the_leaves_of_nested_properties(tmp_path):
         assert ("RLE_DICTIONARY" in chunk.encodings) == (path in repeating), path
         assert chunk.is_stats_set or path == "none", path
     assert pq.read_table(tmp_path / "t.parquet").equals(table.cast(pq.read_schema(tmp_path / "t.parquet")))
+
+
+def test_a_mixed_value_without_json_form_is_named():
+    from tvoronoi.errors import TvoronoiError
+
+    with pytest.raises(TvoronoiError, match="tag: the value <object"):
+        geoparquet._typed_column(pa, [1, object()], "tag")

@@ -128,8 +128,9 @@ def projjson(crs) -> dict | None:
         raise TvoronoiError(f"{crs}: not a CRS pyproj knows ({e}); give one like EPSG:3857") from None
 
 
-def _typed_column(pa, values: list):
-    """An Arrow array of one property: its own type when the values share one, else JSON text."""
+def _typed_column(pa, values: list, name: str = "a property"):
+    """An Arrow array of one property: its own type when the values share one, else text (see
+    :func:`_mixed_column`)."""
     if isinstance(values, TextColumn):
         return values.to_arrow()
     numbers = _number_column(pa, values)
@@ -138,9 +139,30 @@ def _typed_column(pa, values: list):
     try:
         return pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
-        import orjson
+        return _mixed_column(pa, values, name)
 
-        return pa.array([None if v is None else orjson.dumps(v).decode() for v in values], pa.string())
+
+def _mixed_column(pa, values: list, name: str = "a property"):
+    """A string array of a property whose values mix types (``1``, ``"01"``, ``2.5``): a string
+    as it is (``"01"``, never ``'"01"'``), any other value as the JSON text the GeoJSON output
+    writes for it (``"1"``, ``"2.5"``, ``"[1,2]"``), null for None.
+
+    Raises
+    ------
+    TvoronoiError
+        A value has no JSON form.
+    """
+    import orjson
+
+    out = []
+    for v in values:
+        if v is not None and not isinstance(v, str):
+            try:
+                v = orjson.dumps(v, option=orjson.OPT_SERIALIZE_NUMPY).decode()
+            except orjson.JSONEncodeError as e:
+                raise TvoronoiError(f"{name}: the value {v!r} cannot be written as JSON text ({e})") from None
+        out.append(v)
+    return pa.array(out, pa.string())
 
 
 def _number_column(pa, values: list):
@@ -357,7 +379,8 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     """Write the Voronoi cells as GeoParquet 1.1: one row per distinct site, in input order.
 
     Columns: ``site`` (int64, the 0-based input row), the site's properties as
-    typed Arrow columns (a property whose values mix types is JSON text),
+    typed Arrow columns (a property whose values mix types is text: strings as they
+    are, other values their JSON text),
     ``duplicates`` (list of later rows at the same place, null where none),
     ``geometry`` (WKB Polygon, null for a cell that misses the box) and ``bbox``
     (struct xmin, ymin, xmax, ymax: the covering columns of GeoParquet 1.1).
@@ -400,7 +423,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
                 values = points.columns[name]
                 if len(kept) < n_sites:
                     values = [values[i] for i in kept.tolist()]
-            columns[renames.get(name, name)] = _typed_column(pa, values)
+            columns[renames.get(name, name)] = _typed_column(pa, values, name)
     columns["duplicates"] = _duplicates_column(pa, diagram, kept)
     if getattr(diagram, "clipped", None) is not None:
         # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
