@@ -356,3 +356,109 @@ def test_to_against_the_extension(tmp_path, points_csv, capsys, cells, triangles
         assert status == 0, err
         head = (tmp_path / cells).read_bytes()[:4]
         assert (head == b"PAR1") == (to == "parquet")
+
+
+def _features(path) -> list[dict]:
+    return [f["properties"] for f in json.loads(path.read_text())["features"]]
+
+
+def test_geoparquet_keeps_null_list_and_struct_columns(tmp_path):
+    """Property columns Arrow cannot count the distinct values of (all null, lists, structs, maps)
+    are written with their own types, and read back as the GeoJSON output writes them."""
+    (tmp_path / "empty.csv").write_text("x,y,note\n0,0,\n1,0,\n0,1,\n1,1,\n")
+    features = [
+        {"tags": ["a", "b"], "meta": {"k": 1, "ok": True}},
+        {"tags": ["a"], "meta": {"k": 2, "ok": False}},
+        {"tags": None, "meta": None},
+        {"tags": [], "meta": {"k": 3, "ok": None}},
+    ]
+    doc = {
+        "type": "FeatureCollection",
+        "features": [
+            {"type": "Feature", "geometry": {"type": "Point", "coordinates": xy}, "properties": p}
+            for xy, p in zip([[0, 0], [1, 0], [0, 1], [1, 1]], features)
+        ],
+    }
+    (tmp_path / "nested.geojson").write_text(json.dumps(doc))
+    table = pa.table(
+        {
+            "x": [0.0, 1, 0, 1],
+            "y": [0.0, 0, 1, 1],
+            "ids": pa.array([[1, 2], [3], None, []], pa.list_(pa.int64())),
+            "none": pa.nulls(4),
+        }
+    )
+    pq.write_table(table, tmp_path / "lists.parquet")
+    expected_types = {
+        "empty.csv": {"note": pa.null()},
+        "nested.geojson": {
+            "tags": pa.list_(pa.string()),
+            "meta": pa.struct([("k", pa.int64()), ("ok", pa.bool_())]),
+        },
+        "lists.parquet": {"ids": pa.list_(pa.int64()), "none": pa.null()},
+    }
+    for name, types in expected_types.items():
+        stem = name.split(".")[0]
+        assert run(tmp_path / name, "-o", tmp_path / f"{stem}.out.parquet") == 0, name
+        assert run(tmp_path / name, "-o", tmp_path / f"{stem}.out.geojson") == 0, name
+        got = pq.read_table(tmp_path / f"{stem}.out.parquet")
+        for column, kind in types.items():
+            assert got.schema.field(column).type.equals(kind, check_metadata=False), (name, column)
+        rows = got.drop_columns(["geometry", "bbox", "duplicates"]).to_pylist()
+        assert rows == _features(tmp_path / f"{stem}.out.geojson"), name
+
+
+def test_parts_keep_null_list_struct_and_dictionary_columns(tmp_path):
+    """A distributed task's GeoParquet parts (from its diagram, or from shapely cells) take the
+    columns pandas hands to Arrow as null, list, struct and dictionary arrays."""
+    pd = pytest.importorskip("pandas")
+    import tvoronoi
+    from tvoronoi.writers.parts import write_cells_part, write_part
+
+    d = tvoronoi.voronoi(np.array([[0.0, 0], [1, 0], [0, 1], [1, 1]]), bbox=(-1, -1, 2, 2))
+    rows = np.arange(4)
+    frame = pd.DataFrame(
+        {
+            "site": rows,
+            "none": [None] * 4,
+            "ids": [[1, 2], [3], None, []],
+            "meta": [{"k": 1}, {"k": 2}, None, {"k": 3}],
+            "kind": pd.Categorical(["a", "b", "a", None]),
+        }
+    )
+    direct = write_cells_part(frame, d, rows, tmp_path, "part-direct")
+    shapes = write_part(frame, d.to_shapely(), tmp_path, "part-shapes", "parquet")
+    for name in (direct, shapes):
+        got = pq.read_table(tmp_path / name).drop_columns(["geometry", "bbox"])
+        assert got.schema.field("none").type == pa.null()
+        assert got.to_pydict() == {
+            "site": [0, 1, 2, 3],
+            "none": [None] * 4,
+            "ids": [[1, 2], [3], None, []],
+            "meta": [{"k": 1}, {"k": 2}, None, {"k": 3}],
+            "kind": ["a", "b", "a", None],
+        }
+
+
+def test_a_property_of_mixed_types_is_text_that_agrees_with_geojson(tmp_path):
+    """A GeoJSON property whose values mix types is a GeoParquet string column: each string as it
+    is ("01" stays "01", not '"01"'), each other value the JSON text the GeoJSON output holds."""
+    import orjson
+
+    values = [1, "01", 2.5, None, [1, "x"], {"k": 'say "hi"'}, True, 'a "quoted", word']
+    doc = {
+        "type": "FeatureCollection",
+        "features": [
+            {"type": "Feature", "geometry": {"type": "Point", "coordinates": [i % 3, i // 3]}, "properties": {"a": v}}
+            for i, v in enumerate(values)
+        ],
+    }
+    (tmp_path / "mixed.geojson").write_text(json.dumps(doc))
+    assert run(tmp_path / "mixed.geojson", "-o", tmp_path / "c.parquet") == 0
+    assert run(tmp_path / "mixed.geojson", "-o", tmp_path / "c.geojson") == 0
+    column = pq.read_table(tmp_path / "c.parquet")["a"]
+    assert column.type == pa.string()
+    assert column.to_pylist()[:4] == ["1", "01", "2.5", None]
+    written = [p["a"] for p in _features(tmp_path / "c.geojson")]
+    assert written == values
+    assert column.to_pylist() == [v if v is None or isinstance(v, str) else orjson.dumps(v).decode() for v in written]

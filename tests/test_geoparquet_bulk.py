@@ -125,7 +125,8 @@ def test_extent_of_cells_some_of_which_miss_the_box():
         [0.5, float("nan"), None, -0.0, float("inf")],
         [1, 2.5],  # mixed: pyarrow's own inference
         [True, False, None],
-        ["a", 1],  # mixed types: JSON text
+        ["a", 1],  # mixed types: text, a string as it is, a number its JSON text
+        ["01", None, 2.5, [1, "x"], {"k": "v"}, True, 'say "hi"'],
         [],
     ],
 )
@@ -134,7 +135,7 @@ def test_number_columns_as_pyarrow_makes_them(values):
     try:
         theirs = pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
-        theirs = pa.array([None if v is None else json_text(v) for v in values], pa.string())
+        theirs = pa.array([v if v is None or isinstance(v, str) else json_text(v) for v in values], pa.string())
     assert ours.type == theirs.type
     assert ours.null_count == theirs.null_count
     assert ours.to_pylist() == theirs.to_pylist() or _same_with_nan(ours.to_pylist(), theirs.to_pylist())
@@ -219,3 +220,38 @@ def test_column_options_reach_every_column(tmp_path):
     assert "RLE_DICTIONARY" in chunks["kind"].encodings
     assert "RLE_DICTIONARY" not in chunks["name"].encodings
     assert pq.read_table(tmp_path / "c.parquet")["name"].to_pylist()[:2] == ["site 0", "site 1"]
+
+
+def test_column_options_reach_the_leaves_of_nested_properties(tmp_path):
+    """A property of lists, structs or maps is stored as Parquet columns of its leaves: the
+    dictionary goes to each leaf whose values repeat, statistics to every leaf; an all-null
+    property and a dictionary array are written too (Arrow counts neither's distinct values)."""
+    import pyarrow.parquet as pq
+
+    n = 64
+    columns = {
+        "site": pa.array(range(n), pa.int64()),
+        "tags": pa.array([["a", "b"][: i % 3] for i in range(n)]),
+        "meta": pa.array([{"k": i % 2, "name": f"n{i}"} for i in range(n)]),
+        "pairs": pa.array([[("k", i)] for i in range(n)], pa.map_(pa.string(), pa.int64())),
+        "none": pa.nulls(n),
+        "kind": pa.array(["x", "y"] * (n // 2)).dictionary_encode(),
+        "duplicates": pa.nulls(n, pa.list_(pa.int64())),
+    }
+    table = pa.table(columns)
+    geoparquet.write_table(pa, table, str(tmp_path / "t.parquet"), overwrite=False)
+    group = pq.read_metadata(tmp_path / "t.parquet").row_group(0)
+    chunks = {group.column(k).path_in_schema: group.column(k) for k in range(group.num_columns)}
+    assert list(chunks) == geoparquet._leaf_paths(table.schema)
+    repeating = {"tags.list.element", "meta.k", "pairs.key_value.key", "kind"}
+    for path, chunk in chunks.items():
+        assert ("RLE_DICTIONARY" in chunk.encodings) == (path in repeating), path
+        assert chunk.is_stats_set or path == "none", path
+    assert pq.read_table(tmp_path / "t.parquet").equals(table.cast(pq.read_schema(tmp_path / "t.parquet")))
+
+
+def test_a_mixed_value_without_json_form_is_named():
+    from tvoronoi.errors import TvoronoiError
+
+    with pytest.raises(TvoronoiError, match="tag: the value <object"):
+        geoparquet._typed_column(pa, [1, object()], "tag")

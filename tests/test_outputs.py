@@ -95,6 +95,33 @@ def test_a_symbolic_link_keeps_pointing_to_its_replaced_target(tmp_path, points,
     assert target.read_bytes().count(b'"type":"Feature"') == 5
 
 
+def test_a_dangling_symbolic_link_is_written_through_without_force(tmp_path, points, capsys):
+    """A link whose target is missing is no existing output: the target is created, the link kept
+    (through a chain of links too); once the target exists, the link needs --force again."""
+    (tmp_path / "tgt").mkdir()
+    link = tmp_path / "link.geojson"
+    link.symlink_to("tgt/real.geojson")
+    chain = tmp_path / "chain.geojson"
+    chain.symlink_to("link2.geojson")
+    (tmp_path / "link2.geojson").symlink_to("tgt/other.geojson")
+    for name, target in ((link, "real.geojson"), (chain, "other.geojson")):
+        assert cli.main(["batch", str(points), "-o", str(name), "-q"]) == 0
+        assert name.is_symlink() and (tmp_path / "link2.geojson").is_symlink()
+        assert (tmp_path / "tgt" / target).read_bytes().count(b'"type":"Feature"') == 5
+        assert cli.main(["batch", str(points), "-o", str(name), "-q"]) == 2  # exists now
+    assert "exists: add --force" in capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "tgt").iterdir()) == ["other.geojson", "real.geojson"]
+
+
+def test_a_symbolic_link_loop_is_not_replaced(tmp_path, points, capsys):
+    (tmp_path / "a.geojson").symlink_to("b.geojson")
+    (tmp_path / "b.geojson").symlink_to("a.geojson")
+    for force in ([], ["--force"]):
+        assert cli.main(["batch", str(points), "-o", str(tmp_path / "a.geojson"), "-q", *force]) != 0
+        assert os.readlink(tmp_path / "a.geojson") == "b.geojson" and os.readlink(tmp_path / "b.geojson") == "a.geojson"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.geojson", "b.geojson", "p.csv"]
+
+
 def test_stdout_dash(points, capsysbinary):
     assert cli.main(["batch", str(points), "-o", "-", "-q"]) == 0
     assert capsysbinary.readouterr().out.count(b'"type":"Feature"') == 5

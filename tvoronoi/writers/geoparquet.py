@@ -128,8 +128,9 @@ def projjson(crs) -> dict | None:
         raise TvoronoiError(f"{crs}: not a CRS pyproj knows ({e}); give one like EPSG:3857") from None
 
 
-def _typed_column(pa, values: list):
-    """An Arrow array of one property: its own type when the values share one, else JSON text."""
+def _typed_column(pa, values: list, name: str = "a property"):
+    """An Arrow array of one property: its own type when the values share one, else text (see
+    :func:`_mixed_column`)."""
     if isinstance(values, TextColumn):
         return values.to_arrow()
     numbers = _number_column(pa, values)
@@ -138,9 +139,30 @@ def _typed_column(pa, values: list):
     try:
         return pa.array(values)
     except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError):
-        import orjson
+        return _mixed_column(pa, values, name)
 
-        return pa.array([None if v is None else orjson.dumps(v).decode() for v in values], pa.string())
+
+def _mixed_column(pa, values: list, name: str = "a property"):
+    """A string array of a property whose values mix types (``1``, ``"01"``, ``2.5``): a string
+    as it is (``"01"``, never ``'"01"'``), any other value as the JSON text the GeoJSON output
+    writes for it (``"1"``, ``"2.5"``, ``"[1,2]"``), null for None.
+
+    Raises
+    ------
+    TvoronoiError
+        A value has no JSON form.
+    """
+    import orjson
+
+    out = []
+    for v in values:
+        if v is not None and not isinstance(v, str):
+            try:
+                v = orjson.dumps(v, option=orjson.OPT_SERIALIZE_NUMPY).decode()
+            except orjson.JSONEncodeError as e:
+                raise TvoronoiError(f"{name}: the value {v!r} cannot be written as JSON text ({e})") from None
+        out.append(v)
+    return pa.array(out, pa.string())
 
 
 def _number_column(pa, values: list):
@@ -357,7 +379,8 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
     """Write the Voronoi cells as GeoParquet 1.1: one row per distinct site, in input order.
 
     Columns: ``site`` (int64, the 0-based input row), the site's properties as
-    typed Arrow columns (a property whose values mix types is JSON text),
+    typed Arrow columns (a property whose values mix types is text: strings as they
+    are, other values their JSON text),
     ``duplicates`` (list of later rows at the same place, null where none),
     ``geometry`` (WKB Polygon, null for a cell that misses the box) and ``bbox``
     (struct xmin, ymin, xmax, ymax: the covering columns of GeoParquet 1.1).
@@ -400,7 +423,7 @@ def write_cells_parquet(diagram, points, out, *, overwrite: bool = True, crs=Non
                 values = points.columns[name]
                 if len(kept) < n_sites:
                     values = [values[i] for i in kept.tolist()]
-            columns[renames.get(name, name)] = _typed_column(pa, values)
+            columns[renames.get(name, name)] = _typed_column(pa, values, name)
     columns["duplicates"] = _duplicates_column(pa, diagram, kept)
     if getattr(diagram, "clipped", None) is not None:
         # cut to a clip region: Polygons with holes and MultiPolygons, written by shapely
@@ -470,19 +493,27 @@ def _parquet_options(schema, columns: dict | None = None, *, compress_bbox: bool
     zstd, at level 1 (at the default level compressing takes twice as long for a file a few
     percent smaller), the geometry at GEOMETRY_ZSTD_LEVEL; the bbox columns uncompressed
     unless ``compress_bbox`` (the bounds of Voronoi cells shrink by 6%, for 0.07 s at 10^6
-    cells; those of triangles, which share their corners, by 40%). Dictionaries for the properties whose values repeat
+    cells; those of triangles, which share their corners, by 40%). Dictionaries for the
+    Parquet columns of the properties (a nested property's leaves) whose values repeat
     (``columns``: the property arrays, a sample of each looked at; without them, every
     property): a column of distinct names would fill a dictionary in every row group only to
     fall back. Statistics for every column but the geometry (the bbox columns' let a reader
     skip row groups). The site numbers delta-encoded.
     """
     own = {"site", "duplicates", "geometry", "bbox", "sites"}
-    properties = [name for name in schema.names if name not in own]
-    if columns is not None:
-        properties = [name for name in properties if _repeats(columns[name])]
-    statistics = [name for name in schema.names if name not in ("geometry", "bbox")]
+    properties = [field for field in schema if field.name not in own]
+    if columns is None:
+        dictionary = [path for field in properties for path, _ in _leaves(field.name, field.type)]
+    else:
+        dictionary = [
+            path
+            for field in properties
+            for path, values in _leaves(field.name, field.type, _sample(columns[field.name]))
+            if _repeats(values)
+        ]
+    # the options name Parquet's column paths: a nested column's are its leaves' ("duplicates.list.element")
+    statistics = [path for path in _leaf_paths(schema) if path != "geometry"]
     bbox = [f"bbox.{k}" for k in ("xmin", "ymin", "xmax", "ymax")] if "bbox" in schema.names else []
-    statistics += bbox
     plain = [] if compress_bbox else bbox
     compressed = [path for path in _leaf_paths(schema) if path not in plain]
     options: dict = {}
@@ -494,7 +525,7 @@ def _parquet_options(schema, columns: dict | None = None, *, compress_bbox: bool
         options,
         compression={**{path: "zstd" for path in compressed}, **{path: "none" for path in plain}},
         compression_level={name: GEOMETRY_ZSTD_LEVEL if name == "geometry" else 1 for name in compressed},
-        use_dictionary=properties or False,
+        use_dictionary=dictionary or False,
         write_statistics=statistics,
     )
 
@@ -502,28 +533,65 @@ def _parquet_options(schema, columns: dict | None = None, *, compress_bbox: bool
 def _leaf_paths(schema) -> list[str]:
     """The Parquet column paths of an Arrow schema's fields, as per-column options name them
     ("bbox.xmin", "duplicates.list.element")."""
+    return [path for field in schema for path, _ in _leaves(field.name, field.type)]
 
+
+def _leaves(name: str, kind, values=None) -> list:
+    """The Parquet column paths of a field (its name and Arrow type), each with its values in
+    ``values`` (an Arrow array of the field, or None): [(path, values or None)]. A list's
+    leaves are its elements', a map's its keys' and values', a struct's its fields'."""
     import pyarrow.types as pt
 
-    def paths(name: str, kind) -> list[str]:
-        if pt.is_list(kind) or pt.is_large_list(kind) or pt.is_fixed_size_list(kind):
-            return paths(f"{name}.list.element", kind.value_type)
-        if pt.is_struct(kind):
-            return [
-                p for k in range(kind.num_fields) for p in paths(f"{name}.{kind.field(k).name}", kind.field(k).type)
-            ]
-        return [name]
+    if pt.is_map(kind):
+        keys = items = None
+        if values is not None:
+            # the entries of the rows of ``values`` (``keys`` and ``items`` are the whole array's)
+            start, stop = values.offsets[0].as_py(), values.offsets[-1].as_py()
+            keys, items = values.keys.slice(start, stop - start), values.items.slice(start, stop - start)
+        return [
+            *_leaves(f"{name}.key_value.key", kind.key_type, keys),
+            *_leaves(f"{name}.key_value.value", kind.item_type, items),
+        ]
+    if pt.is_list(kind) or pt.is_large_list(kind) or pt.is_fixed_size_list(kind):
+        return _leaves(f"{name}.list.element", kind.value_type, None if values is None else values.flatten())
+    if pt.is_struct(kind):
+        fields = [None] * kind.num_fields if values is None else values.flatten()
+        return [
+            leaf
+            for k in range(kind.num_fields)
+            for leaf in _leaves(f"{name}.{kind.field(k).name}", kind.field(k).type, fields[k])
+        ]
+    return [(name, values)]
 
-    return [path for field in schema for path in paths(field.name, field.type)]
+
+def _sample(values):
+    """The first DICTIONARY_SAMPLE values of a column (an Arrow array or chunked array) as one array."""
+    import pyarrow as pa
+
+    sample = values.slice(0, DICTIONARY_SAMPLE)
+    return sample.combine_chunks() if isinstance(sample, pa.ChunkedArray) else sample
 
 
 def _repeats(values) -> bool:
-    """Whether the values of a property repeat enough for a dictionary: at most half of the first
-    DICTIONARY_SAMPLE are distinct."""
-    import pyarrow.compute as pc
+    """Whether the values of a Parquet column (an array of one leaf of a property, from
+    :func:`_sample`) repeat enough for a dictionary: at most half of them are distinct.
 
-    sample = values.slice(0, DICTIONARY_SAMPLE)
-    return 2 * pc.count_distinct(sample, mode="all").as_py() <= max(len(sample), 1)
+    Values of no type to count (all null: nothing to look up; a type Arrow cannot count) are
+    written plain, as they always can be; a dictionary array's indices are counted.
+    """
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.types as pt
+
+    if pt.is_null(values.type):
+        return False
+    if pt.is_dictionary(values.type):
+        values = values.indices
+    try:
+        distinct = pc.count_distinct(values, mode="all").as_py()
+    except pa.ArrowNotImplementedError:
+        return False
+    return 2 * distinct <= max(len(values), 1)
 
 
 def _BBOX_TYPE(pa):

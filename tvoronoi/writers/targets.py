@@ -46,10 +46,10 @@ class AtomicFile:
     ----------
     path : str or os.PathLike
         The target. A symbolic link is followed: the file it points to is
-        replaced and the link keeps pointing to it.
+        replaced, or created when it is missing, and the link keeps pointing to it.
     overwrite : bool
         Replace an existing target; if False, ``FileExistsError`` is raised when the
-        target exists, on opening and again just before the rename.
+        target (what a link points to) exists, on opening and again just before the rename.
 
     Raises
     ------
@@ -82,7 +82,9 @@ class AtomicFile:
     def _check_target(self) -> None:
         if os.path.isdir(self.target):
             raise IsADirectoryError(errno.EISDIR, "is a directory", self.path)
-        if not self.overwrite and os.path.lexists(self.path):
+        # what a link leads to: a link whose target is missing is no existing output (its target
+        # is written, the link kept); one in a loop leads to a link, which exists
+        if not self.overwrite and os.path.lexists(self.target):
             raise FileExistsError(errno.EEXIST, "file exists", self.path)
         try:
             mode = os.stat(self.target).st_mode
