@@ -49,7 +49,10 @@ output:
   region covers get cells, which tile the region; a site outside it is
   written with "geometry": null (a warning gives their count). --lloyd N
   first moves every site N times to the centroid of its cell (within the
-  box, or the clip region) and writes the cells of the moved sites.
+  box, or the clip region) and writes the cells of the moved sites; a
+  centroid outside its cell (in a hole or notch of the region) gives way
+  to the cell's nearest point, just inside: no site leaves the region, and
+  the sites outside it stay where they are.
 
   --dask local[:WORKERS] or --dask tcp://HOST:PORT builds the cells tile by
   tile on a Dask cluster (pip install 'tvoronoi[dask]'), the same cells bit
@@ -166,7 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--lloyd",
         type=int,
         metavar="N",
-        help="Lloyd relaxation: move each site to its cell's centroid N times, then write the cells",
+        help="Lloyd relaxation: move each site to its cell's centroid N times (kept inside the --clip region), "
+        "then write the cells",
     )
     batch.add_argument(
         "--delaunay",
