@@ -472,3 +472,12 @@ def test_tvoronoi_file_opens_the_ui_on_that_file(monkeypatch, tmp_path, capsys):
     code = cli.main([str(tmp_path / "nope.csv")])
     assert code != 0 and seen == [str(src), None]
     assert "nope.csv: no such file" in capsys.readouterr().err
+
+
+def test_a_usage_error_names_the_batch_command_alone(capsys, tmp_path, points_csv):
+    """argparse's message for a bad option of batch: 'tvoronoi batch', not the main usage line pasted in."""
+    status, _, err = run(capsys, "batch", points_csv, "-o", tmp_path / "c.geojson", "--to", "gpkg")
+    assert status == 2
+    assert err.startswith("usage: tvoronoi batch [-h]")
+    assert "tvoronoi batch: error: argument --to: invalid choice: 'gpkg'" in err
+    assert "FILE |" not in err

@@ -462,3 +462,51 @@ def test_a_property_of_mixed_types_is_text_that_agrees_with_geojson(tmp_path):
     written = [p["a"] for p in _features(tmp_path / "c.geojson")]
     assert written == values
     assert column.to_pylist() == [v if v is None or isinstance(v, str) else orjson.dumps(v).decode() for v in written]
+
+
+def test_crs_option_over_the_file_s_own_crs_warns(tmp_path, capsys):
+    doc = {
+        "type": "FeatureCollection",
+        "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3035"}},
+        "features": [
+            {"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": c}}
+            for c in ([0, 0], [10, 0], [0, 10])
+        ],
+    }
+    path = tmp_path / "p.geojson"
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "c.parquet"
+    assert cli.main(["batch", str(path), "-o", str(out), "--crs", "EPSG:3857"]) == 0
+    err = capsys.readouterr().err
+    assert "--crs EPSG:3857 replaces" in err and "EPSG:3035" in err and "not transformed" in err
+    crs = json.loads(pq.read_table(out).schema.metadata[b"geo"])["columns"]["geometry"]["crs"]
+    assert crs["id"]["code"] in (3857, "3857")
+    # the same CRS given again: nothing to say
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "d.parquet"), "--crs", "EPSG:3035"]) == 0
+    assert "replaces" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("suffix", "separator"), [(".geojsonl", b""), (".geojsons", b"\x1e"), (".json", b"")])
+def test_geojson_sequences_are_read(tmp_path, capsys, suffix, separator):
+    """Point features one a line (GDAL's GeoJSONSeq, jq's output) or after RS (RFC 8142), by extension
+    or found in a .json file: the same sites and properties as the FeatureCollection."""
+    sites = DATASETS["uniform"][:40]
+    features = [
+        {"type": "Feature", "properties": {"k": i}, "geometry": {"type": "Point", "coordinates": [x, y]}}
+        for i, (x, y) in enumerate(sites.tolist())
+    ]
+    path = tmp_path / f"p{suffix}"
+    path.write_bytes(b"".join(separator + json.dumps(f).encode() + b"\n" for f in features))
+    whole = tmp_path / "whole.geojson"
+    whole.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "a.geojson"), "-q"]) == 0
+    assert cli.main(["batch", str(whole), "-o", str(tmp_path / "b.geojson"), "-q"]) == 0
+    assert (tmp_path / "a.geojson").read_bytes() == (tmp_path / "b.geojson").read_bytes()
+
+
+def test_a_broken_line_of_a_geojson_sequence_is_named(tmp_path, capsys):
+    path = tmp_path / "p.geojsonl"
+    good = json.dumps({"type": "Feature", "properties": {}, "geometry": {"type": "Point", "coordinates": [0, 1]}})
+    path.write_text(f"{good}\n{good}\n{{broken\n")
+    assert cli.main(["batch", str(path), "-o", str(tmp_path / "c.geojson")]) == 2
+    assert "p.geojsonl, line 3: broken JSON" in capsys.readouterr().err

@@ -137,6 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     batch = commands.add_parser(
         "batch",
+        prog=f"{PROG} batch",  # (argparse would prefix the main parser's whole usage line)
         help="write the Voronoi cells of a point file as GeoJSON or GeoParquet",
         description="Read points, build their Voronoi diagram clipped to a box, and write the cells as GeoJSON, "
         "a GeoJSON sequence or GeoParquet.",
@@ -205,7 +206,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--precision",
         type=int,
         metavar="N",
-        help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles)",
+        help="GeoJSON: round coordinates to N decimal digits (default: the exact doubles, valid cells; "
+        "rounding coarser than the cells' detail can make rings touch or cross)",
     )
     batch.add_argument(
         "--crs",
@@ -379,6 +381,11 @@ def _batch_run(args, phases: Phases) -> int:
         if points.choice is not None and not args.quiet:
             phases.note(f"{points.source}: {points.choice}")
         crs = args.crs or points.crs or (CRS84 if points.lonlat else None)
+        if args.crs and points.crs and crs_name(points.crs) != crs_name(args.crs) and not args.quiet:
+            phases.warn(
+                f"--crs {args.crs} replaces {points.source}'s own CRS {crs_name(points.crs)}; the coordinates "
+                "are labelled, not transformed (drop --crs to keep the file's)"
+            )
         lonlat = crs is not None and crs_name(crs) in ("OGC:CRS84", "EPSG:4326")
         if "parquet" in formats.values():
             projjson(crs)  # a CRS pyproj does not know fails here, before the build

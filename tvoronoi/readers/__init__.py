@@ -34,6 +34,11 @@ EXTENSIONS = {
     ".pts": "text",
     ".geojson": "geojson",
     ".json": "geojson",
+    ".geojsons": "geojson",  # GeoJSON sequences (RFC 8142), as tvoronoi writes them
+    ".geojsonseq": "geojson",
+    ".geojsonl": "geojson",
+    ".jsonl": "geojson",
+    ".ndjson": "geojson",
     ".npy": "npy",
     ".parquet": "parquet",
     ".geoparquet": "parquet",
@@ -262,15 +267,46 @@ def _loads_json(data: bytes, source: str):
     """Parse a JSON file (UTF-8, with or without BOM)."""
     if data.startswith(codecs.BOM_UTF8):
         data = data[len(codecs.BOM_UTF8) :]
+    if data.lstrip(b" \t\r\n")[:1] == RECORD_SEPARATOR:
+        return _loads_json_sequence(data, source)
     try:
         return orjson.loads(data)
     except orjson.JSONDecodeError as e:
+        if e.msg == "unexpected content after document" and b"\n" in data[: e.pos]:
+            # one document a line: GeoJSONSeq (.geojsonl, as tvoronoi and GDAL write it)
+            return _loads_json_sequence(data, source)
         raise InputFileError(
             f"{source}, line {e.lineno}, column {e.colno}: broken JSON: {e.msg}; fix the file there"
         ) from None
     except UnicodeDecodeError as e:
         line = _line_of(data, e.start)
         raise InputFileError(f"{source}, line {line}: the file is not UTF-8; save it as UTF-8") from None
+
+
+RECORD_SEPARATOR = b"\x1e"
+
+
+def _loads_json_sequence(data: bytes, source: str) -> dict:
+    """A GeoJSON text sequence (RFC 8142: RS before each text, or one text a line) as one
+    FeatureCollection of its features; a FeatureCollection in the sequence gives its features."""
+    features: list = []
+    for number, line in enumerate(data.split(b"\n"), start=1):
+        for text in line.split(RECORD_SEPARATOR):
+            if not text.strip():
+                continue
+            try:
+                doc = orjson.loads(text)
+            except orjson.JSONDecodeError as e:
+                raise InputFileError(
+                    f"{source}, line {number}: broken JSON in a GeoJSON sequence: {e.msg}; fix the file there"
+                ) from None
+            except UnicodeDecodeError:
+                raise InputFileError(f"{source}, line {number}: the file is not UTF-8; save it as UTF-8") from None
+            if type(doc) is dict and doc.get("type") == "FeatureCollection" and type(doc.get("features")) is list:
+                features.extend(doc["features"])
+            else:
+                features.append(doc)
+    return {"type": "FeatureCollection", "features": features}
 
 
 def _line_of(data: bytes, offset: int) -> int:
