@@ -361,3 +361,14 @@ def test_a_cells_cut_depends_on_it_and_the_region_alone(rng, spikes):
     ):
         sub, _ = cut_polygons(cells[part], region)
         assert (shapely.to_wkb(sub) == shapely.to_wkb(whole[part])).all()
+
+
+def test_a_geoseries_or_geodataframe_clips_as_the_union_of_its_geometries(rng):
+    geopandas = pytest.importorskip("geopandas")
+    parts = [shapely.box(0, 0, 1, 1), shapely.box(1, 0, 2, 1), shapely.box(3, 3, 4, 4)]
+    pts = rng.random((300, 2)) * 4
+    union = shapely.union_all(parts)
+    want = tvoronoi.voronoi(pts, clip=union).to_shapely()
+    for clip in (geopandas.GeoSeries(parts), geopandas.GeoDataFrame(geometry=parts)):
+        got = tvoronoi.voronoi(pts, clip=clip).to_shapely()
+        assert [None if g is None else g.wkb for g in got] == [None if g is None else g.wkb for g in want]

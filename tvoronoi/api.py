@@ -217,7 +217,7 @@ def voronoi(
         with conflict lists.
     seed : int
         Seed of the random insertion order.
-    clip : shapely Polygon or MultiPolygon, optional
+    clip : shapely Polygon or MultiPolygon, or a GeoSeries / GeoDataFrame (their union), optional
         A region (concave, with holes, in several parts): the diagram is
         that of the points the region covers, each cell cut to the region,
         so that the cells tile it. Points outside get no cell (None in

@@ -88,7 +88,8 @@ class ClippedDiagram(Diagram):
 
 
 def as_region(clip, *, what: str = "clip"):
-    """Check a clip region: a non-empty, valid shapely Polygon or MultiPolygon with finite coordinates.
+    """Check a clip region: a non-empty, valid shapely Polygon or MultiPolygon with finite coordinates
+    (a GeoSeries or GeoDataFrame stands for the union of its geometries).
 
     Raises
     ------
@@ -97,6 +98,9 @@ def as_region(clip, *, what: str = "clip"):
     """
     import shapely
 
+    if type(clip).__name__ in ("GeoSeries", "GeoDataFrame") and hasattr(clip, "union_all"):
+        # geopandas: read_file(...) gives a frame; its union is the region
+        clip = clip.union_all()
     if not isinstance(clip, (shapely.Polygon, shapely.MultiPolygon)):
         raise TvoronoiError(f"{what} must be a shapely Polygon or MultiPolygon, got {type(clip).__name__}")
     if clip.is_empty:
