@@ -6,7 +6,7 @@ Times whole processes (start-up included) and their peak memory, for
   pandas.read_csv -> shapely.voronoi_polygons -> geopandas.to_file (GeoJSON), the usual pipeline
 on the same file of n points (x, y and two text columns).
 
-    python benchmarks/batch.py --n 1M --out benchmarks/results/batch
+    python benchmarks/batch.py --n 1M --out benchmarks/results
     python benchmarks/batch.py --n 1M --before /tmp/old --before-label 'before, fbb596b'
 
 --before DIR runs an older checkout's package as well (``git archive REV tvoronoi | tar -x -C DIR``,
