@@ -360,3 +360,20 @@ def test_dataframe_points_column_errors_name_column_and_row(bad, words):
         tvoronoi.voronoi(frame)
     for word in words:
         assert word in str(info.value)
+
+
+def test_a_geoseries_crs_reaches_the_cells():
+    geopandas = pytest.importorskip("geopandas")
+    rng = np.random.default_rng(31)
+    xy = rng.random((200, 2)) * 1000
+    series = geopandas.GeoSeries(shapely.points(xy), crs="EPSG:3035")
+    d = tvoronoi.voronoi(series)
+    assert d.crs == series.crs
+    assert d.to_geopandas().crs == series.crs
+    assert d.to_geopandas(crs="EPSG:3857").crs == "EPSG:3857"  # given: it wins
+    frame = geopandas.GeoDataFrame({"v": np.arange(200)}, geometry=series)
+    clipped = tvoronoi.voronoi(frame, clip=shapely.box(100, 100, 900, 900))
+    assert clipped.to_geopandas().crs == series.crs
+    assert tvoronoi.voronoi(xy).crs is None and tvoronoi.voronoi(xy).to_geopandas().crs is None
+    # the same cells either way
+    assert np.array_equal(d.cell_vertices, tvoronoi.voronoi(xy).cell_vertices)

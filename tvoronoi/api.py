@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 
@@ -10,7 +11,7 @@ import numpy as np
 from tvoronoi.diagram import Diagram
 from tvoronoi.engines import scale_exponent
 from tvoronoi.errors import CoordinateRangeError, EngineError, TvoronoiError
-from tvoronoi.point_input import explain_failure, foreign_points
+from tvoronoi.point_input import crs_of, explain_failure, foreign_points
 
 ENGINES = ("incremental", "fortune")
 INSERTION_ORDERS = ("brio", "random")
@@ -255,15 +256,18 @@ def voronoi(
 
             region = as_region(clip)
             box = region_box(region) if bbox is None else as_bbox(bbox)
-            return clip_to_region(
+            d: Diagram = clip_to_region(
                 pts,
                 region,
                 lambda inside: build_diagram(
                     inside, box, engine=engine, insertion=insertion, seed=seed, threads=threads
                 ),
             )
-        box = default_bbox(pts) if bbox is None else as_bbox(bbox)
-        return build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
+        else:
+            box = default_bbox(pts) if bbox is None else as_bbox(bbox)
+            d = build_diagram(pts, box, engine=engine, insertion=insertion, seed=seed, threads=threads)
+    crs = crs_of(points)
+    return d if crs is None else dataclasses.replace(d, crs=crs)
 
 
 def as_threads(threads) -> int:

@@ -45,6 +45,9 @@ class Diagram:
         ``cell_points[cell_vertices[cell_offsets[i]:cell_offsets[i + 1]]]``.
     engine : str
         The engine that built the diagram.
+    crs : optional
+        The coordinates' CRS when the input carried one (a GeoSeries or GeoDataFrame with a ``crs``), as
+        it gave it; None otherwise. :meth:`to_geopandas` uses it unless given another.
     """
 
     sites: np.ndarray
@@ -60,6 +63,7 @@ class Diagram:
     cell_offsets: np.ndarray
     cell_vertices: np.ndarray
     engine: str = "incremental"
+    crs: object = None
 
     @cached_property
     def he_next(self) -> np.ndarray:
@@ -170,7 +174,8 @@ class Diagram:
         properties : mapping or DataFrame, optional
             Columns to carry, one value per input point, taken by position.
         crs : optional
-            The coordinates' CRS, in any form geopandas accepts ("EPSG:4326").
+            The coordinates' CRS, in any form geopandas accepts ("EPSG:4326"); by default the
+            input's (``self.crs``).
 
         Returns
         -------
@@ -187,7 +192,7 @@ class Diagram:
         """
         from tvoronoi.shapes import cells_frame
 
-        return cells_frame(self, properties, crs)
+        return cells_frame(self, properties, self.crs if crs is None else crs)
 
     @cached_property
     def _locator(self):

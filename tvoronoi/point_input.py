@@ -77,6 +77,11 @@ def foreign_points(points):
     return None
 
 
+def crs_of(points):
+    """The CRS a geopandas GeoSeries or GeoDataFrame carries (None for it without one, or for anything else)."""
+    return getattr(points, "crs", None) if _is_geopandas(points) else None
+
+
 def explain_failure(points) -> str | None:
     """Why a sequence that numpy could not read as numbers failed, when a shapely geometry is in it."""
     if not isinstance(points, (list, tuple)):
