@@ -965,6 +965,22 @@ def test_semicolon_csv_with_decimal_commas(tmp_path):
     assert points.properties(1) == {"Name": "B", "Pop": 2000}
 
 
+@pytest.mark.parametrize("rows", [50, 5000])  # the row walk, and the bulk readers
+def test_semicolon_csv_properties_with_decimal_commas_are_numbers(tmp_path, rows):
+    body = "".join(f"P{i};{i},5;2,25;{i % 7},{i % 10};{i};{i},{i}x;0{i % 3}\n" for i in range(rows))
+    points = read(tmp_path, "p.csv", "Name;X;Y;Area;Pop;Code;Zip\n" + body + "Q;1;2;;7;a;\n")
+    area = [points.properties(i)["Area"] for i in range(rows + 1)]
+    assert area[:rows] == [float(f"{i % 7}.{i % 10}") for i in range(rows)] and area[rows] is None
+    assert [points.properties(i)["Pop"] for i in range(3)] == [0, 1, 2]  # integers stay integers
+    assert points.properties(1)["Code"] == "1,1x"  # not a number: text as written
+    assert points.properties(1)["Zip"] == "01"  # leading zeros: text as written
+
+
+def test_comma_csv_keeps_a_quoted_decimal_comma_as_text(tmp_path):
+    points = read(tmp_path, "p.csv", 'x,y,area\n1,2,"3,5"\n3,4,"4,5"\n')
+    assert points.properties(0)["area"] == "3,5"
+
+
 def test_semicolon_csv_bad_value_is_named_as_written(tmp_path):
     message = error(tmp_path, "p.csv", "x;y\n1,5;2\n1,5,3;4\n")
     assert 'line 3: "1,5,3" in column "x" is not a number' in message

@@ -31,6 +31,7 @@ from .columns import (
     resolve_column,
 )
 from .pointset import PointSet, convert_column
+from .text_column import TextColumn
 
 LAYOUT_CHARS = 1 << 16
 # a table text up to this size is kept to name the line of a site in a later message
@@ -96,6 +97,8 @@ def read_table(
         points.where = _fast_lines(text, offset, source, kind, layout, len(points))
     if points.where is not None:
         points.where = _line_label(points.where)
+    if layout.delimiter == ";":
+        _decimal_comma_columns(points.columns)
     names = [name.strip().lower() for name in (layout.names[layout.ix], layout.names[layout.iy])]
     points.lonlat = layout.has_header and names[0] in LON_NAMES and names[1] in LAT_NAMES
     points.choice = layout.choice
@@ -204,6 +207,21 @@ def _is_number(s: str) -> bool:
 def _is_decimal_comma_number(s: str) -> bool:
     """A number with a decimal point or (spreadsheets' semicolon CSV) a decimal comma."""
     return _is_number(s) or (s.count(",") == 1 and _is_number(s.replace(",", ".")))
+
+
+def _decimal_comma_columns(columns: dict) -> None:
+    """In a semicolon-separated file, a text column all of whose values are numbers, some written with a
+    decimal comma ("3,5", "4"), becomes a number column (3.5, 4.0), in place: the coordinates of such a
+    file are read so too. (A decimal point stays a decimal point: "1.000" is 1.0, as in any file.)"""
+    for name, column in columns.items():
+        values = column.tolist() if isinstance(column, TextColumn) else column
+        present = [v for v in values if v is not None]
+        if not present or not all(isinstance(v, str) for v in present):
+            continue
+        if not any("," in v for v in present) or not all(_is_decimal_comma_number(v) for v in present):
+            continue
+        numbers = [None if v is None else float(v.replace(",", ".")) for v in values]
+        columns[name] = [v if v is None or math.isfinite(v) else None for v in numbers]
 
 
 def _decimal_points(values, delimiter: str):
