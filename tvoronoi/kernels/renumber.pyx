@@ -58,20 +58,27 @@ cdef inline int32_t first_site(const int32_t* corners, const int32_t* old_to_new
     return low
 
 
+cdef inline int bits_for(Py_ssize_t count) noexcept nogil:
+    # bits per axis of a grid of about one cell per site (4^b >= count), at most MAX_GRID_BITS
+    cdef int b = 0
+    while b < MAX_GRID_BITS and (<Py_ssize_t> 1 << (2 * b)) < count:
+        b += 1
+    return b
+
+
 cdef int z_sort(const double* xs, const double* ys, int32_t* ids, Py_ssize_t count, int depth) noexcept nogil:
     """Sort the sites ids[0:count] stably by the Z-curve index of their cell in a grid of about one cell
     per site over their own bounding box, then each crowded cell again, up to MAX_DEPTH levels (a tight
     cluster beside far sites is ordered inside too). Returns -1 if a grid's scratch could not be
     allocated (the sites of that grid keep their order), else 0: ids is a permutation of itself either way."""
     cdef Py_ssize_t k, lo, hi
-    cdef int b = 0, top, key, status = 0
+    cdef int b, top, key, status = 0
     cdef double xlo, xhi, ylo, yhi, sx, sy, x, y
     cdef Py_ssize_t n_cells
     cdef int32_t* keys
     cdef int32_t* start
     cdef int32_t* out
-    while b < MAX_GRID_BITS and (<Py_ssize_t> 1 << (2 * b)) < count:
-        b += 1
+    b = bits_for(count)
     top = (1 << b) - 1
     n_cells = <Py_ssize_t> 1 << (2 * b)
     xlo = xhi = xs[ids[0]]
@@ -108,6 +115,7 @@ cdef int z_sort(const double* xs, const double* ys, int32_t* ids, Py_ssize_t cou
         out[start[keys[k]]] = ids[k]
         start[keys[k]] += 1
     memcpy(ids, out, count * sizeof(int32_t))
+    free(keys); free(out)   # (only the cells' ends are needed below: the levels under this one hold less)
     # the crowded cells (start[key] is now where cell key ends); the sites at either end of the box
     # fall in different cells, so each is smaller than this one
     if depth + 1 < MAX_DEPTH:
@@ -117,16 +125,13 @@ cdef int z_sort(const double* xs, const double* ys, int32_t* ids, Py_ssize_t cou
             if hi - lo > CROWDED and status == 0:
                 status = z_sort(xs, ys, ids + lo, hi - lo, depth + 1)
             lo = hi
-    free(keys); free(out); free(start)
+    free(start)
     return status
 
 
 def grid_bits(Py_ssize_t n):
-    """Bits per axis of the grid the sites are ordered on: about one site a cell, at most MAX_GRID_BITS."""
-    cdef int b = 0
-    while b < MAX_GRID_BITS and (<Py_ssize_t> 1 << (2 * b)) < n:
-        b += 1
-    return b
+    """Bits per axis of the grid n sites are ordered on: about one site a cell, at most MAX_GRID_BITS."""
+    return bits_for(n)
 
 
 def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
