@@ -169,3 +169,19 @@ def test_changed_lists_the_cells_that_moved(rng):
         same = len(after) == len(before[i]) and np.allclose(after, before[i])
         assert same or i in changed, f"cell {i} changed but is not listed"
     assert 200 in changed and len(changed) < 20
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_a_new_site_out_of_range_is_measured_against_the_diagram(engine):
+    """The range rule for an insert or a move names the diagram's scale, not the new site itself, and
+    nothing changes."""
+    dv = tvoronoi.DynamicVoronoi(uniform(50, seed=3), engine=engine)
+    before = [dv.diagram().cell_polygon(i).tolist() for i in range(50)]
+    for update in (lambda: dv.insert(5e-324, 5e-324), lambda: dv.move(0, 1e-300, 0.5)):
+        with pytest.raises(tvoronoi.TvoronoiError) as caught:
+            update()
+        message = str(caught.value)
+        assert message.startswith("the new site: coordinate ")
+        assert "smaller than the scale of the diagram (about " in message
+        assert "around the scale of the diagram" in message and "(the same point)" not in message
+    assert [dv.diagram().cell_polygon(i).tolist() for i in range(50)] == before

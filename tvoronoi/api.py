@@ -25,8 +25,12 @@ BBOX_MARGIN = 0.10
 RANGE_BITS = 170
 
 
-def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
+def check_range(pts: np.ndarray, e: int, *, what: str = "point", scale_of: str | None = None) -> None:
     """Refuse nonzero coordinates more than 2^170 from the scale 2^e (naming the first row at fault).
+
+    ``what`` names the rows ("point" gives "point 3"; a name starting with "the " names a single one).
+    ``scale_of`` names where the scale comes from when it is not these points' own ("the diagram" for a
+    new site or a query point): the message then measures against it, not against the largest of them.
 
     Raises
     ------
@@ -49,12 +53,18 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point") -> None:
     bad = (pts != 0) & ((mag < low) | (mag > high))
     if bad.any():
         row, col = (int(v) for v in np.argwhere(bad)[0])
-        top_row, top_col = (int(v) for v in np.unravel_index(int(np.argmax(mag)), mag.shape))
+        if scale_of is not None:
+            top_row, top = -1, math.ldexp(1.0, e)
+        else:
+            top_row, top_col = (int(v) for v in np.unravel_index(int(np.argmax(mag)), mag.shape))
+            top = float(pts[top_row, top_col])
         raise CoordinateRangeError(
             rows=(row, top_row),
-            values=(float(pts[row, col]), float(pts[top_row, top_col])),
+            values=(float(pts[row, col]), top),
             small=bool(mag[row, col] < low),
-            locate=lambda i: f"{what} {i}",
+            locate=lambda i: (
+                (what if what.startswith("the ") else f"{what} {i}") if i >= 0 else f"the scale of {scale_of}"
+            ),
         )
 
 

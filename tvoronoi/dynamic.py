@@ -22,7 +22,7 @@ def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
         raise TvoronoiError(f"coordinates must be numbers, got ({x!r}, {y!r})") from None
     if not (math.isfinite(x) and math.isfinite(y)):
         raise TvoronoiError(f"coordinates must be finite, got ({x!r}, {y!r})")
-    check_range(np.array([[x, y]]), e, what="new site")
+    check_range(np.array([[x, y]]), e, what="the new site", scale_of="the diagram")
     return x, y
 
 

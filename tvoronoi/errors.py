@@ -28,12 +28,15 @@ class CoordinateRangeError(TvoronoiError):
     def explain(self, locate) -> str:
         """The message, with ``locate(row)`` naming a row ("point 3", "data.csv, line 5")."""
         (row, top_row), (value, top) = self.rows, self.values
-        if self.small:
+        if self.small and top_row < 0:  # the scale is a diagram's, not these points' (a new site, a query)
+            what = f"over 1e51 times smaller than {locate(top_row)} (about {top:.3g})"
+        elif self.small:
             other = "the same point" if top_row == row else locate(top_row)
             what = f"over 1e51 times smaller than the largest coordinate, {top!r} ({other})"
         else:
             what = "over 1e51 times larger than the diagram's scale"
+        around = locate(top_row) if top_row < 0 else "the largest coordinate"
         return (
             f"{locate(row)}: coordinate {value!r} is {what}: exact arithmetic covers a range of 2^170 "
-            f"(about 1e51) around the largest coordinate; round tiny values to 0, or remove the outlier"
+            f"(about 1e51) around {around}; round tiny values to 0, or remove the outlier"
         )

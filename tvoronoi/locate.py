@@ -72,7 +72,7 @@ class SiteLocator:
             raise TvoronoiError(f"query point {k} is ({q[k, 0]!r}, {q[k, 1]!r}): coordinates must be finite")
         if self.first < 0:
             raise TvoronoiError("the diagram has no sites: there is no nearest site to locate")
-        check_range(q, self.e, what="query point")
+        check_range(q, self.e, what="query point", scale_of="the diagram")
         scaled = np.ldexp(q, -self.e)
         buckets = self._buckets(q)
         # queries in grid order: consecutive walks touch nearby sites (a few times faster on large inputs)
