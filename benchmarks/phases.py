@@ -4,9 +4,10 @@ For each distribution and size, and each engine and thread count, the phases of 
 cells are timed one after the other, in interleaved repeats (the median is reported):
 
   order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
-  tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep)
-  dual      sites and triangles renumbered along a Z-curve, then the Voronoi half-edge structure and
-            its correctly rounded vertices
+  tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep), then for the
+            incremental engine its sites and triangles renumbered along a Z-curve (on two threads the
+            sites' order is made beside the triangulation)
+  dual      the Voronoi half-edge structure and its correctly rounded vertices
   cells     clipping every cell to the box and gathering the cells into input order
 
 and, on the same points, whole calls of other tools: Shewchuk's Triangle (`triangle.voronoi`: vertices
@@ -66,9 +67,8 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         e = engines.scale_exponent(pts)
         s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
         t1 = time.perf_counter()
-        t = engines.triangulate(s, engine=engine)
+        t = build.triangulate_and_lay_out(s, engine=engine, insertion="brio", threads=threads)
         t2 = time.perf_counter()
-        t = engines.spatial(t, threads)
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t
         t3 = time.perf_counter()

@@ -179,3 +179,30 @@ def test_builds_renumber_the_incremental_engine_only():
     assert engines.spatial(fort) is fort
     r = engines.spatial(inc)
     assert r is not inc and np.array_equal(r.sites.perm, engines.renumbered(inc).sites.perm)
+
+
+def test_a_layout_made_beforehand_gives_the_same_triangulation():
+    """build.triangulate_and_lay_out makes the sites' order while the triangulation runs: the same result."""
+    pts = generate("clustered", 5_000, seed=24)
+    t = triangulation(pts, "incremental")
+    layout = engines.spatial_sites(t.sites)
+    a, b = engines.renumbered(t), engines.renumbered(t, 2, layout)
+    for name in ("tv", "opp", "dup"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    for name in ("perm", "xs", "ys"):
+        assert np.array_equal(getattr(a.sites, name), getattr(b.sites, name)), name
+
+
+def test_the_overlapped_build_gives_the_same_diagram(monkeypatch):
+    """On two threads the layout is made beside the triangulation from 2^15 sites on; lowering that bound
+    and raising it give the same Diagram."""
+    import tvoronoi
+    from tvoronoi import build
+
+    pts = generate("gaussian", 3_000, seed=25)
+    monkeypatch.setattr(build, "OVERLAP_MIN_SITES", 1)
+    overlapped = tvoronoi.voronoi(pts, threads=2)
+    monkeypatch.setattr(build, "OVERLAP_MIN_SITES", 10**9)
+    plain = tvoronoi.voronoi(pts, threads=2)
+    for name in ("he_origin", "he_twin", "he_face", "face_edge", "vertices", "cell_vertices", "cell_offsets"):
+        assert np.array_equal(getattr(overlapped, name), getattr(plain, name)), name

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import contextvars
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from tvoronoi import engines
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError
 from tvoronoi.kernels import clip, pages
+
+# fewer sites: the layout is made after the triangulation (a thread costs more than it would save)
+OVERLAP_MIN_SITES = 1 << 15
 
 
 def build_arrays():
@@ -21,13 +27,26 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     with build_arrays():
-        t = engines.run(
+        s = engines.prepare(
             pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
         )
-        t = engines.spatial(t, threads)  # the dual and the clipper walk the sites in this order
+        t = triangulate_and_lay_out(s, engine=engine, insertion=insertion, threads=threads)
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+
+
+def triangulate_and_lay_out(s: engines.Sites, *, engine: str, insertion: str, threads: int) -> engines.Triangulation:
+    """Triangulate prepared sites and renumber them for the dual and the clipper (engines.spatial), which
+    walk the sites in order. The sites' new order reads their coordinates alone: on more than one
+    thread it is made on a second one while the triangulation runs (both kernels release the GIL), in
+    this context (the build's arrays are made as on the first). The same result either way."""
+    if threads < 2 or engine != "incremental" or len(s) < OVERLAP_MIN_SITES:
+        return engines.spatial(engines.triangulate(s, engine=engine, insertion=insertion), threads)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        layout = pool.submit(contextvars.copy_context().run, engines.spatial_sites, s)
+        t = engines.triangulate(s, engine=engine, insertion=insertion)
+        return engines.spatial(t, threads, layout.result())
 
 
 def assemble(

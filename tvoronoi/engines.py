@@ -185,32 +185,50 @@ class Triangulation:
         return out
 
 
-def spatial(t: Triangulation, threads: int = 1) -> Triangulation:
+@dataclass(frozen=True)
+class SiteLayout:
+    """Sites renumbered along a Z-curve (kernels/renumber.pyx): new site k is old site new_to_old[k]."""
+
+    new_to_old: np.ndarray  # (n,) int32
+    old_to_new: np.ndarray  # (n,) int32, its inverse
+    sites: Sites  # the same sites in the new order (perm still maps each to its input row)
+
+
+def spatial_sites(s: Sites) -> SiteLayout:
+    """The sites' Z-curve order and the sites in it. It reads their coordinates alone, so a build on
+    more than one thread makes it while the triangulation runs (build.build_diagram)."""
+    new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
+    return SiteLayout(new_to_old, old_to_new, Sites(s.exponent, s.perm[new_to_old], s.xs[new_to_old], s.ys[new_to_old]))
+
+
+def spatial(t: Triangulation, threads: int = 1, layout: SiteLayout | None = None) -> Triangulation:
     """The triangulation the dual and the clipper read best: they walk the sites in order, so neighbours
     should be near in memory.
 
-    The incremental engine's is renumbered (``renumbered``); Fortune's is returned as it is: its sites
-    come in sweep order and its triangles are stored as the sweep makes them, next to their sites
-    already (renumbering it cost 50 ms more than it saved at 10^6 sites).
+    The incremental engine's is renumbered (``renumbered``, with ``layout`` if it is made already);
+    Fortune's is returned as it is: its sites come in sweep order and its triangles are stored as the
+    sweep makes them, next to their sites already (renumbering it cost 50 ms more than it saved at
+    10^6 sites).
     """
-    return renumbered(t, threads) if t.engine == "incremental" else t
+    return renumbered(t, threads, layout) if t.engine == "incremental" else t
 
 
-def renumbered(t: Triangulation, threads: int = 1) -> Triangulation:
+def renumbered(t: Triangulation, threads: int = 1, layout: SiteLayout | None = None) -> Triangulation:
     """The same triangulation with its sites and triangles renumbered along a Z-curve (kernels/renumber.pyx).
 
     Only the numbering changes (``sites.perm`` still maps each site to its input row); the result is the
-    same for any thread count. A flat triangulation is returned as it is.
+    same for any thread count, and with or without a ``layout`` made beforehand (``spatial_sites`` of
+    ``t.sites``). A flat triangulation is returned as it is.
     """
     if t.flat:
         return t
-    s = t.sites
-    new_to_old, old_to_new, tv, opp = renumber.spatial_order(s.xs, s.ys, t.tv, t.opp, threads)
-    dup = t.dup[new_to_old]
+    if layout is None:
+        layout = spatial_sites(t.sites)
+    tv, opp = renumber.triangle_order(t.tv, t.opp, layout.old_to_new, threads)
+    dup = t.dup[layout.new_to_old]
     repeats = dup >= 0
-    dup[repeats] = old_to_new[dup[repeats]]
-    sites = Sites(s.exponent, s.perm[new_to_old], s.xs[new_to_old], s.ys[new_to_old])
-    return Triangulation(t.engine, sites, tv, opp, dup)
+    dup[repeats] = layout.old_to_new[dup[repeats]]
+    return Triangulation(t.engine, layout.sites, tv, opp, dup)
 
 
 def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triangulation:

@@ -134,54 +134,48 @@ def grid_bits(Py_ssize_t n):
     return bits_for(n)
 
 
-def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
-                  int threads=1):
-    """Sites and triangles renumbered so that neighbours in the plane are neighbours in memory.
+def site_order(const double[::1] xs, const double[::1] ys):
+    """The sites sorted along a Z-curve (z_sort): (new_to_old, old_to_new), each (n,) int32.
 
     Sites are sorted (stably, by a counting sort) by the Z-curve index of their cell in a grid of about
     one cell per site over their bounding box, and the sites of a crowded cell again on a grid of their
-    own (z_sort); a triangle goes with the smallest new number among its finite sites (stably too), so
-    the triangles around consecutive sites are stored together.
-
-    Parameters
-    ----------
-    xs, ys : (n,) float64, the sites.
-    tv, opp : (3 * n_tri,) int32, a triangulation of them (vertex n is the vertex at infinity) and its
-        twin half-edges, as incremental.triangulate or fortune.sweep return them.
-    threads : int, threads for the keys and the rewrite (the result is the same for any count).
-
-    Returns
-    -------
-    new_to_old : (n,) int32, new site k is old site new_to_old[k].
-    old_to_new : (n,) int32, its inverse.
-    tv2, opp2 : (3 * n_tri,) int32, the same triangulation in the new numbers: new triangle T is an old
-        one with its corners in the same rotation, sites and half-edges renumbered.
+    own. It reads the coordinates alone, so a build makes it while the triangulation runs.
     """
-    cdef Py_ssize_t n = xs.shape[0], n_he = tv.shape[0], n_tri = n_he // 3, k, t
-    cdef int inf = <int> n, a, T, o, status = 0
+    cdef Py_ssize_t n = xs.shape[0], k
     new_to_old_arr = np.empty(n, np.int32)
     old_to_new_arr = np.empty(n, np.int32)
+    cdef int32_t[::1] new_to_old = new_to_old_arr, old_to_new = old_to_new_arr
+    cdef int status = 0
+    if n == 0:
+        return new_to_old_arr, old_to_new_arr
+    with nogil:
+        for k in range(n):
+            new_to_old[k] = <int32_t> k
+        status = z_sort(&xs[0], &ys[0], &new_to_old[0], n, 0)
+        for k in range(n):
+            old_to_new[new_to_old[k]] = <int32_t> k
+    # (status -1: a grid's scratch could not be allocated and its sites kept their order; every order
+    # is a correct numbering, this one only less local)
+    return new_to_old_arr, old_to_new_arr
+
+
+def triangle_order(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[::1] old_to_new, int threads=1):
+    """The triangulation tv, opp in the sites' new numbers (old_to_new, vertex n the vertex at infinity),
+    its triangles counting-sorted by their smallest new site (stably): (tv2, opp2), new triangle T an old
+    one with its corners in the same rotation. The same arrays for any thread count."""
+    cdef Py_ssize_t n = old_to_new.shape[0], n_he = tv.shape[0], n_tri = n_he // 3, k, t
+    cdef int inf = <int> n, a, T, o
     tv2_arr = np.empty(n_he, np.int32)
     opp2_arr = np.empty(n_he, np.int32)
-    cdef int32_t[::1] new_to_old = new_to_old_arr, old_to_new = old_to_new_arr
     cdef int32_t[::1] tv2 = tv2_arr, opp2 = opp2_arr
     cdef int32_t[::1] keys = np.empty(max(n_tri, 1), np.int32)      # each triangle's smallest new site
     cdef int32_t[::1] start = np.zeros(n + 1, np.int32)
     cdef int32_t[::1] tri_new = np.empty(max(n_tri, 1), np.int32)
     cdef int T_threads = threads if n_tri >= PARALLEL_MIN_TRIANGLES and threads > 1 else 1
-    if n == 0:
-        return new_to_old_arr, old_to_new_arr, tv2_arr, opp2_arr
-
+    if n_tri == 0:
+        return tv2_arr, opp2_arr
     with nogil:
-        # sites: sorted by the Z-curve index of their cell, in a grid over their bounding box (sites in
-        # one cell keep their order; crowded cells are ordered again, on grids of their own)
-        for k in range(n):
-            new_to_old[k] = <int32_t> k
-        status = z_sort(&xs[0], &ys[0], &new_to_old[0], n, 0)
-        for k in prange(n, num_threads=T_threads, schedule="static"):
-            old_to_new[new_to_old[k]] = <int32_t> k
-
-        # triangles: a counting sort by their smallest new site (every triangle has a finite one)
+        # a counting sort by the smallest new site (every triangle has a finite one)
         for t in prange(n_tri, num_threads=T_threads, schedule="static"):
             keys[t] = first_site(&tv[3 * t], &old_to_new[0], inf)
         for t in range(n_tri):
@@ -200,6 +194,28 @@ def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1]
                 tv2[3 * T + k] = old_to_new[a] if a != inf else inf
                 o = opp[3 * t + k]
                 opp2[3 * T + k] = 3 * tri_new[o // 3] + o % 3
-    # (status -1: a grid's scratch could not be allocated and its sites kept their order; every order
-    # is a correct numbering, this one only less local)
-    return new_to_old_arr, old_to_new_arr, tv2_arr, opp2_arr
+    return tv2_arr, opp2_arr
+
+
+def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
+                  int threads=1):
+    """Sites and triangles renumbered so that neighbours in the plane are neighbours in memory:
+    site_order, then triangle_order.
+
+    Parameters
+    ----------
+    xs, ys : (n,) float64, the sites.
+    tv, opp : (3 * n_tri,) int32, a triangulation of them (vertex n is the vertex at infinity) and its
+        twin half-edges, as incremental.triangulate or fortune.sweep return them.
+    threads : int, threads for the triangles' keys and rewrite (the result is the same for any count).
+
+    Returns
+    -------
+    new_to_old : (n,) int32, new site k is old site new_to_old[k].
+    old_to_new : (n,) int32, its inverse.
+    tv2, opp2 : (3 * n_tri,) int32, the same triangulation in the new numbers: new triangle T is an old
+        one with its corners in the same rotation, sites and half-edges renumbered.
+    """
+    new_to_old, old_to_new = site_order(xs, ys)
+    tv2, opp2 = triangle_order(tv, opp, old_to_new, threads)
+    return new_to_old, old_to_new, tv2, opp2
