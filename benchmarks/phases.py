@@ -5,8 +5,10 @@ cells are timed one after the other, in interleaved repeats (the median is repor
 
   order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
   tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep), then for the
-            incremental engine its sites and triangles renumbered along a Z-curve (on two threads the
-            sites' order is made beside the triangulation)
+            incremental engine its sites and triangles renumbered along a Z-curve. From
+            halves.SPLIT_MIN_SITES sites on, the incremental engine goes by halves (tvoronoi.halves):
+            each half ordered, triangulated and renumbered on its own thread, then joined; its order
+            is then part of tri, and its order column reads "-"
   dual      the Voronoi half-edge structure and its correctly rounded vertices
   cells     clipping every cell to the box and gathering the cells into input order
 
@@ -38,7 +40,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from benchmarks.common import atomic_write, describe_machine, machine, parse_sizes, subprocess_env  # noqa: E402
-from tvoronoi import build, engines  # noqa: E402
+from tvoronoi import build, engines, halves  # noqa: E402
 from tvoronoi.api import default_bbox  # noqa: E402
 from tvoronoi.generators import generate  # noqa: E402
 
@@ -65,9 +67,14 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         k0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         t0 = time.perf_counter()
         e = engines.scale_exponent(pts)
-        s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
-        t1 = time.perf_counter()
-        t = build.triangulate_and_lay_out(s, engine=engine, insertion="brio", threads=threads)
+        by_halves = engine == "incremental" and len(pts) >= halves.SPLIT_MIN_SITES
+        if by_halves:  # each half is ordered and triangulated on its own thread: one figure for both
+            t1 = t0
+            t = build.triangulation(pts, e, engine=engine, insertion="brio", seed=0, threads=threads)
+        else:
+            s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
+            t1 = time.perf_counter()
+            t = build.triangulate_and_lay_out(s, engine=engine, insertion="brio", threads=threads)
         t2 = time.perf_counter()
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t
@@ -77,7 +84,8 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         k1 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         assert d.cell_offsets[-1] > 0
         del d, out
-    return {"order": t1 - t0, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3, "system": k1 - k0}
+    order = None if by_halves else t1 - t0
+    return {"order": order, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3, "system": k1 - k0}
 
 
 def others(pts: np.ndarray, geos_max: int) -> dict:
@@ -148,8 +156,8 @@ def build_peak(dist: str, n: int, engine: str, threads: int) -> float:
     return float(res.stdout.strip())
 
 
-def fmt_ns(seconds: float, n: int) -> str:
-    return f"{seconds / n * 1e9:,.0f}"
+def fmt_ns(seconds: float | None, n: int) -> str:
+    return "-" if seconds is None else f"{seconds / n * 1e9:,.0f}"
 
 
 def main(argv=None) -> None:
@@ -179,8 +187,8 @@ def main(argv=None) -> None:
                         gc.collect()
                         runs.setdefault((engine, threads), []).append(time_phases(pts, engine, threads))
             for (engine, threads), reps in runs.items():
-                med = {p: statistics.median(r[p] for r in reps) for p in PHASES}
-                med["total"] = statistics.median(sum(r[p] for p in PHASES) for r in reps)
+                med = {p: None if reps[0][p] is None else statistics.median(r[p] for r in reps) for p in PHASES}
+                med["total"] = statistics.median(sum(r[p] or 0.0 for p in PHASES) for r in reps)
                 med["system"] = statistics.median(r["system"] for r in reps)
                 rows.append(
                     {
@@ -194,7 +202,7 @@ def main(argv=None) -> None:
                 )
                 print(
                     f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
-                    + " ".join(f"{p}={med[p] * 1e3:.0f}ms" for p in (*PHASES, "total", "system")),
+                    + " ".join(f"{p}={(med[p] or 0.0) * 1e3:.0f}ms" for p in (*PHASES, "total", "system")),
                     flush=True,
                 )
             for tool, seconds in others(pts, args.geos_max).items():
@@ -212,7 +220,8 @@ def report(rows: list[dict], info: dict) -> str:
         f"Machine: {describe_machine(info)}",
         "",
         "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
-        "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells. The other tools are "
+        "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells (by halves, the incremental "
+        "engine orders each half within tri: order reads -). The other tools are "
         "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
         "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
         "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process. System: the "

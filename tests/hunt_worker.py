@@ -97,7 +97,9 @@ def _serve(kernels: str | None) -> None:
     import adversarial
     import exact_checks
     import tvoronoi
+    from tvoronoi import halves
 
+    default_split_min = halves.SPLIT_MIN_SITES
     unraisable: list[str] = []
 
     def hook(u):  # an error inside a noexcept kernel function
@@ -125,8 +127,11 @@ def _serve(kernels: str | None) -> None:
         out: dict = {}
         unraisable.clear()
         try:
+            # split_min: builds from that many sites go by halves (tvoronoi.halves), on two threads
+            halves.SPLIT_MIN_SITES = req.get("split_min", default_split_min)
+            threads = 2 if "split_min" in req else None
             with poisoned_empty(req.get("poison")):
-                d = tvoronoi.voronoi(pts, engine=req["engine"], bbox=bbox)
+                d = tvoronoi.voronoi(pts, engine=req["engine"], bbox=bbox, threads=threads)
             out["build"] = "ok"
         except Exception as exc:  # noqa: BLE001 -- reported, not hidden
             tb = traceback.extract_tb(exc.__traceback__)[-1]

@@ -7,7 +7,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from tvoronoi import engines
+from tvoronoi import engines, halves
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import EngineError
 from tvoronoi.kernels import clip, pages
@@ -27,13 +27,24 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     e = engines.scale_exponent(pts)
     engines.check_box_scale(box, e)
     with build_arrays():
-        s = engines.prepare(
-            pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
-        )
-        t = triangulate_and_lay_out(s, engine=engine, insertion=insertion, threads=threads)
+        t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads)
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+
+
+def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed: int, threads: int):
+    """The triangulation of checked points, scaled by 2^-e, laid out for the dual: by halves
+    (tvoronoi.halves) for the incremental engine in BRIO order from SPLIT_MIN_SITES sites on, whatever the
+    thread count, else whole (triangulate_and_lay_out)."""
+    if engine == "incremental" and insertion == "brio" and len(pts) >= halves.SPLIT_MIN_SITES:
+        t = halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e, seed=seed, threads=threads)
+        if t is not None:
+            return t
+    s = engines.prepare(
+        pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
+    )
+    return triangulate_and_lay_out(s, engine=engine, insertion=insertion, threads=threads)
 
 
 def triangulate_and_lay_out(s: engines.Sites, *, engine: str, insertion: str, threads: int) -> engines.Triangulation:

@@ -10,3 +10,14 @@ def site_order(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def triangle_order(
     tv: np.ndarray, opp: np.ndarray, old_to_new: np.ndarray, threads: int = 1
 ) -> tuple[np.ndarray, np.ndarray]: ...
+def triangle_order_into(
+    tv: np.ndarray,
+    opp: np.ndarray,
+    old_to_new: np.ndarray,
+    tv2: np.ndarray,
+    opp2: np.ndarray,
+    site_base: int,
+    tri_base: int,
+    inf_out: int,
+    threads: int = 1,
+) -> None: ...

@@ -163,17 +163,29 @@ def triangle_order(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[
     """The triangulation tv, opp in the sites' new numbers (old_to_new, vertex n the vertex at infinity),
     its triangles counting-sorted by their smallest new site (stably): (tv2, opp2), new triangle T an old
     one with its corners in the same rotation. The same arrays for any thread count."""
+    tv2_arr = np.empty(tv.shape[0], np.int32)
+    opp2_arr = np.empty(tv.shape[0], np.int32)
+    triangle_order_into(tv, opp, old_to_new, tv2_arr, opp2_arr, 0, 0, old_to_new.shape[0], threads)
+    return tv2_arr, opp2_arr
+
+
+def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[::1] old_to_new,
+                        int32_t[::1] tv2, int32_t[::1] opp2, int site_base, int tri_base, int inf_out,
+                        int threads=1):
+    """triangle_order, written into tv2, opp2 (each as long as tv) as part of a larger triangulation
+    (tvoronoi.halves): sites numbered from site_base on and the vertex at infinity inf_out, triangles from
+    tri_base on (the twins count from there: tv2 and opp2 are the slice of the larger arrays that starts
+    at half-edge 3 tri_base)."""
     cdef Py_ssize_t n = old_to_new.shape[0], n_he = tv.shape[0], n_tri = n_he // 3, k, t
     cdef int inf = <int> n, a, T, o
-    tv2_arr = np.empty(n_he, np.int32)
-    opp2_arr = np.empty(n_he, np.int32)
-    cdef int32_t[::1] tv2 = tv2_arr, opp2 = opp2_arr
+    if tv2.shape[0] != n_he or opp2.shape[0] != n_he or opp.shape[0] != n_he:
+        raise ValueError("triangle_order_into: tv, opp, tv2 and opp2 differ in length")
     cdef int32_t[::1] keys = np.empty(max(n_tri, 1), np.int32)      # each triangle's smallest new site
     cdef int32_t[::1] start = np.zeros(n + 1, np.int32)
     cdef int32_t[::1] tri_new = np.empty(max(n_tri, 1), np.int32)
     cdef int T_threads = threads if n_tri >= PARALLEL_MIN_TRIANGLES and threads > 1 else 1
     if n_tri == 0:
-        return tv2_arr, opp2_arr
+        return
     with nogil:
         # a counting sort by the smallest new site (every triangle has a finite one)
         for t in prange(n_tri, num_threads=T_threads, schedule="static"):
@@ -191,10 +203,9 @@ def triangle_order(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[
             T = tri_new[t]
             for k in range(3):
                 a = tv[3 * t + k]
-                tv2[3 * T + k] = old_to_new[a] if a != inf else inf
+                tv2[3 * T + k] = site_base + old_to_new[a] if a != inf else inf_out
                 o = opp[3 * t + k]
-                opp2[3 * T + k] = 3 * tri_new[o // 3] + o % 3
-    return tv2_arr, opp2_arr
+                opp2[3 * T + k] = 3 * (tri_base + tri_new[o // 3]) + o % 3
 
 
 def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,

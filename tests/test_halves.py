@@ -1,0 +1,265 @@
+"""The triangulation by halves (tvoronoi/halves.py, kernels/seam.pyx): exactly Delaunay, the same cells as
+one triangulation of all the sites, and the same Diagram on any thread count.
+
+Builds take that path from SPLIT_MIN_SITES sites on; these tests lower the threshold so that every family
+of hard input, small as it is here, is cut in two and joined.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from conftest import DATASETS
+from tests import adversarial
+from tests.exact_checks import CHECKS, cells_of, check_same_cells
+from tvoronoi import api, engines, halves
+from tvoronoi.generators import generate
+from tvoronoi.kernels import seam
+
+ARRAYS = (
+    "site_of",
+    "vertices",
+    "he_origin",
+    "he_twin",
+    "he_face",
+    "face_edge",
+    "triangles",
+    "cell_points",
+    "cell_offsets",
+    "cell_vertices",
+)
+
+
+@pytest.fixture
+def split_always(monkeypatch):
+    """Every build of three sites or more goes by halves; joined() records whether each join held."""
+    monkeypatch.setattr(halves, "SPLIT_MIN_SITES", 3)
+    joins: list[bool] = []
+    real = halves.joined
+
+    def spy(*args, **kwargs):
+        t = real(*args, **kwargs)
+        joins.append(t is not None)
+        return t
+
+    monkeypatch.setattr(halves, "joined", spy)
+    return joins
+
+
+def whole(pts, bbox=None, threads=1):
+    """The build of one triangulation of all the sites (no halves)."""
+    saved = halves.SPLIT_MIN_SITES
+    halves.SPLIT_MIN_SITES = 1 << 62
+    try:
+        return api.voronoi(pts, bbox=bbox, threads=threads)
+    finally:
+        halves.SPLIT_MIN_SITES = saved
+
+
+def assert_same_diagram(a, b) -> None:
+    for name in ARRAYS:
+        assert np.array_equal(getattr(a, name), getattr(b, name)), f"{name} differs"
+
+
+def check_by_halves(pts, bbox=None, joins=None) -> None:
+    """The build by halves: exactly Delaunay, valid cells equal to one triangulation's, and the same
+    Diagram on 1, 2 and 3 threads."""
+    d = api.voronoi(pts, bbox=bbox, threads=2)
+    for check in CHECKS.values():  # exactly Delaunay; cells valid, distinct points, a tiling of the box
+        check(d)
+    check_same_cells(cells_of(whole(pts, bbox)), cells_of(d), names=("whole", "halves"))
+    for threads in (1, 3):
+        assert_same_diagram(d, api.voronoi(pts, bbox=bbox, threads=threads))
+    if joins is not None:
+        assert all(joins), "a join reported a defect and the build fell back to one triangulation"
+
+
+# families whose sites have no two halves to triangulate: too few, or collinear on one side
+WHOLE_FAMILIES = {
+    "collinear_exact",
+    "collinear_dyadic_repeats",
+    "collinear_plus_one_ulp",
+    "two_sites_1e12_2ulps",
+    "two_sites_1e12_1ulp",
+    "subnormal_default_box",
+    "subnormal_row_default_box",
+    "duplicates_of_triangle",
+    "duplicates_of_collinear",
+}
+
+
+@pytest.mark.parametrize("name", sorted(adversarial.FAMILIES))
+def test_every_family_by_halves(name, split_always):
+    case = adversarial.make(name)
+    check_by_halves(case.points, case.bbox, split_always)
+    if name not in WHOLE_FAMILIES and not name.startswith("sites_"):
+        assert split_always, "the build did not go by halves"
+
+
+@pytest.mark.parametrize("name", sorted(DATASETS))
+def test_datasets_by_halves(name, split_always):
+    check_by_halves(DATASETS[name], joins=split_always)
+
+
+def lattice_disk(r: int, centre=(0, 0)) -> np.ndarray:
+    """Every integer point within distance r of centre: circles of many cocircular sites, cut through."""
+    g = np.arange(-r, r + 1)
+    x, y = np.meshgrid(g, g)
+    keep = x * x + y * y <= r * r
+    return np.c_[x[keep] + centre[0], y[keep] + centre[1]].astype(float)
+
+
+SEAM_CASES = {
+    # the median line through a column of a grid, through the centre of cocircular rings, along a row
+    "grid_column_on_the_line": np.array([(i, j) for i in range(21) for j in range(15)], float),
+    "lattice_disk": lattice_disk(12),
+    "lattice_disk_offset": lattice_disk(9, (0.5, 0.0)),
+    "rotated_square_lattice": np.array([(i - j, i + j) for i in range(16) for j in range(16)], float),
+    "two_clusters_apart": np.r_[generate("uniform", 300, seed=5), generate("uniform", 300, seed=6) + 1e6],
+    "one_side_collinear": np.r_[
+        np.c_[np.linspace(-1, -0.5, 200), np.linspace(0, 1, 200)], generate("uniform", 200, seed=7)
+    ],
+    "vertical_line_and_cloud": np.r_[np.c_[np.zeros(150), np.arange(150.0)], generate("uniform", 150, seed=8) * 150],
+    "half_on_the_median": np.r_[
+        np.c_[np.full(300, 0.5), generate("uniform", 300, seed=9)[:, 1]], generate("uniform", 300, seed=10)
+    ],
+    "circle_points_across": np.c_[
+        np.cos(np.linspace(0, 2 * np.pi, 400, endpoint=False)), np.sin(np.linspace(0, 2 * np.pi, 400, endpoint=False))
+    ],
+    "thin_strip_across": np.c_[generate("uniform", 500, seed=11)[:, 0], 1e-9 * generate("uniform", 500, seed=12)[:, 1]],
+}
+
+
+@pytest.mark.parametrize("name", sorted(SEAM_CASES))
+def test_seam_cases(name, split_always):
+    check_by_halves(SEAM_CASES[name], joins=split_always)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(-6, 6), st.integers(-6, 6)), min_size=3, max_size=120),
+    st.sampled_from([1.0, 0.1, 2.0**-30, 1e9]),
+)
+def test_hypothesis_small_integer_sites(coords, unit):
+    """Small integer grids (cocircular sites everywhere, many on the median lines) scaled by a unit."""
+    pts = np.array(coords, float) * unit
+    saved = halves.SPLIT_MIN_SITES
+    halves.SPLIT_MIN_SITES = 3
+    try:
+        check_by_halves(pts)
+    finally:
+        halves.SPLIT_MIN_SITES = saved
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(8, 400), st.sampled_from(["uniform", "gaussian", "clustered"]))
+def test_hypothesis_random_sites_rounded(seed, n, dist):
+    """Random sites rounded to a few decimals, as instruments give them."""
+    pts = np.round(generate(dist, n, seed=seed), 2)
+    saved = halves.SPLIT_MIN_SITES
+    halves.SPLIT_MIN_SITES = 3
+    try:
+        check_by_halves(pts)
+    finally:
+        halves.SPLIT_MIN_SITES = saved
+
+
+def test_a_large_build_goes_by_halves_and_threads_agree():
+    """At the real threshold: the build by halves on 1 and 2 threads is the same Diagram, with the same
+    cells as one triangulation."""
+    pts = generate("clustered", halves.SPLIT_MIN_SITES + 5000, seed=3)
+    e = engines.scale_exponent(pts)
+    assert halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e) is not None
+    one, two = api.voronoi(pts, threads=1), api.voronoi(pts, threads=2)
+    assert_same_diagram(one, two)
+    w = whole(pts)
+    assert np.array_equal(w.cell_offsets, two.cell_offsets)
+    assert np.array_equal(w.cell_points[w.cell_vertices], two.cell_points[two.cell_vertices])
+
+
+def test_no_cut_when_the_median_line_holds_most_sites():
+    """Most sites on one vertical and one horizontal line: no balanced cut, the whole triangulation."""
+    y = np.arange(100.0)
+    pts = np.r_[np.c_[np.zeros(100), y], np.c_[y, np.zeros(100)], [[3.0, 4.0]]]
+    assert halves.cut(pts[:, 0], pts[:, 1]) is None
+
+
+# ---------------------------------------------------------------------------------------------
+# what a half keeps: only triangles whose closed circumdisk is strictly on its side, checked exactly
+
+
+def exact_clear(a, b, c, split, axis, below) -> bool:
+    """The closed circumdisk of abc lies strictly below (or above) the line, in rational arithmetic."""
+    ax, ay, bx, by, cx, cy = (Fraction(float(v)) for v in (*a, *b, *c))
+    d = 2 * ((bx - ax) * (cy - ay) - (by - ay) * (cx - ax))
+    if d == 0:
+        return False
+    b2, c2 = (bx - ax) ** 2 + (by - ay) ** 2, (cx - ax) ** 2 + (cy - ay) ** 2
+    ux = ((cy - ay) * b2 - (by - ay) * c2) / d
+    uy = ((bx - ax) * c2 - (cx - ax) * b2) / d
+    r2 = ux * ux + uy * uy
+    centre = ax + ux if axis == 0 else ay + uy
+    gap = Fraction(split) - centre if below else centre - Fraction(split)
+    return gap > 0 and gap * gap > r2
+
+
+def kept(tri, split, axis, below):
+    xs = np.array([p[0] for p in tri], float)
+    ys = np.array([p[1] for p in tri], float)
+    keep = np.zeros(1, np.int8)
+    marks = np.zeros(3, np.int8)
+    seam.kept_triangles(xs, ys, np.array([0, 1, 2], np.int32), 3, split, axis, below, 0.0, 0.0, 0.0, 0.0, keep, marks)
+    assert marks.tolist() == ([0, 0, 0] if keep[0] else [1, 1, 1])
+    return bool(keep[0])
+
+
+coordinate = st.floats(-1.0, 1.0, allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=3000, deadline=None)
+@given(
+    st.tuples(coordinate, coordinate),
+    st.tuples(coordinate, coordinate),
+    st.tuples(coordinate, coordinate),
+    coordinate,
+    st.sampled_from([0, 1]),
+    st.booleans(),
+    st.integers(0, 1000),
+)
+# found by this test: sides of 1e-115, whose products of three differences underflowed to zero
+@example((0.0, -7.623063129501359e-116), (-7.623063129501359e-116, 0.0), (0.0, 0.0), 0.0, 0, True, 0)
+def test_a_kept_triangle_is_clear_of_the_line(a, b, c, split, axis, below, shrink):
+    """Whatever the triangle (flat, tiny, huge circle, touching the line, at any scale down to
+    subnormal sides), a kept one is clear of it."""
+    a, b, c = (tuple(math.ldexp(v, -shrink) for v in p) for p in (a, b, c))
+    split = math.ldexp(split, -shrink)
+    if orient(a, b, c) <= 0:
+        a, b = b, a
+    if kept((a, b, c), split, axis, below):
+        assert exact_clear(a, b, c, split, axis, below)
+
+
+def orient(a, b, c):
+    return (Fraction(b[0]) - Fraction(a[0])) * (Fraction(c[1]) - Fraction(a[1])) - (Fraction(b[1]) - Fraction(a[1])) * (
+        Fraction(c[0]) - Fraction(a[0])
+    )
+
+
+@pytest.mark.parametrize("ulps", [0, 1, 2, 4, 64, 1 << 20])
+def test_triangles_whose_circle_touches_the_line_are_left_to_the_seam(ulps):
+    """The circle through (-1, 1), (-1, -1) and (0, 0) touches x = 0; lines a few ulps right of it: kept
+    only if the exact test agrees, never when the circle touches the line, always when it is far."""
+    tri = ((-1.0, 1.0), (-1.0, -1.0), (0.0, 0.0))  # circle centre (-1, 0), radius 1: touches x = 0
+    tri = (tri[1], tri[2], tri[0]) if orient(*tri) < 0 else tri
+    split = float(np.nextafter(0.0, 1.0) * ulps) if ulps else 0.0
+    got = kept(tri, split, 0, True)
+    assert not got or exact_clear(*tri, split, 0, True)
+    if ulps == 0:
+        assert not got
+    if ulps == 1 << 20:
+        assert not got  # 2^20 subnormal ulps is still far below the filter's margin
+    assert kept(tri, 0.5, 0, True)

@@ -1,0 +1,179 @@
+"""The incremental engine on two halves of the sites: each half ordered, triangulated and renumbered on its
+own thread, then the two joined along the seam between them (kernels/seam.pyx).
+
+The cut, each half's order and the join read the sites alone, never the thread count: the same
+triangulation, numbered the same way, on one thread or two. A build takes this path from
+SPLIT_MIN_SITES sites on (tvoronoi.build).
+"""
+
+from __future__ import annotations
+
+import contextvars
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from tvoronoi import engines
+from tvoronoi.kernels import incremental, order, renumber, seam
+
+# fewer sites: one triangulation (two halves and a seam cost more than they save on two threads)
+SPLIT_MIN_SITES = 1 << 16
+# a half with fewer than this share of the sites (many sites on the median line): no split on that axis
+LEAST_SHARE = 0.25
+
+
+@dataclass(frozen=True)
+class Cut:
+    """The line the sites are cut by: coordinate ``axis`` (0: x, 1: y) below ``split`` on the left."""
+
+    axis: int
+    split: float
+    left: np.ndarray  # (n,) bool, the left half's sites
+
+
+def cut(xs: np.ndarray, ys: np.ndarray) -> Cut | None:
+    """The cut at the median of the longer side of the sites' box (else of the other side), or None when
+    neither gives two halves of at least LEAST_SHARE of the sites each."""
+    n = len(xs)
+    if n < 4:
+        return None
+    spans = (float(xs.max() - xs.min()), float(ys.max() - ys.min()))
+    for axis in (0, 1) if spans[0] >= spans[1] else (1, 0):
+        c = xs if axis == 0 else ys
+        split = float(np.partition(c, n // 2)[n // 2])
+        left = c < split
+        n_left = int(np.count_nonzero(left))
+        if min(n_left, n - n_left) >= LEAST_SHARE * n:
+            return Cut(axis, split, left)
+    return None
+
+
+@dataclass(frozen=True)
+class Joined:
+    """The arrays the two halves write into, each its own part, and the seam then joins in place."""
+
+    xs: np.ndarray  # (n,) float64: the left half's sites first, each half along a Z-curve
+    ys: np.ndarray
+    perm: np.ndarray  # (n,) int32: site k is input site perm[k]
+    dup: np.ndarray  # (n,) int32
+    tv: np.ndarray  # (3 (2 n - 2),) int32: the left half's triangles from the start, the right's at the end
+    opp: np.ndarray
+    keep: np.ndarray  # (2 n - 2,) int8: seam.kept_triangles
+    seam: np.ndarray  # (n,) int8: the seam sites, marked by seam.kept_triangles
+
+    @classmethod
+    def empty(cls, n: int) -> Joined:
+        cap = max(2 * n - 2, 1)
+        return cls(
+            np.empty(n, np.float64),
+            np.empty(n, np.float64),
+            np.empty(n, np.int32),
+            np.empty(n, np.int32),
+            np.empty(3 * cap, np.int32),
+            np.empty(3 * cap, np.int32),
+            np.zeros(cap, np.int8),
+            np.zeros(n, np.int8),
+        )
+
+
+def half(
+    xs,
+    ys,
+    rows,
+    other_box: tuple[float, float, float, float],
+    c: Cut,
+    out: Joined,
+    first: int,
+    *,
+    seed: int,
+    threads: int,
+):
+    """Order, triangulate and renumber the sites ``rows`` of xs, ys (scaled, input order), as sites
+    first.. of ``out``, their triangles at its start (first == 0, the left half) or at its end; mark the
+    triangles it keeps (other_box: the other half's bounding box). Returns the slots its triangles take
+    (lo, hi), or None when its sites are collinear."""
+    s = engines.prepare(xs[rows], ys[rows], engine="incremental", seed=seed, threads=threads, exponent=0)
+    t = engines.triangulate(s, engine="incremental")
+    if t.tv is None or t.opp is None:
+        return None
+    n, k, n_tri = len(xs), len(rows), len(t.tv) // 3
+    lo = 0 if first == 0 else len(out.keep) - n_tri
+    new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
+    tv, opp = out.tv[3 * lo : 3 * (lo + n_tri)], out.opp[3 * lo : 3 * (lo + n_tri)]
+    renumber.triangle_order_into(t.tv, t.opp, old_to_new, tv, opp, first, lo, n, threads)
+    mine = slice(first, first + k)
+    # (mode "clip": the indices are in range, and numpy buffers take's output in its checking mode)
+    np.take(s.xs, new_to_old, out=out.xs[mine], mode="clip")
+    np.take(s.ys, new_to_old, out=out.ys[mine], mode="clip")
+    np.take(rows[s.perm], new_to_old, out=out.perm[mine], mode="clip")
+    if (t.dup >= 0).any():  # repeated sites: each names a copy that holds the place, in the new numbers
+        dup = t.dup[new_to_old]
+        out.dup[mine] = np.where(dup >= 0, old_to_new[np.maximum(dup, 0)] + first, -1)
+    else:
+        out.dup[mine] = -1
+    del t
+    seam.kept_triangles(
+        out.xs, out.ys, tv, n, c.split, c.axis, first == 0, *other_box, out.keep[lo : lo + n_tri], out.seam
+    )
+    return lo, lo + n_tri
+
+
+def box(xs: np.ndarray, ys: np.ndarray, rows: np.ndarray) -> tuple[float, float, float, float]:
+    """The bounding box of the sites ``rows``."""
+    x, y = xs[rows], ys[rows]
+    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
+
+
+def triangulate(xs: np.ndarray, ys: np.ndarray, exponent: int, *, seed: int = 0, threads: int = 1):
+    """The Delaunay triangulation of scaled sites (input order) by halves, renumbered for the dual.
+
+    Returns an engines.Triangulation whose ``sites.perm`` maps its sites to input rows, or None when the
+    sites do not split (too many on the median lines, a half's sites collinear): the caller then
+    triangulates them whole. Two threads work when ``threads`` is 2 or more, each half then ordered on
+    half of them.
+    """
+    c = cut(xs, ys)
+    if c is None:
+        return None
+    rows_l = np.flatnonzero(c.left).astype(np.int32)
+    rows_r = np.flatnonzero(~c.left).astype(np.int32)
+    out = Joined.empty(len(xs))
+    jobs = (
+        (rows_l, box(xs, ys, rows_r), 0),
+        (rows_r, box(xs, ys, rows_l), len(rows_l)),
+    )
+    if threads >= 2:
+        each = threads // 2
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            # the right half on a second thread, in this context (the build's arrays are made as here)
+            rows, other, first = jobs[1]
+            job = pool.submit(
+                contextvars.copy_context().run, half, xs, ys, rows, other, c, out, first, seed=seed, threads=each
+            )
+            rows, other, first = jobs[0]
+            slots = [half(xs, ys, rows, other, c, out, first, seed=seed, threads=each), job.result()]
+    else:
+        slots = [half(xs, ys, rows, other, c, out, first, seed=seed, threads=1) for rows, other, first in jobs]
+    left, right = slots
+    if left is None or right is None:
+        return None
+    return joined(out, left[1], right[0], exponent, seed)
+
+
+def joined(out: Joined, gap_lo: int, gap_hi: int, exponent: int, seed: int) -> engines.Triangulation | None:
+    """The two halves joined: the seam sites triangulated, then seam.join in place."""
+    n = len(out.xs)
+    sites_m = np.flatnonzero(out.seam).astype(np.int32)
+    sites_m = sites_m[order.brio_order(out.xs[sites_m], out.ys[sites_m], seed)]
+    status, tv_m, opp_m, _ = incremental.triangulate(
+        np.ascontiguousarray(out.xs[sites_m]), np.ascontiguousarray(out.ys[sites_m])
+    )
+    if status != incremental.STATUS_OK:
+        return None  # the seam sites are collinear
+    expected = 2 * int(np.count_nonzero(out.dup < 0)) - 2
+    holes = np.flatnonzero(out.keep == 0).astype(np.int32)  # the triangles not kept, and the gap
+    if seam.join(out.tv, out.opp, out.keep, holes, gap_lo, gap_hi, n, tv_m, opp_m, sites_m, expected) != seam.STATUS_OK:
+        return None  # a defect: the tests hunt for it; the whole triangulation is still right
+    sites = engines.Sites(exponent, out.perm, out.xs, out.ys)
+    return engines.Triangulation("incremental", sites, out.tv[: 3 * expected], out.opp[: 3 * expected], out.dup)

@@ -1,0 +1,263 @@
+"""Two halves of the sites, triangulated apart, joined along the seam between them (tvoronoi/halves.py).
+
+The sites are cut by a line x = split (or y = split): the left half holds the sites below it, the
+right half the others. Each half's Delaunay triangulation is made on its own; then
+
+  1. kept_triangles: a triangle of one half whose closed circumdisk lies strictly on its own side of the
+     line holds no site of the other half in or on its circle, so it is a Delaunay triangle of all the
+     sites, and so is every triangle on the same circle (all of the circle's sites are in its half, and
+     the half triangulated their whole polygon). An infinite triangle is kept when the other half's
+     bounding box lies strictly inside its hull edge: that edge is then a hull edge of all the sites.
+  2. the seam sites (marked by kept_triangles): the sites of the triangles not kept. Every triangle of the whole triangulation that is
+     not kept has its corners among them (near such a corner, a kept triangle would overlap it).
+  3. join: the triangulation of the seam sites (made by the caller) is kept where the halves kept
+     nothing. Each edge between a kept triangle and one not kept is an edge of it: the kept circle
+     through its ends is empty, with no site on its far arc, so a circle a little past it through the
+     same ends holds no site at all. A flood fill from those edges, never across them, finds its
+     triangles in the region not kept; they are Delaunay triangles of all the sites (each lies in a
+     polygon of cocircular sites, or is one, whose circle is empty of every site).
+
+No decision reads the thread count: the same triangulation on one thread or two.
+"""
+
+import numpy as np
+
+from libc.math cimport fabs
+from libc.stdint cimport int32_t
+
+from tvoronoi.kernels.predicates cimport orient2d
+from tvoronoi.kernels.mesh cimport nxt, prv
+
+cdef enum:
+    OK = 0
+    NOT_AN_EDGE = 1     # a kept edge missing from the seam's triangulation (a defect to report)
+    WRONG_COUNT = 2     # the joined triangulation does not have 2 n - 2 triangles (a defect to report)
+
+STATUS_OK = OK
+
+# The circumdisk test in doubles, with a bound on its rounding error (see disk_clear), for sites scaled
+# below 1 in magnitude (as the engines scale them). Triangles whose sides' product of three
+# (|b'|_1 |c'|_1 (|b'|_1 + |c'|_1)) is below TINY, where products of differences could underflow, and
+# triangles whose determinant is below FLAT times its magnitude (nearly flat) are left to the seam:
+# always safe, as keeping is the only decision that needs proof. Above TINY, an underflowed product is
+# off by at most 2^-1074, far below the relative bound. SLACK is 64 units of rounding, over four times
+# the bound derived below.
+cdef double EPS = 2.0 ** -53
+cdef double SLACK = 64.0 * 2.0 ** -53
+cdef double FLAT = 2.0 ** -20
+cdef double TINY = 2.0 ** -900
+
+
+cdef inline bint disk_clear(double ax, double ay, double bx, double by, double cx, double cy,
+                            double split, int axis, bint below) noexcept nogil:
+    """True only if the closed circumdisk of triangle abc lies strictly below the line (below) or strictly
+    above it; False also when the doubles cannot tell (the triangle is then left to the seam).
+
+    With b' = b - a, c' = c - a, the centre is a + u, u = (c'y B - b'y C, b'x C - c'x B) / d, where
+    B = |b'|^2, C = |c'|^2, d = 2 (b'x c'y - b'y c'x), and the radius is |u| <= |u|_1. With D = |b'|_1 |c'|_1
+    (which bounds |b'x c'y| + |b'y c'x|, and |b'|^2 by |b'|_1^2) and one rounding unit e: d is off by at
+    most 6 e D + e |d|, each numerator by 7 e D (|b'|_1 + |c'|_1) + e |N|, so once |d| > FLAT D the
+    computed u is off in the 1-norm by at most 14 e D (|b'|_1 + |c'|_1) / |d| + |u|_1 (6 e D / |d| + 3 e);
+    the centre's coordinate adds e of itself, the final sum 2 e of its terms. SLACK times each term
+    covers all of it more than four times over.
+    """
+    cdef double bx_ = bx - ax, by_ = by - ay, cx_ = cx - ax, cy_ = cy - ay
+    cdef double nb = fabs(bx_) + fabs(by_), nc = fabs(cx_) + fabs(cy_)
+    cdef double big = nb * nc, d, ux, uy, r, err, base, centre, wb, wc
+    if not big * (nb + nc) > TINY:
+        return False                # products of three differences could underflow
+    d = 2.0 * (bx_ * cy_ - by_ * cx_)
+    if not fabs(d) > FLAT * big:
+        return False                # nearly flat: a huge circle, left to the seam
+    wb = bx_ * bx_ + by_ * by_
+    wc = cx_ * cx_ + cy_ * cy_
+    ux = (cy_ * wb - by_ * wc) / d
+    uy = (bx_ * wc - cx_ * wb) / d
+    r = fabs(ux) + fabs(uy)
+    if axis == 0:
+        base = ax
+        centre = ax + ux
+    else:
+        base = ay
+        centre = ay + uy
+    err = SLACK * (big * (nb + nc) / fabs(d) + r * big / fabs(d) + r + fabs(base) + fabs(split))
+    if below:
+        return centre + r + err < split
+    return centre - r - err > split
+
+
+def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, int inf, double split,
+                   int axis, bint below, double ox0, double oy0, double ox1, double oy1, signed char[::1] keep,
+                   signed char[::1] seam):
+    """Which triangles of one half are triangles of the whole triangulation (1) or left to the seam (0).
+
+    Parameters
+    ----------
+    xs, ys : (n,) float64, the sites; tv : (3 k,) int32, the half's triangles (vertex inf at infinity).
+    split, axis : the line: x = split (axis 0) or y = split (axis 1).
+    below : the half lies below the line (its sites' coordinate < split), else on or above it.
+    ox0, oy0, ox1, oy1 : the bounding box of the other half's sites.
+    keep : (k,) int8, written.
+    seam : (n,) int8, set to 1 at the sites of the triangles not kept (the seam sites; the halves' sites
+        are apart, so both halves can mark at once).
+    """
+    cdef Py_ssize_t n_tri = tv.shape[0] // 3, t
+    cdef int a, b, c, u, w
+    cdef double qx[4]
+    cdef double qy[4]
+    if keep.shape[0] != n_tri or seam.shape[0] < inf:
+        raise ValueError("kept_triangles: keep must hold one entry a triangle, seam one a site")
+    qx[0] = ox0; qy[0] = oy0; qx[1] = ox1; qy[1] = oy0; qx[2] = ox1; qy[2] = oy1; qx[3] = ox0; qy[3] = oy1
+    with nogil:
+        for t in range(n_tri):
+            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+            if a != inf and b != inf and c != inf:
+                keep[t] = disk_clear(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], split, axis, below)
+                if not keep[t]:
+                    seam[a] = 1; seam[b] = 1; seam[c] = 1
+                continue
+            # an infinite triangle (u, w, inf): its region is the open half-plane left of u->w
+            if a == inf:
+                u = b; w = c
+            elif b == inf:
+                u = c; w = a
+            else:
+                u = a; w = b
+            keep[t] = (orient2d(xs[u], ys[u], xs[w], ys[w], qx[0], qy[0]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[1], qy[1]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[2], qy[2]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[3], qy[3]) < 0)
+            if not keep[t]:
+                seam[u] = 1; seam[w] = 1
+
+
+cdef inline int edge_from(const int32_t* tv, const int32_t* opp, const int32_t* vedge, int a, int b) noexcept nogil:
+    """The half-edge a->b of a triangulation (a finite), found around a from vedge[a]; -1 if none."""
+    cdef int e0 = vedge[a], e = e0
+    if e0 < 0:
+        return -1
+    while True:
+        if tv[nxt(e)] == b:
+            return e
+        e = opp[prv(e)]             # the next half-edge out of a
+        if e == e0:
+            return -1
+
+
+def join(int32_t[::1] tv, int32_t[::1] opp, signed char[::1] keep, const int32_t[::1] holes, int gap_lo,
+         int gap_hi, int n, const int32_t[::1] tv_m, const int32_t[::1] opp_m, const int32_t[::1] sites_m,
+         int expected):
+    """Join two halves in place: the triangles of both lie in tv, opp, in one numbering (vertex n at
+    infinity), the left half's below gap_lo and the right half's from gap_hi on; keep marks those kept
+    (kept_triangles) and holes lists, increasing, the slots of the others and of the gap between.
+    The seam's triangles (tv_m, opp_m, its site k being site sites_m[k]) that the fill reaches take the
+    holes in order; triangles from slot ``expected`` on (2 n - 2 for n distinct sites) then move down into
+    any holes still free below it (repeated sites leave some). The work is that of the seam alone.
+
+    Returns STATUS_OK, or a defect (NOT_AN_EDGE, WRONG_COUNT); tv[:3 expected], opp[:3 expected] then
+    hold the triangulation. keep is overwritten (which slots are taken).
+    """
+    cdef int cap = keep.shape[0], n_m = sites_m.shape[0], n_tri_m = tv_m.shape[0] // 3, n_holes = holes.shape[0]
+    cdef int t, k, e, o, a, b, h, F, q, head = 0, tail = 0, count = cap - n_holes, status = OK
+    cdef int32_t[::1] slot_m = np.full(max(n_tri_m, 1), -1, np.int32)
+    cdef int32_t[::1] local = np.full(n + 1, -1, np.int32)        # site -> seam site
+    cdef int32_t[::1] vedge = np.full(n_m + 1, -1, np.int32)
+    cdef int32_t[::1] across = np.full(max(3 * n_tri_m, 1), -1, np.int32)   # seam half-edge -> kept twin
+    cdef int32_t[::1] queue = np.empty(max(n_tri_m, 1), np.int32)
+    if tv.shape[0] != 3 * cap or opp.shape[0] != 3 * cap or not 0 <= gap_lo <= gap_hi <= cap:
+        raise ValueError("join: tv, opp and keep disagree")
+    with nogil:
+        for k in range(n_m):
+            local[sites_m[k]] = k
+        local[n] = n_m
+        for e in range(3 * n_tri_m):
+            if tv_m[e] != n_m:
+                vedge[tv_m[e]] = e
+
+        # each edge between a triangle not kept and a kept one: its reverse in the seam's triangulation is
+        # where the fill starts, and the fill does not cross it
+        for q in range(n_holes):
+            t = holes[q]
+            if gap_lo <= t < gap_hi:
+                continue
+            for k in range(3):
+                e = opp[3 * t + k]              # the kept side, a->b
+                if not keep[e // 3]:
+                    continue
+                a = local[tv[e]]
+                b = local[tv[3 * (e // 3) + (e % 3 + 1) % 3]]
+                if a < 0 or b < 0:
+                    status = NOT_AN_EDGE
+                    break
+                if b != n_m:
+                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], b, a)
+                else:
+                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], a, b)
+                    h = opp_m[h] if h >= 0 else -1
+                if h < 0 or across[h] >= 0:
+                    status = NOT_AN_EDGE
+                    break
+                across[h] = e
+                if slot_m[h // 3] < 0:
+                    slot_m[h // 3] = 0
+                    queue[tail] = h // 3
+                    tail += 1
+            if status != OK:
+                break
+
+        # no kept triangle at all: the seam's triangulation is the whole of it
+        if status == OK and count == 0:
+            for t in range(n_tri_m):
+                slot_m[t] = 0
+                queue[tail] = t
+                tail += 1
+
+        # the fill: the seam's triangles reached from those edges, never across them
+        while status == OK and head < tail:
+            t = queue[head]
+            head += 1
+            for k in range(3):
+                if across[3 * t + k] >= 0:
+                    continue
+                o = opp_m[3 * t + k] // 3
+                if slot_m[o] < 0:
+                    slot_m[o] = 0
+                    queue[tail] = o
+                    tail += 1
+        if status == OK and (count + tail != expected or tail > n_holes):
+            status = WRONG_COUNT
+        if status == OK:
+            # the reached triangles into the holes, linked to each other and to the kept ones
+            for k in range(tail):
+                slot_m[queue[k]] = holes[k]
+                keep[holes[k]] = 1
+            for k in range(tail):
+                t = queue[k]
+                F = holes[k]
+                for e in range(3):
+                    a = tv_m[3 * t + e]
+                    tv[3 * F + e] = n if a == n_m else sites_m[a]
+                    h = across[3 * t + e]
+                    if h >= 0:
+                        opp[3 * F + e] = h
+                        opp[h] = 3 * F + e
+                    else:
+                        o = opp_m[3 * t + e]
+                        opp[3 * F + e] = 3 * slot_m[o // 3] + o % 3
+            # repeated sites: the holes still free below expected take the triangles from there on
+            k = tail
+            t = cap - 1
+            while k < n_holes and holes[k] < expected:
+                while not keep[t]:
+                    t -= 1
+                F = holes[k]
+                for e in range(3):
+                    tv[3 * F + e] = tv[3 * t + e]
+                    o = opp[3 * t + e]
+                    opp[3 * F + e] = o
+                    opp[o] = 3 * F + e
+                keep[F] = 1
+                keep[t] = 0
+                k += 1
+                t -= 1
+    return status
