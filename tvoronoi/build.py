@@ -28,6 +28,7 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
     engines.check_box_scale(box, e)
     with build_arrays():
         t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads)
+        pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
