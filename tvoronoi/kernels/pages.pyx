@@ -10,7 +10,9 @@ and resizes it in place (mremap); smaller arrays come from malloc as before. An 
 that made it, so arrays that outlive the build are freed correctly whenever they are.
 
 In the checked build (AddressSanitizer) every array comes from malloc, so that the sanitizer sees them.
-``trim_heap()`` hands back what the C library's heap holds freed (the kernels' own scratch comes from
+While a build runs, freed mappings (up to 32 MiB) are kept and given to the next large arrays, resized in
+place: their pages are resident already, where a fresh mapping's are faulted in and zeroed by the kernel.
+They are unmapped when the last ``mapped()`` block ends. ``trim_heap()`` hands back what the C library's heap holds freed (the kernels' own scratch comes from
 malloc); a build calls it between phases.
 """
 
@@ -36,12 +38,111 @@ cdef extern from *:
     #define TV_MAP_MIN ((size_t) 1 << 20)
     #define TV_HUGE_MIN ((size_t) 4 << 20)
 
+    #if TV_MAPS
+    /* Mappings freed during a build are kept (up to TV_KEEP_BYTES) and given to the next large
+       arrays, resized in place by the page tables (mremap): their pages are resident already, where a
+       fresh mapping's must be faulted in and zeroed by the kernel, a third of a build's time on a
+       virtual machine. They are unmapped when the last build leaves (tv_depth back to 0). */
+    #include <pthread.h>
+    #include <unistd.h>
+    #define TV_KEEP_SLOTS 16
+    #define TV_KEEP_BYTES ((size_t) 32 << 20)
+    static pthread_mutex_t tv_lock = PTHREAD_MUTEX_INITIALIZER;
+    static char* tv_kept[TV_KEEP_SLOTS];
+    static size_t tv_kept_len[TV_KEEP_SLOTS];
+    static int tv_n_kept = 0;
+    static size_t tv_kept_bytes = 0;
+    static int tv_depth = 0;
+
+    /* a kept mapping for len bytes: the smallest that holds them, else the largest (grown); NULL if none */
+    static char* tv_reuse(size_t len, size_t* had) {
+        int k, best = -1;
+        char* p;
+        pthread_mutex_lock(&tv_lock);
+        for (k = 0; k < tv_n_kept; k++) {
+            if (best < 0) { best = k; continue; }
+            if (tv_kept_len[k] >= len ? (tv_kept_len[best] < len || tv_kept_len[k] < tv_kept_len[best])
+                                      : (tv_kept_len[best] < len && tv_kept_len[k] > tv_kept_len[best]))
+                best = k;
+        }
+        if (best < 0) { pthread_mutex_unlock(&tv_lock); return NULL; }
+        p = tv_kept[best];
+        *had = tv_kept_len[best];
+        tv_kept_bytes -= tv_kept_len[best];
+        tv_n_kept--;
+        tv_kept[best] = tv_kept[tv_n_kept];
+        tv_kept_len[best] = tv_kept_len[tv_n_kept];
+        pthread_mutex_unlock(&tv_lock);
+        return p;
+    }
+
+    /* keep a freed mapping for reuse if a build is running and there is room; else unmap it */
+    static void tv_release(char* p, size_t len) {
+        pthread_mutex_lock(&tv_lock);
+        if (tv_depth > 0 && tv_n_kept < TV_KEEP_SLOTS && tv_kept_bytes + len <= TV_KEEP_BYTES) {
+            tv_kept[tv_n_kept] = p;
+            tv_kept_len[tv_n_kept] = len;
+            tv_n_kept++;
+            tv_kept_bytes += len;
+            pthread_mutex_unlock(&tv_lock);
+            return;
+        }
+        pthread_mutex_unlock(&tv_lock);
+        munmap(p, len);
+    }
+
+    static void tv_enter(void) {
+        pthread_mutex_lock(&tv_lock);
+        tv_depth++;
+        pthread_mutex_unlock(&tv_lock);
+    }
+
+    static void tv_leave(void) {
+        int k, n;
+        char* gone[TV_KEEP_SLOTS];
+        size_t gone_len[TV_KEEP_SLOTS];
+        pthread_mutex_lock(&tv_lock);
+        n = 0;
+        if (--tv_depth == 0) {
+            for (k = 0; k < tv_n_kept; k++) { gone[k] = tv_kept[k]; gone_len[k] = tv_kept_len[k]; }
+            n = tv_n_kept;
+            tv_n_kept = 0;
+            tv_kept_bytes = 0;
+        }
+        pthread_mutex_unlock(&tv_lock);
+        for (k = 0; k < n; k++) munmap(gone[k], gone_len[k]);
+    }
+    #else
+    static void tv_enter(void) {}
+    static void tv_leave(void) {}
+    #endif
+
     static void* tv_block(size_t n, int zeroed) {
         char* p;
-        size_t len = n + TV_HEAD;
+        size_t len = n + TV_HEAD, had = 0;
         if (len < n) return NULL;
     #if TV_MAPS
         if (len >= TV_MAP_MIN) {
+    #if defined(MREMAP_MAYMOVE)
+            p = tv_reuse(len, &had);
+            if (p != NULL && had != len) {
+                char* q = (char*) mremap(p, had, len, MREMAP_MAYMOVE);
+                if (q == MAP_FAILED) { munmap(p, had); p = NULL; }
+                else p = q;
+            }
+    #else
+            p = NULL;
+    #endif
+            if (p != NULL) {
+                if (zeroed) {
+                    /* the old pages hold old data up to their end; a part grown past them is fresh */
+                    size_t page = (size_t) sysconf(_SC_PAGESIZE), used = (had + page - 1) / page * page;
+                    memset(p, 0, used < len ? used : len);
+                }
+                ((size_t*) p)[0] = len;
+                ((size_t*) p)[1] = n;
+                return p + TV_HEAD;
+            }
             p = (char*) mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
             if (p == MAP_FAILED) return NULL;
     #ifdef MADV_HUGEPAGE
@@ -71,7 +172,7 @@ cdef extern from *:
         if (ptr == NULL) return;
         p = (char*) ptr - TV_HEAD;
     #if TV_MAPS
-        if (((size_t*) p)[0] != 0) { munmap(p, ((size_t*) p)[0]); return; }
+        if (((size_t*) p)[0] != 0) { tv_release(p, ((size_t*) p)[0]); return; }
     #endif
         free(p);
     }
@@ -122,6 +223,8 @@ cdef extern from *:
     PyDataMem_Handler tv_handler
     int TV_MAPS
     int tv_trim() nogil
+    void tv_enter() nogil
+    void tv_leave() nogil
 
 cdef extern from "numpy/arrayobject.h":
     void _import_array() except *
@@ -137,10 +240,12 @@ MAPS = bool(TV_MAPS)
 def mapped():
     """Arrays made in this block (in this thread or task) come from the mapping handler above."""
     old = PyDataMem_SetHandler(HANDLER)
+    tv_enter()
     try:
         yield
     finally:
         PyDataMem_SetHandler(old)
+        tv_leave()
 
 
 def trim_heap():
