@@ -6,9 +6,9 @@ cells are timed one after the other, in interleaved repeats (the median is repor
   order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
   tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep), then for the
             incremental engine its sites and triangles renumbered along a Z-curve. From
-            halves.SPLIT_MIN_SITES sites on, the incremental engine goes by halves (tvoronoi.halves):
-            each half ordered, triangulated and renumbered on its own thread, then joined; its order
-            is then part of tri, and its order column reads "-"
+            halves.SPLIT_MIN_SITES sites on, both engines go by halves (tvoronoi.halves): each half
+            ordered, triangulated and renumbered on its own thread, then joined; the order is then
+            part of tri, and the order column reads "-"
   dual      the Voronoi half-edge structure and its correctly rounded vertices
   cells     clipping every cell to the box and gathering the cells into input order
 
@@ -67,7 +67,7 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
         k0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         t0 = time.perf_counter()
         e = engines.scale_exponent(pts)
-        by_halves = engine == "incremental" and len(pts) >= halves.SPLIT_MIN_SITES
+        by_halves = len(pts) >= halves.SPLIT_MIN_SITES
         if by_halves:  # each half is ordered and triangulated on its own thread: one figure for both
             t1 = t0
             t = build.triangulation(pts, e, engine=engine, insertion="brio", seed=0, threads=threads)
@@ -220,8 +220,8 @@ def report(rows: list[dict], info: dict) -> str:
         f"Machine: {describe_machine(info)}",
         "",
         "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
-        "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells (by halves, the incremental "
-        "engine orders each half within tri: order reads -). The other tools are "
+        "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells (by halves, each half is "
+        "ordered within tri: order reads -). The other tools are "
         "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
         "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
         "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process. System: the "

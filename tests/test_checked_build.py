@@ -38,10 +38,12 @@ def test_checked_incremental_family(checked, family):
     assert build_only(checked, {"family": family, "engine": "incremental"}) == "ok"
 
 
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize("family", list(adversarial.FAMILIES))
-def test_checked_incremental_family_by_halves(checked, family):
-    """The same families cut in two, triangulated on two threads and joined (tvoronoi.halves)."""
-    assert build_only(checked, {"family": family, "engine": "incremental", "split_min": 3}) == "ok"
+def test_checked_family_by_halves(checked, family, engine):
+    """The same families cut in two, each half triangulated on a thread of its own, and joined
+    (tvoronoi.halves), by either engine."""
+    assert build_only(checked, {"family": family, "engine": engine, "split_min": 3}) == "ok"
 
 
 @pytest.mark.parametrize("fixture", sorted(FIXTURES))

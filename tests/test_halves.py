@@ -50,12 +50,12 @@ def split_always(monkeypatch):
     return joins
 
 
-def whole(pts, bbox=None, threads=1):
+def whole(pts, bbox=None, threads=1, engine="incremental"):
     """The build of one triangulation of all the sites (no halves)."""
     saved = halves.SPLIT_MIN_SITES
     halves.SPLIT_MIN_SITES = 1 << 62
     try:
-        return api.voronoi(pts, bbox=bbox, threads=threads)
+        return api.voronoi(pts, bbox=bbox, threads=threads, engine=engine)
     finally:
         halves.SPLIT_MIN_SITES = saved
 
@@ -65,15 +65,15 @@ def assert_same_diagram(a, b) -> None:
         assert np.array_equal(getattr(a, name), getattr(b, name)), f"{name} differs"
 
 
-def check_by_halves(pts, bbox=None, joins=None) -> None:
-    """The build by halves: exactly Delaunay, valid cells equal to one triangulation's, and the same
-    Diagram on 1, 2 and 3 threads."""
-    d = api.voronoi(pts, bbox=bbox, threads=2)
+def check_by_halves(pts, bbox=None, joins=None, engine="incremental") -> None:
+    """The build by halves: exactly Delaunay, valid cells equal to one triangulation's (of either engine),
+    and the same Diagram on 1, 2 and 3 threads."""
+    d = api.voronoi(pts, bbox=bbox, threads=2, engine=engine)
     for check in CHECKS.values():  # exactly Delaunay; cells valid, distinct points, a tiling of the box
         check(d)
     check_same_cells(cells_of(whole(pts, bbox)), cells_of(d), names=("whole", "halves"))
     for threads in (1, 3):
-        assert_same_diagram(d, api.voronoi(pts, bbox=bbox, threads=threads))
+        assert_same_diagram(d, api.voronoi(pts, bbox=bbox, threads=threads, engine=engine))
     if joins is not None:
         assert all(joins), "a join reported a defect and the build fell back to one triangulation"
 
@@ -92,17 +92,19 @@ WHOLE_FAMILIES = {
 }
 
 
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize("name", sorted(adversarial.FAMILIES))
-def test_every_family_by_halves(name, split_always):
+def test_every_family_by_halves(name, engine, split_always):
     case = adversarial.make(name)
-    check_by_halves(case.points, case.bbox, split_always)
+    check_by_halves(case.points, case.bbox, split_always, engine)
     if name not in WHOLE_FAMILIES and not name.startswith("sites_"):
         assert split_always, "the build did not go by halves"
 
 
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize("name", sorted(DATASETS))
-def test_datasets_by_halves(name, split_always):
-    check_by_halves(DATASETS[name], joins=split_always)
+def test_datasets_by_halves(name, engine, split_always):
+    check_by_halves(DATASETS[name], joins=split_always, engine=engine)
 
 
 def lattice_disk(r: int, centre=(0, 0)) -> np.ndarray:
@@ -134,47 +136,55 @@ SEAM_CASES = {
 }
 
 
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize("name", sorted(SEAM_CASES))
-def test_seam_cases(name, split_always):
-    check_by_halves(SEAM_CASES[name], joins=split_always)
+def test_seam_cases(name, engine, split_always):
+    check_by_halves(SEAM_CASES[name], joins=split_always, engine=engine)
 
 
 @settings(max_examples=60, deadline=None)
 @given(
     st.lists(st.tuples(st.integers(-6, 6), st.integers(-6, 6)), min_size=3, max_size=120),
     st.sampled_from([1.0, 0.1, 2.0**-30, 1e9]),
+    st.sampled_from(["incremental", "fortune"]),
 )
-def test_hypothesis_small_integer_sites(coords, unit):
+def test_hypothesis_small_integer_sites(coords, unit, engine):
     """Small integer grids (cocircular sites everywhere, many on the median lines) scaled by a unit."""
     pts = np.array(coords, float) * unit
     saved = halves.SPLIT_MIN_SITES
     halves.SPLIT_MIN_SITES = 3
     try:
-        check_by_halves(pts)
+        check_by_halves(pts, engine=engine)
     finally:
         halves.SPLIT_MIN_SITES = saved
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.integers(8, 400), st.sampled_from(["uniform", "gaussian", "clustered"]))
-def test_hypothesis_random_sites_rounded(seed, n, dist):
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(8, 400),
+    st.sampled_from(["uniform", "gaussian", "clustered"]),
+    st.sampled_from(["incremental", "fortune"]),
+)
+def test_hypothesis_random_sites_rounded(seed, n, dist, engine):
     """Random sites rounded to a few decimals, as instruments give them."""
     pts = np.round(generate(dist, n, seed=seed), 2)
     saved = halves.SPLIT_MIN_SITES
     halves.SPLIT_MIN_SITES = 3
     try:
-        check_by_halves(pts)
+        check_by_halves(pts, engine=engine)
     finally:
         halves.SPLIT_MIN_SITES = saved
 
 
-def test_a_large_build_goes_by_halves_and_threads_agree():
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_a_large_build_goes_by_halves_and_threads_agree(engine):
     """At the real threshold: the build by halves on 1 and 2 threads is the same Diagram, with the same
     cells as one triangulation."""
     pts = generate("clustered", halves.SPLIT_MIN_SITES + 5000, seed=3)
     e = engines.scale_exponent(pts)
-    assert halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e) is not None
-    one, two = api.voronoi(pts, threads=1), api.voronoi(pts, threads=2)
+    assert halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e, engine=engine) is not None
+    one, two = api.voronoi(pts, threads=1, engine=engine), api.voronoi(pts, threads=2, engine=engine)
     assert_same_diagram(one, two)
     w = whole(pts)
     assert np.array_equal(w.cell_offsets, two.cell_offsets)

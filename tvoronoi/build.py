@@ -36,10 +36,11 @@ def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: in
 
 def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed: int, threads: int):
     """The triangulation of checked points, scaled by 2^-e, laid out for the dual: by halves
-    (tvoronoi.halves) for the incremental engine in BRIO order from SPLIT_MIN_SITES sites on, whatever the
-    thread count, else whole (triangulate_and_lay_out)."""
-    if engine == "incremental" and insertion == "brio" and len(pts) >= halves.SPLIT_MIN_SITES:
-        t = halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e, seed=seed, threads=threads)
+    (tvoronoi.halves) from SPLIT_MIN_SITES sites on, whatever the thread count (Fortune's sweep, or the
+    incremental engine in BRIO order), else whole (triangulate_and_lay_out)."""
+    if (engine == "fortune" or insertion == "brio") and len(pts) >= halves.SPLIT_MIN_SITES:
+        sx, sy = np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e)
+        t = halves.triangulate(sx, sy, e, engine=engine, seed=seed, threads=threads)
         if t is not None:
             return t
     s = engines.prepare(

@@ -1,5 +1,5 @@
-"""The incremental engine on two halves of the sites: each half ordered, triangulated and renumbered on its
-own thread, then the two joined along the seam between them (kernels/seam.pyx).
+"""An engine on two halves of the sites: each half ordered, triangulated and renumbered on its own thread,
+then the two joined along the seam between them (kernels/seam.pyx).
 
 The cut, each half's order and the join read the sites alone, never the thread count: the same
 triangulation, numbered the same way, on one thread or two. A build takes this path from
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.kernels import incremental, order, renumber, seam
+from tvoronoi.kernels import renumber, seam
 
 # fewer sites: one triangulation (two halves and a seam cost more than they save on two threads)
 SPLIT_MIN_SITES = 1 << 16
@@ -78,6 +78,7 @@ class Joined:
 
 
 def half(
+    engine: str,
     xs,
     ys,
     rows,
@@ -93,8 +94,8 @@ def half(
     first.. of ``out``, their triangles at its start (first == 0, the left half) or at its end; mark the
     triangles it keeps (other_box: the other half's bounding box). Returns the slots its triangles take
     (lo, hi), or None when its sites are collinear."""
-    s = engines.prepare(xs[rows], ys[rows], engine="incremental", seed=seed, threads=threads, exponent=0)
-    t = engines.triangulate(s, engine="incremental")
+    s = engines.prepare(xs[rows], ys[rows], engine=engine, seed=seed, threads=threads, exponent=0)
+    t = engines.triangulate(s, engine=engine)
     if t.tv is None or t.opp is None:
         return None
     n, k, n_tri = len(xs), len(rows), len(t.tv) // 3
@@ -125,7 +126,9 @@ def box(xs: np.ndarray, ys: np.ndarray, rows: np.ndarray) -> tuple[float, float,
     return float(x.min()), float(y.min()), float(x.max()), float(y.max())
 
 
-def triangulate(xs: np.ndarray, ys: np.ndarray, exponent: int, *, seed: int = 0, threads: int = 1):
+def triangulate(
+    xs: np.ndarray, ys: np.ndarray, exponent: int, *, engine: str = "incremental", seed: int = 0, threads: int = 1
+):
     """The Delaunay triangulation of scaled sites (input order) by halves, renumbered for the dual.
 
     Returns an engines.Triangulation whose ``sites.perm`` maps its sites to input rows, or None when the
@@ -149,31 +152,45 @@ def triangulate(xs: np.ndarray, ys: np.ndarray, exponent: int, *, seed: int = 0,
             # the right half on a second thread, in this context (the build's arrays are made as here)
             rows, other, first = jobs[1]
             job = pool.submit(
-                contextvars.copy_context().run, half, xs, ys, rows, other, c, out, first, seed=seed, threads=each
+                contextvars.copy_context().run,
+                half,
+                engine,
+                xs,
+                ys,
+                rows,
+                other,
+                c,
+                out,
+                first,
+                seed=seed,
+                threads=each,
             )
             rows, other, first = jobs[0]
-            slots = [half(xs, ys, rows, other, c, out, first, seed=seed, threads=each), job.result()]
+            slots = [half(engine, xs, ys, rows, other, c, out, first, seed=seed, threads=each), job.result()]
     else:
-        slots = [half(xs, ys, rows, other, c, out, first, seed=seed, threads=1) for rows, other, first in jobs]
+        slots = [half(engine, xs, ys, rows, other, c, out, first, seed=seed, threads=1) for rows, other, first in jobs]
     left, right = slots
     if left is None or right is None:
         return None
-    return joined(out, left[1], right[0], exponent, seed)
+    return joined(out, left[1], right[0], exponent, seed, engine)
 
 
-def joined(out: Joined, gap_lo: int, gap_hi: int, exponent: int, seed: int) -> engines.Triangulation | None:
-    """The two halves joined: the seam sites triangulated, then seam.join in place."""
+def joined(
+    out: Joined, gap_lo: int, gap_hi: int, exponent: int, seed: int, engine: str
+) -> engines.Triangulation | None:
+    """The two halves joined: the seam sites triangulated (by the same engine), then seam.join in place."""
     n = len(out.xs)
     sites_m = np.flatnonzero(out.seam).astype(np.int32)
-    sites_m = sites_m[order.brio_order(out.xs[sites_m], out.ys[sites_m], seed)]
-    status, tv_m, opp_m, _ = incremental.triangulate(
-        np.ascontiguousarray(out.xs[sites_m]), np.ascontiguousarray(out.ys[sites_m])
+    m = engines.triangulate(
+        engines.prepare(out.xs[sites_m], out.ys[sites_m], engine=engine, seed=seed, exponent=0), engine=engine
     )
-    if status != incremental.STATUS_OK:
+    if m.tv is None or m.opp is None:
         return None  # the seam sites are collinear
+    sites_m = sites_m[m.sites.perm]  # seam site k, in the engine's order, is site sites_m[k]
+    tv_m, opp_m = m.tv, m.opp
     expected = 2 * int(np.count_nonzero(out.dup < 0)) - 2
     holes = np.flatnonzero(out.keep == 0).astype(np.int32)  # the triangles not kept, and the gap
     if seam.join(out.tv, out.opp, out.keep, holes, gap_lo, gap_hi, n, tv_m, opp_m, sites_m, expected) != seam.STATUS_OK:
         return None  # a defect: the tests hunt for it; the whole triangulation is still right
     sites = engines.Sites(exponent, out.perm, out.xs, out.ys)
-    return engines.Triangulation("incremental", sites, out.tv[: 3 * expected], out.opp[: 3 * expected], out.dup)
+    return engines.Triangulation(engine, sites, out.tv[: 3 * expected], out.opp[: 3 * expected], out.dup)

@@ -131,17 +131,22 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
                 seam[u] = 1; seam[w] = 1
 
 
-cdef inline int edge_from(const int32_t* tv, const int32_t* opp, const int32_t* vedge, int a, int b) noexcept nogil:
-    """The half-edge a->b of a triangulation (a finite), found around a from vedge[a]; -1 if none."""
-    cdef int e0 = vedge[a], e = e0
+cdef inline int edge_from(const int32_t* tv, const int32_t* opp, const int32_t* vedge, int a, int b,
+                          int most) noexcept nogil:
+    """The half-edge a->b of a triangulation (a finite), found around a from vedge[a] in at most ``most``
+    steps (a site has fewer neighbours than there are sites; a broken triangulation cannot loop here);
+    -1 if none."""
+    cdef int e0 = vedge[a], e = e0, steps = 0
     if e0 < 0:
         return -1
-    while True:
+    while steps < most:
         if tv[nxt(e)] == b:
             return e
         e = opp[prv(e)]             # the next half-edge out of a
         if e == e0:
             return -1
+        steps += 1
+    return -1
 
 
 def join(int32_t[::1] tv, int32_t[::1] opp, signed char[::1] keep, const int32_t[::1] holes, int gap_lo,
@@ -190,9 +195,9 @@ def join(int32_t[::1] tv, int32_t[::1] opp, signed char[::1] keep, const int32_t
                     status = NOT_AN_EDGE
                     break
                 if b != n_m:
-                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], b, a)
+                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], b, a, n_m + 1)
                 else:
-                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], a, b)
+                    h = edge_from(&tv_m[0], &opp_m[0], &vedge[0], a, b, n_m + 1)
                     h = opp_m[h] if h >= 0 else -1
                 if h < 0 or across[h] >= 0:
                     status = NOT_AN_EDGE
