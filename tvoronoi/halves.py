@@ -114,9 +114,8 @@ def half(
     else:
         out.dup[mine] = -1
     del t
-    seam.kept_triangles(
-        out.xs, out.ys, tv, n, c.split, c.axis, first == 0, *other_box, out.keep[lo : lo + n_tri], out.seam
-    )
+    keep = out.keep[lo : lo + n_tri]
+    seam.kept_triangles(out.xs, out.ys, tv, opp, lo, n, c.split, c.axis, first == 0, *other_box, keep, out.seam)
     return lo, lo + n_tri
 
 

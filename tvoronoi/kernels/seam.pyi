@@ -8,6 +8,8 @@ def kept_triangles(
     xs: np.ndarray,
     ys: np.ndarray,
     tv: np.ndarray,
+    opp: np.ndarray,
+    first: int,
     inf: int,
     split: float,
     axis: int,

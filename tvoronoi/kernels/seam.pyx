@@ -6,14 +6,17 @@ right half the others. Each half's Delaunay triangulation is made on its own; th
   1. kept_triangles: a triangle of one half whose closed circumdisk lies strictly on its own side of the
      line holds no site of the other half in or on its circle, so it is a Delaunay triangle of all the
      sites, and so is every triangle on the same circle (all of the circle's sites are in its half, and
-     the half triangulated their whole polygon). An infinite triangle is kept when the other half's
-     bounding box lies strictly inside its hull edge: that edge is then a hull edge of all the sites.
+     the half triangulated their whole polygon). The test, in doubles, may keep one triangle of such a
+     circle and not the next: a triangle on the same circle as a neighbour not kept is then not kept
+     either. An infinite triangle is kept when the other half's bounding box lies strictly inside its
+     hull edge: that edge is then a hull edge of all the sites.
   2. the seam sites (marked by kept_triangles): the sites of the triangles not kept. Every triangle of the whole triangulation that is
      not kept has its corners among them (near such a corner, a kept triangle would overlap it).
   3. join: the triangulation of the seam sites (made by the caller) is kept where the halves kept
      nothing. Each edge between a kept triangle and one not kept is an edge of it: the kept circle
-     through its ends is empty, with no site on its far arc, so a circle a little past it through the
-     same ends holds no site at all. A flood fill from those edges, never across them, finds its
+     through its ends is empty, with no site on its far arc (the neighbour not kept is not on it, so
+     no site of its half is; none of the other half is on the circle), so a circle a little past it
+     through the same ends holds no site at all. A flood fill from those edges, never across them, finds its
      triangles in the region not kept; they are Delaunay triangles of all the sites (each lies in a
      polygon of cocircular sites, or is one, whose circle is empty of every site).
 
@@ -25,7 +28,7 @@ import numpy as np
 from libc.math cimport fabs
 from libc.stdint cimport int32_t
 
-from tvoronoi.kernels.predicates cimport orient2d
+from tvoronoi.kernels.predicates cimport incircle, orient2d
 from tvoronoi.kernels.mesh cimport nxt, prv
 
 cdef enum:
@@ -40,8 +43,8 @@ STATUS_OK = OK
 # (|b'|_1 |c'|_1 (|b'|_1 + |c'|_1)) is below TINY, where products of differences could underflow, and
 # triangles whose determinant is below FLAT times its magnitude (nearly flat) are left to the seam:
 # always safe, as keeping is the only decision that needs proof. Above TINY, an underflowed product is
-# off by at most 2^-1074, far below the relative bound. SLACK is 64 units of rounding, over four times
-# the bound derived below.
+# off by at most 2^-1074, far below the relative bound. SLACK is 64 units of rounding, about three
+# times the bound derived below (the error of u counts twice: in the centre and in the radius).
 cdef double EPS = 2.0 ** -53
 cdef double SLACK = 64.0 * 2.0 ** -53
 cdef double FLAT = 2.0 ** -20
@@ -59,7 +62,7 @@ cdef inline bint disk_clear(double ax, double ay, double bx, double by, double c
     most 6 e D + e |d|, each numerator by 7 e D (|b'|_1 + |c'|_1) + e |N|, so once |d| > FLAT D the
     computed u is off in the 1-norm by at most 14 e D (|b'|_1 + |c'|_1) / |d| + |u|_1 (6 e D / |d| + 3 e);
     the centre's coordinate adds e of itself, the final sum 2 e of its terms. SLACK times each term
-    covers all of it more than four times over.
+    covers all of it about three times over.
     """
     cdef double bx_ = bx - ax, by_ = by - ay, cx_ = cx - ax, cy_ = cy - ay
     cdef double nb = fabs(bx_) + fabs(by_), nc = fabs(cx_) + fabs(cy_)
@@ -86,14 +89,15 @@ cdef inline bint disk_clear(double ax, double ay, double bx, double by, double c
     return centre - r - err > split
 
 
-def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, int inf, double split,
-                   int axis, bint below, double ox0, double oy0, double ox1, double oy1, signed char[::1] keep,
-                   signed char[::1] seam):
+def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
+                   int first, int inf, double split, int axis, bint below, double ox0, double oy0, double ox1,
+                   double oy1, signed char[::1] keep, signed char[::1] seam):
     """Which triangles of one half are triangles of the whole triangulation (1) or left to the seam (0).
 
     Parameters
     ----------
-    xs, ys : (n,) float64, the sites; tv : (3 k,) int32, the half's triangles (vertex inf at infinity).
+    xs, ys : (n,) float64, the sites; tv, opp : (3 k,) int32, the half's triangles (vertex inf at
+        infinity) and twins, its triangle t being triangle first + t of the whole (the twins count so).
     split, axis : the line: x = split (axis 0) or y = split (axis 1).
     below : the half lies below the line (its sites' coordinate < split), else on or above it.
     ox0, oy0, ox1, oy1 : the bounding box of the other half's sites.
@@ -101,12 +105,13 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
     seam : (n,) int8, set to 1 at the sites of the triangles not kept (the seam sites; the halves' sites
         are apart, so both halves can mark at once).
     """
-    cdef Py_ssize_t n_tri = tv.shape[0] // 3, t
-    cdef int a, b, c, u, w
+    cdef Py_ssize_t n_tri = tv.shape[0] // 3, t, nt, head = 0, tail = 0
+    cdef int a, b, c, u, w, k, o, d
     cdef double qx[4]
     cdef double qy[4]
-    if keep.shape[0] != n_tri or seam.shape[0] < inf:
-        raise ValueError("kept_triangles: keep must hold one entry a triangle, seam one a site")
+    if keep.shape[0] != n_tri or opp.shape[0] != tv.shape[0] or seam.shape[0] < inf:
+        raise ValueError("kept_triangles: keep must hold one entry a triangle, opp one a half-edge, seam one a site")
+    cdef int32_t[::1] queue = np.empty(max(n_tri, 1), np.int32)
     qx[0] = ox0; qy[0] = oy0; qx[1] = ox1; qy[1] = oy0; qx[2] = ox1; qy[2] = oy1; qx[3] = ox0; qy[3] = oy1
     with nogil:
         for t in range(n_tri):
@@ -129,6 +134,31 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
                        and orient2d(xs[u], ys[u], xs[w], ys[w], qx[3], qy[3]) < 0)
             if not keep[t]:
                 seam[u] = 1; seam[w] = 1
+
+        # degenerate case: cocircular sites. The doubles' verdict differs from one triangle of a circle to
+        # the next (the bound reads the circle from the triangle's first corner), so a kept triangle whose
+        # neighbour not kept is on the same circle (exact in-circle 0) is not kept either, until none is:
+        # the edges between kept triangles and the rest then have no site on the kept circle's far arc
+        for t in range(n_tri):
+            if not keep[t] and tv[3 * t] != inf and tv[3 * t + 1] != inf and tv[3 * t + 2] != inf:
+                queue[tail] = <int32_t> t
+                tail += 1
+        while head < tail:
+            t = queue[head]
+            head += 1
+            for k in range(3):
+                nt = opp[3 * t + k] // 3 - first
+                if not keep[nt]:
+                    continue
+                a = tv[3 * nt]; b = tv[3 * nt + 1]; c = tv[3 * nt + 2]
+                if a == inf or b == inf or c == inf:
+                    continue
+                d = tv[3 * t + (k + 2) % 3]             # the corner of t across the shared edge
+                if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0:
+                    keep[nt] = 0
+                    seam[a] = 1; seam[b] = 1; seam[c] = 1
+                    queue[tail] = <int32_t> nt
+                    tail += 1
 
 
 cdef inline int edge_from(const int32_t* tv, const int32_t* opp, const int32_t* vedge, int a, int b,
