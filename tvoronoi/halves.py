@@ -100,19 +100,26 @@ def half(
         return None
     n, k, n_tri = len(xs), len(rows), len(t.tv) // 3
     lo = 0 if first == 0 else len(out.keep) - n_tri
-    new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
     tv, opp = out.tv[3 * lo : 3 * (lo + n_tri)], out.opp[3 * lo : 3 * (lo + n_tri)]
-    renumber.triangle_order_into(t.tv, t.opp, old_to_new, tv, opp, first, lo, n, threads)
     mine = slice(first, first + k)
-    # (mode "clip": the indices are in range, and numpy buffers take's output in its checking mode)
-    np.take(s.xs, new_to_old, out=out.xs[mine], mode="clip")
-    np.take(s.ys, new_to_old, out=out.ys[mine], mode="clip")
-    np.take(rows[s.perm], new_to_old, out=out.perm[mine], mode="clip")
-    if (t.dup >= 0).any():  # repeated sites: each names a copy that holds the place, in the new numbers
-        dup = t.dup[new_to_old]
-        out.dup[mine] = np.where(dup >= 0, old_to_new[np.maximum(dup, 0)] + first, -1)
+    if engine == "fortune":
+        # the sweep's order and its triangles as they are: stored next to their sites already (a Z-curve
+        # renumbering cost Fortune's builds more than it saved, see engines.spatial)
+        renumber.shifted_into(t.tv, t.opp, k, tv, opp, first, lo, n)
+        out.xs[mine], out.ys[mine], out.perm[mine] = s.xs, s.ys, rows[s.perm]
+        out.dup[mine] = np.where(t.dup >= 0, t.dup + first, -1)
     else:
-        out.dup[mine] = -1
+        new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
+        renumber.triangle_order_into(t.tv, t.opp, old_to_new, tv, opp, first, lo, n, threads)
+        # (mode "clip": the indices are in range, and numpy buffers take's output in its checking mode)
+        np.take(s.xs, new_to_old, out=out.xs[mine], mode="clip")
+        np.take(s.ys, new_to_old, out=out.ys[mine], mode="clip")
+        np.take(rows[s.perm], new_to_old, out=out.perm[mine], mode="clip")
+        if (t.dup >= 0).any():  # repeated sites: each names a copy that holds the place, in the new numbers
+            dup = t.dup[new_to_old]
+            out.dup[mine] = np.where(dup >= 0, old_to_new[np.maximum(dup, 0)] + first, -1)
+        else:
+            out.dup[mine] = -1
     del t
     keep = out.keep[lo : lo + n_tri]
     seam.kept_triangles(out.xs, out.ys, tv, opp, lo, n, c.split, c.axis, first == 0, *other_box, keep, out.seam)

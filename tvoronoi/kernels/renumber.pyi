@@ -21,3 +21,13 @@ def triangle_order_into(
     inf_out: int,
     threads: int = 1,
 ) -> None: ...
+def shifted_into(
+    tv: np.ndarray,
+    opp: np.ndarray,
+    inf: int,
+    tv2: np.ndarray,
+    opp2: np.ndarray,
+    site_base: int,
+    tri_base: int,
+    inf_out: int,
+) -> None: ...
