@@ -105,3 +105,30 @@ def validate(d, *, sites_in_box=True):
     check_dcel(d)
     check_vertices(d)
     check_cells(d, sites_in_box=sites_in_box)
+
+
+# every array of a Diagram, for comparing two builds bit for bit
+FIELDS = (
+    "sites",
+    "site_of",
+    "vertices",
+    "he_origin",
+    "he_twin",
+    "he_next",
+    "he_prev",
+    "he_face",
+    "face_edge",
+    "triangles",
+    "cell_points",
+    "cell_offsets",
+    "cell_vertices",
+)
+
+
+def assert_same_diagram(a, b):
+    """Two Diagrams equal bit for bit: every array (dtype, shape, values) and the box."""
+    for name in FIELDS:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.dtype == y.dtype and x.shape == y.shape, name
+        assert np.array_equal(x, y), f"{name} differs"
+    assert a.bbox == b.bbox

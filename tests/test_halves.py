@@ -5,6 +5,7 @@ Builds take that path from SPLIT_MIN_SITES sites on; these tests lower the thres
 of hard input, small as it is here, is cut in two and joined.
 """
 
+import contextlib
 import math
 from fractions import Fraction
 
@@ -16,38 +17,34 @@ from hypothesis import strategies as st
 from conftest import DATASETS
 from tests import adversarial
 from tests.exact_checks import CHECKS, cells_of, check_same_cells
+from tests.invariants import assert_same_diagram
 from tvoronoi import api, engines, halves
 from tvoronoi.generators import generate
 from tvoronoi.kernels import seam
 
-ARRAYS = (
-    "site_of",
-    "vertices",
-    "he_origin",
-    "he_twin",
-    "he_face",
-    "face_edge",
-    "triangles",
-    "cell_points",
-    "cell_offsets",
-    "cell_vertices",
-)
 
-
-@pytest.fixture
-def split_always(monkeypatch):
-    """Every build of three sites or more goes by halves; joined() records whether each join held."""
-    monkeypatch.setattr(halves, "SPLIT_MIN_SITES", 3)
+@contextlib.contextmanager
+def split_from_3():
+    """Every build of three sites or more goes by halves; yields the list of whether each join held."""
+    saved, real = halves.SPLIT_MIN_SITES, halves.joined
     joins: list[bool] = []
-    real = halves.joined
 
     def spy(*args, **kwargs):
         t = real(*args, **kwargs)
         joins.append(t is not None)
         return t
 
-    monkeypatch.setattr(halves, "joined", spy)
-    return joins
+    halves.SPLIT_MIN_SITES, halves.joined = 3, spy
+    try:
+        yield joins
+    finally:
+        halves.SPLIT_MIN_SITES, halves.joined = saved, real
+
+
+@pytest.fixture
+def split_always():
+    with split_from_3() as joins:
+        yield joins
 
 
 def whole(pts, bbox=None, threads=1, engine="incremental"):
@@ -58,11 +55,6 @@ def whole(pts, bbox=None, threads=1, engine="incremental"):
         return api.voronoi(pts, bbox=bbox, threads=threads, engine=engine)
     finally:
         halves.SPLIT_MIN_SITES = saved
-
-
-def assert_same_diagram(a, b) -> None:
-    for name in ARRAYS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), f"{name} differs"
 
 
 def check_by_halves(pts, bbox=None, joins=None, engine="incremental") -> None:
@@ -146,21 +138,10 @@ def test_seam_cases(name, engine, split_always):
 
 
 def check_split_min_3(pts, engine="incremental") -> None:
-    """check_by_halves with the threshold lowered by hand (hypothesis runs many examples in one test),
+    """check_by_halves with the threshold lowered in the test (hypothesis runs many examples in one),
     and no join falling back."""
-    saved, real = halves.SPLIT_MIN_SITES, halves.joined
-    joins: list[bool] = []
-
-    def spy(*args, **kwargs):
-        t = real(*args, **kwargs)
-        joins.append(t is not None)
-        return t
-
-    halves.SPLIT_MIN_SITES, halves.joined = 3, spy
-    try:
+    with split_from_3() as joins:
         check_by_halves(pts, joins=joins, engine=engine)
-    finally:
-        halves.SPLIT_MIN_SITES, halves.joined = saved, real
 
 
 @settings(max_examples=60, deadline=None)

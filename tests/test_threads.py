@@ -10,35 +10,12 @@ import pytest
 
 import tvoronoi
 from tests import adversarial
+from tests.invariants import assert_same_diagram as assert_same
 from tvoronoi import engines
 from tvoronoi.api import as_bbox, default_bbox
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import generate
 from tvoronoi.kernels import clip, dual
-
-FIELDS = (
-    "sites",
-    "site_of",
-    "vertices",
-    "he_origin",
-    "he_twin",
-    "he_next",
-    "he_prev",
-    "he_face",
-    "face_edge",
-    "triangles",
-    "cell_points",
-    "cell_offsets",
-    "cell_vertices",
-)
-
-
-def assert_same(a, b):
-    for name in FIELDS:
-        x, y = getattr(a, name), getattr(b, name)
-        assert x.dtype == y.dtype and x.shape == y.shape, name
-        assert np.array_equal(x, y), f"{name} differs"
-    assert a.bbox == b.bbox
 
 
 def grid(side: int) -> np.ndarray:
