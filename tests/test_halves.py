@@ -289,3 +289,34 @@ def test_integer_sites_at_the_threshold_join_without_falling_back(seed):
     e = engines.scale_exponent(pts)
     t = halves.triangulate(np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e), e, threads=2)
     assert t is not None
+
+
+def test_an_interrupted_build_stops_its_other_half(monkeypatch):
+    """Ctrl-C reaches the main thread's half; the other half's kernels then stop at their next poll
+    (tvoronoi.kernels.STOPPING) instead of running to their end, and a build afterwards is whole."""
+    import time
+
+    from tvoronoi.kernels import STOPPING
+
+    real, outcomes = halves.half, []
+
+    def half(engine, xs, ys, rows, other, c, out, first, **kw):
+        if first == 0:  # the main thread's half: interrupted while the other half works
+            time.sleep(0.02)
+            raise KeyboardInterrupt
+        try:
+            outcomes.append(real(engine, xs, ys, rows, other, c, out, first, **kw))
+        except KeyboardInterrupt as exc:
+            outcomes.append(exc)
+            raise
+
+    monkeypatch.setattr(halves, "half", half)
+    pts = generate("uniform", 800_000, seed=9)
+    with pytest.raises(KeyboardInterrupt):
+        halves.triangulate(pts[:, 0].copy(), pts[:, 1].copy(), 0, threads=2)
+    assert len(outcomes) == 1 and isinstance(outcomes[0], KeyboardInterrupt), outcomes
+    assert not STOPPING
+    monkeypatch.setattr(halves, "half", real)
+    small = generate("uniform", 3000, seed=9)
+    with split_from_3() as joins:
+        check_by_halves(small, joins=joins)

@@ -9,13 +9,15 @@ SPLIT_MIN_SITES sites on (tvoronoi.build).
 from __future__ import annotations
 
 import contextvars
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.kernels import renumber, seam
+from tvoronoi.kernels import STOPPING, renumber, seam
 
 # fewer sites: one triangulation (two halves and a seam cost more than they save on two threads)
 SPLIT_MIN_SITES = 1 << 16
@@ -153,32 +155,46 @@ def triangulate(
         (rows_r, box(xs, ys, rows_l), len(rows_l)),
     )
     if threads >= 2:
-        each = threads // 2
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            # the right half on a second thread, in this context (the build's arrays are made as here)
-            rows, other, first = jobs[1]
-            job = pool.submit(
-                contextvars.copy_context().run,
-                half,
-                engine,
-                xs,
-                ys,
-                rows,
-                other,
-                c,
-                out,
-                first,
-                seed=seed,
-                threads=each,
-            )
-            rows, other, first = jobs[0]
-            slots = [half(engine, xs, ys, rows, other, c, out, first, seed=seed, threads=each), job.result()]
+        slots = on_two_threads(
+            [
+                partial(half, engine, xs, ys, rows, other, c, out, first, seed=seed, threads=threads // 2)
+                for rows, other, first in jobs
+            ]
+        )
     else:
         slots = [half(engine, xs, ys, rows, other, c, out, first, seed=seed, threads=1) for rows, other, first in jobs]
     left, right = slots
     if left is None or right is None:
         return None
     return joined(out, left[1], right[0], exponent, seed, engine)
+
+
+def on_two_threads(calls: list):
+    """[calls[0](), calls[1]()], the second on a second thread, in this context (a build's arrays are made
+    there as here). If the first raises (Ctrl-C), the second thread's kernels are asked to stop at their
+    next poll (tvoronoi.kernels.STOPPING) rather than run to their end before the exception goes on."""
+    ident: list[int] = []
+    stopped = threading.Event()
+
+    def second():
+        ident.append(threading.get_ident())
+        if stopped.is_set():  # asked to stop before it started
+            raise KeyboardInterrupt("the build this thread works for was interrupted")
+        return calls[1]()
+
+    try:
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            job = pool.submit(contextvars.copy_context().run, second)
+            try:
+                first = calls[0]()
+            except BaseException:
+                stopped.set()
+                job.cancel()
+                STOPPING.update(ident)
+                raise
+            return [first, job.result()]
+    finally:
+        STOPPING.difference_update(ident)
 
 
 def joined(
