@@ -42,6 +42,25 @@ def can_fork() -> bool:
     )
 
 
+# the signals a batch stops on, held while it forks
+_HELD = (signal.SIGINT, signal.SIGTERM)
+
+
+def _hold_signals():
+    """Block Ctrl-C and SIGTERM (pending ones wait); returns the mask to restore, or None where signal
+    masks are not available."""
+    if not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+
+
+def _release_signals(held) -> None:
+    """Restore the mask _hold_signals saved: a signal that came meanwhile has its handler run now
+    (pthread_sigmask runs pending handlers before it returns)."""
+    if held is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
 class ForkedPart:
     """Runs ``write_part(file)`` in a forked child, into a temporary file, while the caller goes on.
 
@@ -59,9 +78,14 @@ class ForkedPart:
             raise
         sys.stdout.flush()
         sys.stderr.flush()
+        # Ctrl-C and SIGTERM wait while the process forks: a handler run inside fork's own hooks
+        # (logging's, in the parent) has its exception ignored, and the batch would go on as if
+        # never signalled. They are delivered once the child is known, below.
+        held = _hold_signals()
         try:
             pid = os.fork()
         except OSError:
+            _release_signals(held)
             for fd in (read_end, write_end):
                 os.close(fd)
             self.part.close()
@@ -70,6 +94,7 @@ class ForkedPart:
             os.close(read_end)
             status, report = 1, _TVORONOI + b" the second half of the output failed"
             try:
+                _release_signals(held)
                 signal.signal(signal.SIGINT, signal.SIG_DFL)
                 with os.fdopen(os.dup(self.part.fileno()), "wb", buffering=WRITE_BUFFER) as file:
                     count = write_part(file)
@@ -87,6 +112,11 @@ class ForkedPart:
                     os._exit(status)
         os.close(write_end)
         self.pid, self.reports = pid, read_end
+        try:
+            _release_signals(held)  # a signal that came meanwhile raises here: stop the child too
+        except BaseException:
+            self.abandon()
+            raise
 
     def append_to(self, stream: BinaryIO) -> int:
         """Append the child's part to ``stream`` as the child writes it, then the rest once it has
