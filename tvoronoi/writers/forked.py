@@ -42,23 +42,47 @@ def can_fork() -> bool:
     )
 
 
-# the signals a batch stops on, held while it forks
+# the signals a batch stops on, deferred while it forks
 _HELD = (signal.SIGINT, signal.SIGTERM)
 
 
-def _hold_signals():
-    """Block Ctrl-C and SIGTERM (pending ones wait); returns the mask to restore, or None where signal
-    masks are not available."""
-    if not hasattr(signal, "pthread_sigmask"):
-        return None
-    return signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+def _hold_signals() -> tuple[dict, list]:
+    """Defer Ctrl-C and SIGTERM: until _release_signals their handlers are replaced by one that only
+    notes them. (Blocking them would not do: a signal sent to the process reaches whichever thread
+    does not block it, such as the kernels' OpenMP threads, and Python runs the handler on the main
+    thread all the same.) Returns the handlers to restore and the list of signals noted."""
+    noted: list[int] = []
+
+    def note(signum, frame) -> None:
+        noted.append(signum)
+
+    saved = {}
+    for s in _HELD:
+        try:
+            saved[s] = signal.signal(s, note)
+        except (ValueError, OSError):  # not the main thread, or not settable here
+            pass
+    return saved, noted
 
 
-def _release_signals(held) -> None:
-    """Restore the mask _hold_signals saved: a signal that came meanwhile has its handler run now
-    (pthread_sigmask runs pending handlers before it returns)."""
-    if held is not None:
-        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+def _restore_signals(held: tuple[dict, list]) -> list[int]:
+    """Put the handlers back; returns the signals noted meanwhile that their handlers would act on."""
+    saved, noted = held
+    for s, handler in saved.items():
+        signal.signal(s, handler)
+    return [s for s in dict.fromkeys(noted) if saved.get(s) not in (signal.SIG_IGN, None)]
+
+
+def _deliver(signals: list[int], held: tuple[dict, list]) -> None:
+    """Run the restored handler of each signal noted (it raises, as it would have), or for the default
+    disposition send the signal again."""
+    saved, _ = held
+    for s in signals:
+        handler = saved[s]
+        if callable(handler):
+            handler(s, None)
+        else:
+            signal.raise_signal(s)
 
 
 class ForkedPart:
@@ -85,7 +109,7 @@ class ForkedPart:
         try:
             pid = os.fork()
         except OSError:
-            _release_signals(held)
+            _deliver(_restore_signals(held), held)
             for fd in (read_end, write_end):
                 os.close(fd)
             self.part.close()
@@ -94,7 +118,7 @@ class ForkedPart:
             os.close(read_end)
             status, report = 1, _TVORONOI + b" the second half of the output failed"
             try:
-                _release_signals(held)
+                _restore_signals(held)  # (what came before the fork is the parent's to act on)
                 signal.signal(signal.SIGINT, signal.SIG_DFL)
                 with os.fdopen(os.dup(self.part.fileno()), "wb", buffering=WRITE_BUFFER) as file:
                     count = write_part(file)
@@ -112,11 +136,10 @@ class ForkedPart:
                     os._exit(status)
         os.close(write_end)
         self.pid, self.reports = pid, read_end
-        try:
-            _release_signals(held)  # a signal that came meanwhile raises here: stop the child too
-        except BaseException:
+        came = _restore_signals(held)
+        if came:  # a signal came meanwhile: stop the child, then act on it as its handler would have
             self.abandon()
-            raise
+            _deliver(came, held)
 
     def append_to(self, stream: BinaryIO) -> int:
         """Append the child's part to ``stream`` as the child writes it, then the rest once it has
