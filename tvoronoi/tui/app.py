@@ -32,7 +32,7 @@ from tvoronoi.api import ENGINES
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import DISTRIBUTIONS, generate
 from tvoronoi.readers.pointset import PointSet
-from tvoronoi.tui import editing, playback
+from tvoronoi.tui import editing, playback, terminal
 from tvoronoi.tui.building import BUILD_THREAD_MIN_SITES, Box, BuildFailed, Building, Built, Clock, DiagramReady
 from tvoronoi.tui.canvas import DiagramCanvas
 from tvoronoi.tui.commands import app_commands
@@ -259,6 +259,7 @@ class VoronoiApp(App[int]):
         yield Footer(show_command_palette=False)
 
     def on_mount(self) -> None:
+        terminal.watch(self)  # exit when the terminal hangs up (a closed SSH session)
         self._show_parameters(DEFAULT_DISTRIBUTION)
         self.query_one("#progress").display = False
         self.timeline.display = False
