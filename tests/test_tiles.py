@@ -149,6 +149,71 @@ def test_certification_is_exact_at_the_margin():
     assert certified(np.empty((0, 2)), np.array([0, 0]), site, (0.0, 0.0, 0.0, 0.0))[0]
 
 
+def _exact_room_holds(ring: np.ndarray, site, region, top: float) -> bool:
+    """Exactly, in rationals: every ring point v, moved by up to two ulps of ``top`` in each coordinate
+    (its rounding, with room to spare), is farther inside the region than from the site."""
+    from fractions import Fraction
+
+    u = 2 * Fraction(float(np.spacing(top)))
+    sx, sy = Fraction(float(site[0])), Fraction(float(site[1]))
+    for vx, vy in ring.tolist():
+        vx, vy = Fraction(vx), Fraction(vy)
+        rooms = [
+            vx - Fraction(region[0]) if math.isfinite(region[0]) else None,
+            vy - Fraction(region[1]) if math.isfinite(region[1]) else None,
+            Fraction(region[2]) - vx if math.isfinite(region[2]) else None,
+            Fraction(region[3]) - vy if math.isfinite(region[3]) else None,
+        ]
+        if all(v is None for v in rooms):
+            continue
+        room = min(v for v in rooms if v is not None)
+        room -= u  # the exact point may lie u nearer a side
+        reach = (abs(vx - sx) + u) ** 2 + (abs(vy - sy) + u) ** 2  # and u farther from the site in each coordinate
+        if room < 0 or room * room < reach:
+            return False
+    return True
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    scale=st.sampled_from([1e-300, 1e-160, 1e-8, 1.0, 1e8, 1e150, 1e300]),
+    k=st.integers(1, 8),
+)
+def test_hunt_certification_agrees_with_exact_rationals(seed, scale, k):
+    # rings of k points near a site, regions whose sides pass near the ring: whatever the test certifies
+    # holds exactly, at every scale (tiny distances whose squares underflow, huge ones that overflow)
+    rng = np.random.default_rng(seed)
+    site = rng.normal(size=2) * scale
+    ring = site + rng.normal(size=(k, 2)) * scale
+    r = float(np.max(np.hypot(ring[:, 0] - site[0], ring[:, 1] - site[1])))
+    x0, y0, x1, y1 = (
+        float(v)
+        for v in (ring.min(axis=0) - r * rng.uniform(0.9, 1.1, 2)).tolist()
+        + (ring.max(axis=0) + r * rng.uniform(0.9, 1.1, 2)).tolist()
+    )
+    sides = [x0, y0, x1, y1]
+    # sides at the edge of the test: as near the ring as its distances, in doubles
+    dist = np.hypot(ring[:, 0] - site[0], ring[:, 1] - site[1])
+    edge = [np.min(ring[:, 0] - dist), np.min(ring[:, 1] - dist), np.max(ring[:, 0] + dist), np.max(ring[:, 1] + dist)]
+    for i in range(4):
+        chance = rng.random()
+        if chance < 0.2:
+            sides[i] = -math.inf if i < 2 else math.inf
+        elif chance < 0.6:
+            sides[i] = float(edge[i]) * (1 + (1 if i < 2 else -1) * float(rng.choice([0, 1e-15, 1e-13, 1e-11]))) - (
+                1 if i < 2 else -1
+            ) * float(rng.choice([0, 1, 4, 64])) * float(np.spacing(np.max(np.abs(ring))))
+    region = tuple(sides)
+    ok = certified(ring, np.array([0, k]), site[None], region)[0]
+    if ok and np.all(np.isfinite(ring)):
+        top = float(np.max(np.abs(ring)))
+        assert _exact_room_holds(ring, site, region, top)
+    # a region whose side runs through a ring point never certifies it
+    through = (float(ring[0, 0]), -math.inf, math.inf, math.inf)
+    assert not certified(ring, np.array([0, k]), site[None], through)[0] or np.all(ring[:, 0] == site[0])
+
+
 @settings(max_examples=200, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), k=st.integers(3, 40))
 def test_hunt_certified_cells_are_final(seed, k):
@@ -179,12 +244,10 @@ def test_hunt_certified_cells_are_final(seed, k):
             assert np.array_equal(ring, full.cell_polygon(i))
 
 
-def test_certify_cells_in_chunks_agrees_with_one_pass(monkeypatch):
-    # a tile's diagram with halo sites not wanted; certified a few cells at a time, the verdict is the
-    # test of all the wanted rings at once, the kept cells are the whole diagram's and the reaches those
-    # of the failed rings
-    import tvoronoi.tiles as tiles
-
+def test_certify_cells_agrees_with_the_test_of_gathered_rings():
+    # a tile's diagram with halo sites not wanted; certified where the diagram holds the rings, the
+    # verdict is the test of the wanted rings gathered, the kept cells are the whole diagram's and the
+    # reaches those of the failed rings
     pts = generate("gaussian", 6_000, seed=21)
     rects = kd_rects(pts, 4)
     region = grown(rects[1], 0.05)
@@ -192,7 +255,6 @@ def test_certify_cells_in_chunks_agrees_with_one_pass(monkeypatch):
     want = tile_of(pts[seen, 0], pts[seen, 1], rects) == 1
     box = (-6.0, -6.0, 6.0, 6.0)
     d = tvoronoi.voronoi(pts[seen], bbox=box, threads=1)
-    monkeypatch.setattr(tiles, "CERTIFY_CHUNK", 37)
     verdict = certify_cells(d, pts[seen], want, region)
     rows = np.flatnonzero(want)
     rings = [d.cell_polygon(i) for i in rows]

@@ -33,8 +33,6 @@ SAMPLE_PER_TILE = 1000
 # of the test itself (each at most 2^-53), and ulps for the rounding of a ring's point.
 CERTIFY_RELATIVE = 2.0**-40
 CERTIFY_ULPS = 2.0
-# Cells certified per numpy pass (``certify_cells``): their ring points' temporaries stay a few MiB.
-CERTIFY_CHUNK = 1 << 15
 # Rounds after which a tile sees everything: its region doubles each round, so this bounds nothing
 # in practice; it guards against a region that stops growing (a halo of 0).
 MAX_ROUNDS = 64
@@ -160,50 +158,37 @@ def certified(ring_xy: np.ndarray, offsets: np.ndarray, sites: np.ndarray, regio
 
     Most cells are settled without the test at each point: the room to the nearest side changes by at
     most |v - s| between s and v, so room(s) >= 2 max |v* - s| implies the test at every v*; the site's
-    room and the farthest distance carry the same margins as above.
+    room and the farthest distance carry the same margins as above. The test runs in one compiled pass
+    over the rings (``kernels.certify``); its distances are sqrt(dx^2 + dy^2), hypot where the squares
+    could underflow or overflow, within a few units of 2^-53.
     """
+    offsets = np.ascontiguousarray(offsets, np.int64)
     n_cells = len(offsets) - 1
-    lengths = np.diff(offsets)
-    if len(ring_xy) == 0:
-        return np.ones(n_cells, bool)
-    vx, vy = ring_xy[:, 0], ring_xy[:, 1]
-    with np.errstate(over="ignore", invalid="ignore"):
-        radius = np.hypot(vx - np.repeat(sites[:, 0], lengths), vy - np.repeat(sites[:, 1], lengths))
-        # the ulp of the largest coordinate bounds every point's (ulps grow with magnitude)
-        top = max(float(np.abs(vx).max()), float(np.abs(vy).max()))
-        slack = 2 * CERTIFY_ULPS * float(np.spacing(top)) + 4 * float(np.spacing(0.0))
-        # most cells lie far from every side: room(v) >= room(s) - |v - s| (the room to the nearest side
-        # moves no faster than the point), so a cell whose site has twice its farthest point's distance
-        # as room passes the test below at every point; the computed room of the site errs by one
-        # rounding, covered by the same relative slack
-        ok = np.ones(n_cells, bool)
-        has = lengths > 0
-        farthest = np.zeros(n_cells)
-        farthest[has] = np.maximum.reduceat(radius, offsets[:-1][has])
-        site_room = _room(sites[:, 0], sites[:, 1], region)
-        easy = np.isfinite(farthest) & (
-            site_room * (1 - CERTIFY_RELATIVE) - slack >= 2 * (farthest * (1 + CERTIFY_RELATIVE) + slack)
-        )
-        if easy.all():
-            return ok
-        hard = np.repeat(~easy, lengths)
-        need = radius[hard] * (1 + CERTIFY_RELATIVE) + slack
-        room = _room(vx[hard], vy[hard], region)
-        # a non-finite point or distance is never certified (NaN compares false)
-        passed = np.isfinite(need) & (room * (1 - CERTIFY_RELATIVE) - slack >= need)
-    owner = np.repeat(np.arange(n_cells), lengths)[hard]
-    bad = np.bincount(owner[~passed], minlength=n_cells)
-    return bad == 0
+    return _certify(
+        offsets, np.arange(len(ring_xy), dtype=np.int32), ring_xy, sites, np.arange(n_cells, dtype=np.int64), region
+    )
 
 
-def _room(xs: np.ndarray, ys: np.ndarray, region: Region) -> np.ndarray:
-    """How far each point lies inside the region from its nearest finite side (inf: no finite side)."""
-    x0, y0, x1, y1 = region
-    room = np.full(len(xs), np.inf)
-    for side, value, inward in ((x0, xs, True), (y0, ys, True), (x1, xs, False), (y1, ys, False)):
-        if not math.isinf(side):
-            np.minimum(room, (value - side) if inward else (side - value), out=room)
-    return room
+def _certify(
+    offsets: np.ndarray, vertices: np.ndarray, points: np.ndarray, sites: np.ndarray, rows: np.ndarray, region: Region
+) -> np.ndarray:
+    """(len(rows),) bool: ``certified`` for the cells of ``rows`` of rings given as CSR offsets into vertex
+    numbers of ``points``; ``sites`` indexed by row."""
+    from tvoronoi.kernels.certify import certify_rings
+
+    ok = np.zeros(len(rows), np.uint8)
+    certify_rings(
+        np.ascontiguousarray(offsets, np.int64),
+        np.ascontiguousarray(vertices, np.int32),
+        np.ascontiguousarray(points, np.float64).reshape(-1, 2),
+        np.ascontiguousarray(sites, np.float64).reshape(-1, 2),
+        np.ascontiguousarray(rows, np.int64),
+        (float(region[0]), float(region[1]), float(region[2]), float(region[3])),
+        CERTIFY_RELATIVE,
+        CERTIFY_ULPS,
+        ok,
+    )
+    return ok.view(bool)
 
 
 def flower_box(ring_xy: np.ndarray, sites: np.ndarray) -> Region:
@@ -316,38 +301,19 @@ def certify_cells(diagram, pts: np.ndarray, want: np.ndarray, region: Region, *,
     """Certify the cells of the ``want`` rows of a tile's diagram (as ``build_tile``, without gathering
     their rings: a writer takes the kept cells from the diagram a row group at a time).
 
-    The rings are read ``CERTIFY_CHUNK`` cells at a time, so the test's temporaries stay a few MiB that
-    the heap reuses, instead of a dozen arrays the size of every ring point mapped and faulted afresh.
+    The test reads the rings where the diagram holds them, in one compiled pass (``certified``).
     """
     rows = np.flatnonzero(want)
     if everything or len(rows) == 0:
         return Verdict(rows, np.empty(0, np.int64), np.empty((0, 4)))
     offsets = diagram.cell_offsets
-    ok = np.empty(len(rows), bool)
-    for a in range(0, len(rows), CERTIFY_CHUNK):
-        chunk = rows[a : a + CERTIFY_CHUNK]
-        first, last = int(chunk[0]), int(chunk[-1]) + 1
-        ring_xy, chunk_offsets = _rings_of(diagram, first, last, want[first:last])
-        ok[a : a + len(chunk)] = certified(ring_xy, chunk_offsets, pts[chunk], region)
+    ok = _certify(offsets, diagram.cell_vertices, diagram.cell_points, pts, rows, region)
     failed = rows[~ok]
     reaches = np.empty((len(failed), 4))
     for j, i in enumerate(failed.tolist()):
         ring = diagram.cell_points[diagram.cell_vertices[offsets[i] : offsets[i + 1]]]
         reaches[j] = flower_box(ring, np.repeat(pts[i][None], len(ring), axis=0))
     return Verdict(rows[ok], failed, reaches)
-
-
-def _rings_of(diagram, first: int, last: int, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The rings of the rows first..last-1 of a diagram where ``keep`` holds: (ring_xy, offsets)."""
-    all_offsets = diagram.cell_offsets[first : last + 1]
-    lengths = np.diff(all_offsets)
-    vertices = diagram.cell_vertices[all_offsets[0] : all_offsets[-1]]
-    if not keep.all():
-        vertices = vertices[np.repeat(keep, lengths)]
-        lengths = lengths[keep]
-    offsets = np.zeros(len(lengths) + 1, np.int64)
-    np.cumsum(lengths, out=offsets[1:])
-    return np.take(diagram.cell_points, vertices, axis=0), offsets
 
 
 def group_reaches(pending: np.ndarray, reaches: np.ndarray, margin: float) -> list[tuple[np.ndarray, Region]]:

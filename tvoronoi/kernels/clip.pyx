@@ -13,12 +13,8 @@ from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
     finish_ring, first_right_turn, turn, convex_ring,
 )
+from tvoronoi.kernels.prefetch cimport prefetch
 
-cdef extern from *:
-    """
-    #define TV_CLIP_PREFETCH(p) __builtin_prefetch((const void*)(p))
-    """
-    void prefetch "TV_CLIP_PREFETCH"(const void* p) noexcept nogil
 
 cdef enum:
     HAS = 1

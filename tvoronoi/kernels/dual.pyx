@@ -9,12 +9,8 @@ from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
+from tvoronoi.kernels.prefetch cimport prefetch
 
-cdef extern from *:
-    """
-    #define TV_PREFETCH(p) __builtin_prefetch((const void*)(p))
-    """
-    void prefetch "TV_PREFETCH"(const void* p) noexcept nogil
 
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
