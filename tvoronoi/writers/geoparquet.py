@@ -266,45 +266,40 @@ def _padded_cells(pa, diagram, ra: int, rb: int, keep: np.ndarray, present: np.n
 
         | pad(3) 01 03000000 01000000 n | x0 y0 | x1 y1 | ... | x0 y0 | pad(3) 01 ...
 
-    so the points are gathered from the diagram's positions into the slots in one ``take`` (a
-    header's slot gathers a placeholder, then gets its header), where unpadded WKB would need
-    each byte placed on its own.
+    so the points go from the diagram's positions straight into the slots, with each ring's bounding
+    box, in one compiled pass (``kernels.rings``), and a header's slot then gets its header, where
+    unpadded WKB would need each byte placed on its own.
     """
+    from tvoronoi.kernels.rings import gather_slotted_rings
+
     offsets = diagram.cell_offsets
-    lengths = np.diff(offsets[ra : rb + 1])
-    ring = diagram.cell_vertices[offsets[ra] : offsets[rb]]
-    if not keep.all():
-        ring = ring[np.repeat(keep, lengths)]
-        lengths = lengths[keep]
+    lengths = np.diff(offsets[ra : rb + 1])[keep]
     k = len(lengths)
-    stops = np.cumsum(lengths)
-    starts = stops - lengths
-    # before each ring a header slot (a placeholder index), after it its first point again
-    where = np.empty((k, 2), np.int64)
-    where[:, 0], where[:, 1] = starts, stops
-    what = np.empty((k, 2), ring.dtype)
-    what[:, 0], what[:, 1] = 0, ring[starts]
-    index = np.insert(ring, where.ravel(), what.ravel())
-    positions = np.ascontiguousarray(diagram.cell_points, "<f8").view("<c16").ravel()
-    slots = np.take(positions, index)
+    # before each ring a header slot, after it its first point again
+    header_at = np.zeros(k, np.int64)
+    np.cumsum(lengths[:-1] + 2, out=header_at[1:])
+    slots = np.empty(int(lengths.sum()) + 2 * k, "<c16")
+    kept_mins, kept_maxs = np.empty((k, 2)), np.empty((k, 2))
+    gather_slotted_rings(
+        offsets,
+        diagram.cell_vertices,
+        np.ascontiguousarray(diagram.cell_points, "<f8"),
+        ra,
+        rb,
+        np.ascontiguousarray(keep, np.uint8),
+        slots.view("<f8").reshape(-1, 2),
+        kept_mins,
+        kept_maxs,
+    )
     # the headers: the point count includes the closing point
-    header_at = starts + 2 * np.arange(k)
     headers = np.zeros((k, 16), np.uint8)
     headers[:, WKB_PAD : WKB_PAD + 9] = np.frombuffer(WKB_POLYGON_RING, np.uint8)
     headers[:, WKB_PAD + 9 :] = (lengths + 1).astype("<u4").view(np.uint8).reshape(-1, 4)
     slots[header_at] = headers.view("<c16").ravel()
-    # the bboxes from each ring's points: reduceat over (first point, next header) pairs, the
-    # sums over the pairs' gaps (a header) dropped
-    xy = slots.view("<f8").reshape(-1, 2)
     mins = np.full((len(present), 2), np.nan)
     maxs = np.full((len(present), 2), np.nan)
-    if k:
-        pairs = np.empty((k, 2), np.int64)
-        pairs[:, 0] = header_at + 1
-        pairs[:, 1] = header_at + lengths + 2
-        cuts = pairs.ravel()[:-1]
-        mins[present] = np.minimum.reduceat(xy, cuts, axis=0)[::2]
-        maxs[present] = np.maximum.reduceat(xy, cuts, axis=0)[::2]
+    mins[present] = kept_mins
+    maxs[present] = kept_maxs
     sizes = np.zeros(len(present), np.int64)
     sizes[present] = 16 * (lengths + 2)
     value_offsets = np.zeros(len(present) + 1, np.int64)
