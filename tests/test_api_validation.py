@@ -4,10 +4,13 @@ voronoi, DynamicVoronoi, lloyd and steps share the checks of points, box and eng
 --bbox and --engine use the same ones (their CLI spelling: tests/test_cli.py).
 """
 
+import math
 import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import exact_checks
 import tvoronoi
@@ -211,3 +214,18 @@ def test_check_range_fast_path_agrees_with_every_value_compared():
             with pytest.raises(CoordinateRangeError) as info:
                 check_range(pts, e)
             assert info.value.rows[0] == expected[0]
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=1, max_size=12),
+    more=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), max_size=4),
+)
+def test_scale_exponent_is_that_of_the_largest_magnitude(values, more):
+    # the exponent of the largest |v| over every array given, whichever sign it has (two passes, no
+    # temporary, against the reference: frexp of the largest absolute value)
+    from tvoronoi.engines import scale_exponent
+
+    arrays = [np.array(values), np.array(more)]
+    top = max(abs(v) for v in values + more)
+    assert scale_exponent(*arrays) == (math.frexp(top)[1] if top > 0 else 0)

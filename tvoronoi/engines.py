@@ -30,8 +30,14 @@ def scale_exponent(*values) -> int:
     overflow and underflow at any scale. For a batch diagram only the sites set it: a box far larger
     or smaller than the sites costs no precision, within the limits of check_box_scale.
     """
-    top = max((float(np.abs(np.asarray(v, np.float64)).max()) for v in values if np.size(v)), default=0.0)
+    top = max((_largest_magnitude(np.asarray(v, np.float64)) for v in values if np.size(v)), default=0.0)
     return math.frexp(top)[1] if top > 0 else 0
+
+
+def _largest_magnitude(v: np.ndarray) -> float:
+    """max |v| from two passes without a temporary (NaN if v holds one)."""
+    lo, hi = float(v.min()), float(v.max())
+    return lo if math.isnan(lo) else max(-lo, hi)
 
 
 def check_box_scale(box, e: int) -> None:
