@@ -68,14 +68,17 @@ def time_threads(n: int, repeats: int = 3) -> dict:
 
     pts = np.random.default_rng(5).random((n, 2))
     out: dict = {"n": n}
+    runs: dict[int, list[float]] = {1: [], 2: []}
     for threads in (1, 2):
         tvoronoi.voronoi(pts[:10_000], threads=threads)
-        times = []
-        for _ in range(repeats):
+    for _ in range(repeats):  # interleaved, so that a slow spell of the machine falls on both
+        for threads in (1, 2):
             t0 = time.perf_counter()
             tvoronoi.voronoi(pts, threads=threads)
-            times.append(time.perf_counter() - t0)
-        out[f"threads_{threads}"] = statistics.median(times)
+            runs[threads].append(time.perf_counter() - t0)
+    for threads in (1, 2):
+        out[f"threads_{threads}"] = statistics.median(runs[threads])
+        out[f"threads_{threads}_runs"] = runs[threads]
     # two tiles in two threads, each built with threads=1 (halo: 4 spacings)
     box = default_bbox(pts)
     rects = kd_rects(pts[:: max(1, n // 2000)], 2)
@@ -120,6 +123,13 @@ def one_process(n: int) -> dict:
     if run.returncode != 0:
         raise RuntimeError(run.stderr)
     return {**json.loads(run.stdout.strip().splitlines()[-1]), "load_before": load, "load_after": os.getloadavg()[0]}
+
+
+def _median_run(runs: list[dict], key: str) -> dict | None:
+    """The run whose ``key`` is the median of the runs (the lower middle one of an even count)."""
+    if not runs:
+        return None
+    return sorted(runs, key=lambda r: r[key])[(len(runs) - 1) // 2]
 
 
 def _worker_peak() -> float:
@@ -234,7 +244,8 @@ def report(
         ratio = threads["threads_2"] / threads["threads_1"]
         tiles_ratio = threads["tiles_in_2_threads"] / threads["threads_1"]
         lines += [
-            f"## threads at {threads['n']:,} uniform sites (median of 3)",
+            f"## threads at {threads['n']:,} uniform sites (median of {len(threads.get('threads_1_runs', [0] * 3))}, "
+            "threads=1 and threads=2 interleaved)",
             "",
             "| build | seconds | vs threads=1 |",
             "| --- | --- | --- |",
@@ -245,6 +256,11 @@ def report(
             f"{tiles_ratio:.2f} |",
             "",
         ]
+        if "threads_1_runs" in threads:
+            each = ", ".join(
+                f"{a:.3f} / {b:.3f} = {b / a:.2f}" for a, b in zip(threads["threads_1_runs"], threads["threads_2_runs"])
+            )
+            lines += [f"Each round, threads=1 / threads=2 in seconds: {each}.", ""]
     if cluster and n and not one:
         lines += [
             f"## {n:,} uniform sites out of core: {workers} Dask workers, no one-process run",
@@ -282,6 +298,16 @@ def report(
             f"Parallel efficiency: {efficiency:.0%} (t_one / ({workers} x t_cluster)).",
             "",
         ]
+        if "runs" in one and "runs" in cluster:
+            each = ", ".join(
+                f"{a:.1f} / {b:.1f} s = {a / (workers * b):.0%}" for a, b in zip(one["runs"], cluster["runs"])
+            )
+            lines += [
+                f"The rows above are the median runs of {len(one['runs'])}, one process and cluster interleaved. "
+                f"Each pair, one process / cluster and its efficiency: {each}; efficiency of the medians "
+                f"{statistics.median(one['runs']) / (workers * statistics.median(cluster['runs'])):.0%}.",
+                "",
+            ]
         if "cpu" in one and "worker_cpu" in cluster:
             spent = sum(cluster["worker_cpu"]) + cluster["scheduler_client_cpu"]
             lines += [
@@ -323,6 +349,9 @@ def main(argv=None) -> int:
         action="store_true",
         help="skip the one-process run (for sizes one process cannot hold, such as 10^8: the out-of-core run)",
     )
+    parser.add_argument(
+        "--repeats", type=int, default=1, help="runs of the one process and the cluster, interleaved; medians"
+    )
     parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "results" / "cluster"))
     parser.add_argument("--report-only", action="store_true", help="rewrite OUT.md from OUT.json (no run)")
     args = parser.parse_args(argv)
@@ -342,12 +371,21 @@ def main(argv=None) -> int:
     print(json.dumps(threads), flush=True)
     n = parse_sizes(args.cluster_n)[0] if args.cluster_n != "0" else None
     one = cluster = None
+    ones: list[dict] = []
+    clusters: list[dict] = []
     if n:
-        if not args.no_one_process:
-            one = one_process(n)
-            print(json.dumps(one), flush=True)
-        cluster = on_cluster(n, args.workers, args.tiles)
-        print(json.dumps(cluster), flush=True)
+        for _ in range(args.repeats):  # interleaved: one process, then the cluster, then again
+            if not args.no_one_process:
+                ones.append(one_process(n))
+                print(json.dumps(ones[-1]), flush=True)
+            clusters.append(on_cluster(n, args.workers, args.tiles))
+            print(json.dumps(clusters[-1]), flush=True)
+        one = _median_run(ones, "total")
+        cluster = _median_run(clusters, "seconds")
+        if cluster is not None and len(clusters) > 1:
+            cluster = {**cluster, "runs": [c["seconds"] for c in clusters]}
+        if one is not None and len(ones) > 1:
+            one = {**one, "runs": [o["total"] for o in ones]}
     out = Path(args.out)
     atomic_write(
         out.with_suffix(".json"),
