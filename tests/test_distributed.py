@@ -448,3 +448,26 @@ def test_cli_names_a_csv_file_that_cannot_be_parsed(tmp_path, capsys):
     assert main(["batch", str(tmp_path / "points-*.csv"), "-o", str(tmp_path / "cells"), "--dask", "local:1"]) == 2
     err = capsys.readouterr().err
     assert f"{path}: cannot be read (ParserError: " in err and "line 15001" in err, err
+
+
+def test_a_rounds_units_go_to_the_threads_as_they_free_up(client):
+    # every unit's input held by one worker: the scheduler alone would put the units there, where their
+    # data is; handed out as threads free up, each worker runs its share (3 of 6 equal units)
+    import time
+
+    from tvoronoi.distributed import _run_units
+
+    workers = sorted(client.nthreads())
+    assert len(workers) == 2
+    pieces = [[client.scatter(np.zeros(200_000), workers=[workers[0]])] for _ in range(6)]
+
+    def unit(held, g):
+        from distributed import get_worker
+
+        time.sleep(0.3)
+        return get_worker().address, g, None, None
+
+    outputs = _run_units(client, pieces, [(g,) for g in range(6)], "balance-test", run=unit)
+    ran = client.gather([out[0] for out in outputs])
+    assert client.gather([out[1] for out in outputs]) == list(range(6))
+    assert sorted(ran.count(w) for w in workers) == [3, 3], ran

@@ -656,6 +656,47 @@ class _Run:
     rounds: int
     pending_after: list
     triangles_pending_after: list
+    token: str = ""
+
+
+def _run_units(client, pieces: list, calls: list, token: str, run=None) -> list:
+    """Run ``run(pieces[g], *calls[g])`` (``_run_tile`` by default) for every unit g of a round, each on a
+    worker thread as it frees up: [(cells, triangles, pending cells, pending triangles) futures] in unit
+    order.
+
+    Given all at once, the scheduler placed a round's tiles by where their pieces lay, before it knew
+    their cost: 6 of 10 equal tiles on one of two workers, the other then idle for a third of the run.
+    Here each worker thread gets a unit, and the worker that finishes one gets the next (a preference:
+    another worker takes it if that one is gone).
+    """
+    import operator
+
+    from distributed import as_completed
+
+    threads = client.nthreads() if hasattr(client, "nthreads") else {}
+    slots: list = [address for address, count in sorted(threads.items()) for _ in range(count)] or [None]
+    outputs: list = [None] * len(calls)
+    running = as_completed()
+
+    def start(g: int, worker) -> None:
+        where = {} if worker is None else {"workers": [worker], "allow_other_workers": True}
+        whole = client.submit(run or _run_tile, pieces[g], *calls[g], key=f"tvoronoi-tile-{token}-{g}", pure=False, **where)
+        outputs[g] = [
+            client.submit(operator.getitem, whole, j, key=f"tvoronoi-tile-{token}-{g}-{j}", pure=False)
+            for j in range(4)
+        ]
+        running.add(whole)
+        pieces[g] = None  # the task holds them now: each is freed once the task is done
+
+    waiting = list(range(len(calls)))[::-1]  # the next unit last
+    for worker in slots:
+        if waiting:
+            start(waiting.pop(), worker)
+    for done in running:
+        if waiting:
+            held = client.who_has(done).get(done.key, ()) if done.status == "finished" else ()
+            start(waiting.pop(), next(iter(held), None))
+    return outputs
 
 
 def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: np.ndarray) -> _Run:
@@ -668,7 +709,9 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
     units: list[tuple[int, np.ndarray | None, Region | None, str]] = [
         (t, None, None, BOTH) for t in range(plan.n_tiles)
     ]
-    run = _Run([], [], 0, [], [])
+    import uuid
+
+    run = _Run([], [], 0, [], [], token=uuid.uuid4().hex)
     round_ = 0
     while units:
         round_ += 1
@@ -690,15 +733,20 @@ def _rounds(client, plan: Plan, job: Job, parts: list, summaries: list, firsts: 
             )
             for j, u in enumerate(us):
                 pieces[u].append(chosen[j])
-        tasks = []
+        calls = []
         for g, (t, group, _, kind) in enumerate(units):
             name = f"part-r{round_:02d}-t{t:05d}" + ("" if group is None else f"-g{g:05d}")
-            tasks.append(dask.delayed(_run_tile, nout=4)(pieces[g], t, regions[g], group, kind, job, round_, name))
-        k = len(tasks)
-        futures = client.compute([task[j] for j in range(4) for task in tasks])
-        left_cells, left_tris = client.gather(futures[2 * k : 3 * k]), client.gather(futures[3 * k :])
+            calls.append((t, regions[g], group, kind, job, round_, name))
+        flat = client.compute([piece for unit in pieces for piece in unit])
+        starts = np.cumsum([0] + [len(unit) for unit in pieces])
+        ready = [flat[starts[g] : starts[g + 1]] for g in range(len(pieces))]
+        del flat
+        outputs = _run_units(client, ready, calls, f"{run.token}-r{round_}")
+        cells_f = [out[0] for out in outputs]
+        tris_f = [out[1] for out in outputs]
+        left_cells, left_tris = client.gather([out[2] for out in outputs]), client.gather([out[3] for out in outputs])
         next_units: list[tuple[int, np.ndarray | None, Region | None, str]] = []
-        for (t, _, _, kind), cells, tris, lc, lt in zip(units, futures[:k], futures[k : 2 * k], left_cells, left_tris):
+        for (t, _, _, kind), cells, tris, lc, lt in zip(units, cells_f, tris_f, left_cells, left_tris):
             if kind != TRIANGLES:
                 run.cells.append(cells)
                 next_units += [(t, ids, b, CELLS) for ids, b in group_reaches(lc[0], lc[1], plan.margin(t, round_))]
