@@ -250,7 +250,7 @@ def report(
             "| build | seconds | vs threads=1 |",
             "| --- | --- | --- |",
             f"| voronoi(threads=1) | {threads['threads_1']:.3f} | 1.00 |",
-            f"| voronoi(threads=2): OpenMP phases (dual, clip) | {threads['threads_2']:.3f} | {ratio:.2f} |",
+            f"| voronoi(threads=2): the two halves on two threads, then the OpenMP phases (dual, clip) | {threads['threads_2']:.3f} | {ratio:.2f} |",
             f"| two tiles in two Python threads (build_tile, threads=1 each; "
             f"{threads['tiles_pending']} cells left for a second round) | {threads['tiles_in_2_threads']:.3f} | "
             f"{tiles_ratio:.2f} |",

@@ -680,7 +680,9 @@ def _run_units(client, pieces: list, calls: list, token: str, run=None) -> list:
 
     def start(g: int, worker) -> None:
         where = {} if worker is None else {"workers": [worker], "allow_other_workers": True}
-        whole = client.submit(run or _run_tile, pieces[g], *calls[g], key=f"tvoronoi-tile-{token}-{g}", pure=False, **where)
+        whole = client.submit(
+            run or _run_tile, pieces[g], *calls[g], key=f"tvoronoi-tile-{token}-{g}", pure=False, **where
+        )
         outputs[g] = [
             client.submit(operator.getitem, whole, j, key=f"tvoronoi-tile-{token}-{g}-{j}", pure=False)
             for j in range(4)
