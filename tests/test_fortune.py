@@ -124,3 +124,19 @@ def test_property_engines_agree_on_floats(points):
     f = tvoronoi.voronoi(pts, engine="fortune")
     validate(f)
     assert_same_diagram(f, tvoronoi.voronoi(pts, engine="incremental"))
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    rows=st.lists(
+        st.tuples(st.sampled_from([-2.0, -0.0, 0.0, 0.5, 1.0, 3.0]), st.sampled_from([-1.0, -0.0, 0.0, 2.0, 7.5])),
+        min_size=1,
+        max_size=60,
+    )
+)
+def test_sweep_order_is_a_stable_sort_by_y_then_x(rows):
+    # rows of equal y (and repeated points, and both zeros) in any order: the sites come by y, then by x,
+    # then by input row, as a stable sort of y + i x orders them
+    pts = np.array(rows, np.float64)
+    want = np.argsort(pts[:, 1] + 1j * pts[:, 0], kind="stable")
+    assert np.array_equal(sweep_order(pts[:, 0], pts[:, 1]), want)

@@ -106,9 +106,17 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     """Event order of Fortune's sweep: by y, then x (int32)."""
     perm = np.argsort(ys)
     sy = ys[perm]
-    if len(sy) > 1 and np.any(sy[1:] == sy[:-1]):
-        # rows of equal y: order them by x (a complex sort compares real, then imaginary parts)
-        perm = np.argsort(ys + 1j * xs, kind="stable")
+    tie = sy[1:] == sy[:-1]
+    if len(sy) > 1 and tie.any():
+        # rows of equal y: each run ordered by x, then by input row (as a stable sort by (y, x) would);
+        # only the sites in such runs are sorted again
+        tied = np.zeros(len(sy), bool)
+        tied[1:] = tie
+        tied[:-1] |= tie
+        at = np.flatnonzero(tied)
+        run = np.cumsum(np.r_[True, ~tie])[at]  # the run of equal y each tied position is in
+        rows = perm[at]
+        perm[at] = rows[np.lexsort((rows, xs[rows], run))]
     return perm.astype(np.int32)
 
 
