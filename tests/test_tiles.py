@@ -282,3 +282,44 @@ def test_group_reaches_keeps_far_cells_apart_and_joins_overlapping_ones():
     ]
     # a margin that bridges the gap joins all three
     assert [g.tolist() for g, _ in group_reaches(pending, reaches, 5.0)] == [[3, 7, 9]]
+
+
+def test_certification_refuses_a_bound_that_overflows():
+    # near the top of the doubles, room(s) and twice the farthest distance both overflow: inf >= inf must
+    # not certify. Here an exact check finds a ring point nearer a side (5e307) than its site (1.5e308)
+    ring = np.array([[-5e307, 0.0], [1e308, 1.0]])
+    site = np.array([[1e308, 0.0]])
+    assert not certified(ring, np.array([0, 2]), site, (-1e308, -math.inf, math.inf, math.inf))[0]
+    # end to end: a site the region does not hold cuts the cell, which must stay pending
+    pts = np.array([[1e308, 0.0], [-9e307, 0.0], [-1.01e308, 1e308]])
+    box = (-1.7e308, -1.5e308, 1.7e308, 1.5e308)
+    cells = build_tile(
+        pts[[0, 1]], np.array([0, 1]), np.array([True, False]), (-1e308, -math.inf, math.inf, math.inf), box
+    )
+    assert cells.ids.size == 0 and cells.pending.tolist() == [0]
+    full = tvoronoi.voronoi(pts, bbox=box)
+    assert len(full.cell_polygon(0)) == 5
+    # a side that is not a number certifies nothing
+    assert not certified(np.array([[0.1, 0.0]]), np.array([0, 1]), np.array([[0.0, 0.0]]), (-5.0, math.nan, 5.0, 5.0))[
+        0
+    ]
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), k=st.integers(1, 6))
+def test_hunt_certification_near_the_largest_doubles(seed, k):
+    # sites and ring points near +-1.7e308, sides near -+1e308: distances and rooms overflow; whatever the
+    # test certifies holds exactly
+    rng = np.random.default_rng(seed)
+    # the site near one end of the doubles, its finite sides (one or two) near the other, so that its
+    # room overflows; ring points up to the whole range away, so that twice the farthest overflows too
+    site = rng.choice([-1.0, 1.0], 2) * rng.uniform(0.5, 1.7, 2) * 1e308
+    ring = rng.uniform(-1.0, 1.0, (k, 2)) * 1.7e308
+    near = -np.sign(site) * rng.uniform(0.2, 1.7, 2) * 1e308
+    sides = [-math.inf, -math.inf, math.inf, math.inf]
+    for axis in range(2):
+        if rng.random() < 0.7:
+            sides[axis if near[axis] < 0 else axis + 2] = float(near[axis])
+    region = tuple(sides)
+    if certified(ring, np.array([0, k]), site[None], region)[0]:
+        assert _exact_room_holds(ring, site, region, float(np.max(np.abs(ring))))

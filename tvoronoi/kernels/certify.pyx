@@ -1,6 +1,6 @@
 """The tiles' certification of a cell as final, one pass over the diagram's rings (see tiles.certified)."""
 
-from libc.math cimport INFINITY, fabs, hypot, isfinite, nextafter, sqrt
+from libc.math cimport INFINITY, NAN, fabs, hypot, isfinite, nextafter, sqrt
 from libc.stdint cimport int32_t, int64_t, uint8_t
 
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -24,8 +24,11 @@ cdef inline double distance(double dx, double dy) noexcept nogil:
 
 
 cdef inline double room(double x, double y, const double* region) noexcept nogil:
-    # how far (x, y) lies inside the region from its nearest finite side (inf: no finite side)
+    # how far (x, y) lies inside the region from its nearest finite side (inf: no finite side; NaN for a
+    # NaN side, which then certifies nothing); a difference that overflows is larger than any finite need
     cdef double r = INFINITY
+    if region[0] != region[0] or region[1] != region[1] or region[2] != region[2] or region[3] != region[3]:
+        return NAN
     if isfinite(region[0]) and x - region[0] < r:
         r = x - region[0]
     if isfinite(region[1]) and y - region[1] < r:
@@ -85,9 +88,10 @@ def certify_rings(const int64_t[::1] offsets, const int32_t[::1] vertices, const
                 ok[k] = 0               # a non-finite point or distance is never certified
                 continue
             slack = 2 * ulps * (nextafter(top, INFINITY) - top) + 4 * least
-            # most cells lie far from every side: room(v) >= room(s) - |v - s|
-            if (room(sx, sy, box) * (1 - relative) - slack
-                                       >= 2 * (farthest * (1 + relative) + slack)):
+            # most cells lie far from every side: room(v) >= room(s) - |v - s|; the bound must be finite
+            # (an overflowed one would pass against a room that overflowed too)
+            need = 2 * (farthest * (1 + relative) + slack)
+            if isfinite(need) and room(sx, sy, box) * (1 - relative) - slack >= need:
                 ok[k] = 1
                 continue
             good = True
