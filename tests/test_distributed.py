@@ -471,3 +471,22 @@ def test_a_rounds_units_go_to_the_threads_as_they_free_up(client):
     ran = client.gather([out[0] for out in outputs])
     assert client.gather([out[1] for out in outputs]) == list(range(6))
     assert sorted(ran.count(w) for w in workers) == [3, 3], ran
+
+
+def test_a_failing_unit_stops_its_round_at_once(client):
+    # unit 0 fails at once, the others take 2 s each (8 of them on 2 threads: 8 s to run them all): the
+    # error comes back when unit 0 ends, not once every unit has run
+    import time
+
+    from tvoronoi.distributed import _run_units
+
+    def unit(held, g):
+        if g == 0:
+            raise ValueError("unit 0 cannot be built")
+        time.sleep(2.0)
+        return None, None, None, None
+
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="unit 0"):
+        _run_units(client, [[] for _ in range(8)], [(g,) for g in range(8)], "failure-test", run=unit)
+    assert time.perf_counter() - t0 < 4.0

@@ -667,16 +667,18 @@ def _run_units(client, pieces: list, calls: list, token: str, run=None) -> list:
     Given all at once, the scheduler placed a round's tiles by where their pieces lay, before it knew
     their cost: 6 of 10 equal tiles on one of two workers, the other then idle for a third of the run.
     Here each worker thread gets a unit, and the worker that finishes one gets the next (a preference:
-    another worker takes it if that one is gone).
+    another worker takes it if that one is gone). The threads are counted again as units finish, so that
+    workers that join during a round get units too. A unit that fails stops the round at once.
     """
     import operator
+    from collections import Counter
 
     from distributed import as_completed
 
-    threads = client.nthreads() if hasattr(client, "nthreads") else {}
-    slots: list = [address for address, count in sorted(threads.items()) for _ in range(count)] or [None]
     outputs: list = [None] * len(calls)
     running = as_completed()
+    busy: Counter = Counter()  # units started on each worker and not yet done
+    meant: dict = {}  # the worker each running unit was given to
 
     def start(g: int, worker) -> None:
         where = {} if worker is None else {"workers": [worker], "allow_other_workers": True}
@@ -687,17 +689,34 @@ def _run_units(client, pieces: list, calls: list, token: str, run=None) -> list:
             client.submit(operator.getitem, whole, j, key=f"tvoronoi-tile-{token}-{g}-{j}", pure=False)
             for j in range(4)
         ]
+        busy[worker] += 1
+        meant[whole.key] = worker
         running.add(whole)
         pieces[g] = None  # the task holds them now: each is freed once the task is done
 
+    def fill(waiting: list) -> None:
+        # a unit for every free thread of the workers there are now (all to the scheduler's choice while
+        # it names none)
+        threads = client.nthreads() if hasattr(client, "nthreads") else {}
+        if not threads:
+            if not busy:
+                start(waiting.pop(), None)
+            return
+        for worker, count in sorted(threads.items()):
+            while waiting and busy[worker] < count:
+                start(waiting.pop(), worker)
+
     waiting = list(range(len(calls)))[::-1]  # the next unit last
-    for worker in slots:
-        if waiting:
-            start(waiting.pop(), worker)
+    if waiting and hasattr(client, "wait_for_workers"):
+        client.wait_for_workers(1)
+    if waiting:
+        fill(waiting)
     for done in running:
+        if done.status != "finished":
+            done.result()  # raises the unit's error: the round stops here
+        busy[meant.pop(done.key)] -= 1
         if waiting:
-            held = client.who_has(done).get(done.key, ()) if done.status == "finished" else ()
-            start(waiting.pop(), next(iter(held), None))
+            fill(waiting)
     return outputs
 
 
