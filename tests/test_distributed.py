@@ -490,3 +490,30 @@ def test_a_failing_unit_stops_its_round_at_once(client):
     with pytest.raises(ValueError, match="unit 0"):
         _run_units(client, [[] for _ in range(8)], [(g,) for g in range(8)], "failure-test", run=unit)
     assert time.perf_counter() - t0 < 4.0
+
+
+def test_workers_that_join_during_a_round_get_units():
+    # a cluster without workers when the round starts, two joining 0.3 s later: the round waits for them
+    # and runs its units two at a time (one at a time, six units of 0.5 s would take 3 s)
+    import threading
+    import time
+
+    import distributed
+
+    from tvoronoi.distributed import _run_units
+
+    def unit(held, g):
+        time.sleep(0.5)
+        return distributed.get_worker().address, g, None, None
+
+    with distributed.LocalCluster(
+        n_workers=0, processes=False, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        with distributed.Client(cluster) as c:
+            threading.Timer(0.3, lambda: cluster.scale(2)).start()
+            t0 = time.perf_counter()
+            outputs = _run_units(c, [[] for _ in range(6)], [(g,) for g in range(6)], "join-test", run=unit)
+            ran = c.gather([out[0] for out in outputs])
+            elapsed = time.perf_counter() - t0
+    assert len(set(ran)) == 2, ran
+    assert elapsed < 2.7, elapsed
