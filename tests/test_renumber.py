@@ -206,3 +206,55 @@ def test_the_overlapped_build_gives_the_same_diagram(monkeypatch):
     plain = tvoronoi.voronoi(pts, threads=2)
     for name in ("he_origin", "he_twin", "he_face", "face_edge", "vertices", "cell_vertices", "cell_offsets"):
         assert np.array_equal(getattr(overlapped, name), getattr(plain, name)), name
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1, 300),
+    data=st.data(),
+)
+def test_take_sites_is_numpy_indexing_of_both_columns(n, data):
+    """take_sites gathers both coordinates at int32 indices, from strided columns as from contiguous ones."""
+    pts = np.random.default_rng(n).normal(size=(n, 2))
+    idx = np.asarray(data.draw(st.lists(st.integers(0, n - 1), max_size=2 * n)), np.int32)
+    x, y = renumber.take_sites(pts[:, 0], pts[:, 1], idx)  # strided columns
+    assert x.flags.c_contiguous and y.flags.c_contiguous
+    assert np.array_equal(x, pts[idx, 0]) and np.array_equal(y, pts[idx, 1])
+    cx, cy = renumber.take_sites(pts[:, 0].copy(), pts[:, 1].copy(), idx)
+    assert np.array_equal(cx, x) and np.array_equal(cy, y)
+
+
+@pytest.mark.parametrize("bad", [-1, 5, 2**31 - 1])
+def test_take_sites_refuses_an_index_out_of_range(bad):
+    xs = np.arange(5.0)
+    with pytest.raises(IndexError, match="out of range"):
+        renumber.take_sites(xs, xs, np.array([0, bad, 1], np.int32))
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 200), n_rows=st.integers(1, 400), seed=st.integers(0, 2**16))
+def test_sites_into_is_the_three_gathers_it_replaces(n, n_rows, seed):
+    """sites_into writes xs[new_to_old], ys[new_to_old] and rows[perm][new_to_old] into slices of larger
+    arrays, leaving the rest of them alone."""
+    rng = np.random.default_rng(seed)
+    xs, ys = rng.random(n), rng.random(n)
+    rows = rng.integers(0, 10**6, n_rows).astype(np.int32)
+    perm = rng.integers(0, n_rows, n).astype(np.int32)
+    new_to_old = rng.permutation(n).astype(np.int32)
+    ox, oy, orows = np.full(n + 7, -1.0), np.full(n + 7, -1.0), np.full(n + 7, -1, np.int32)
+    renumber.sites_into(xs, ys, rows, perm, new_to_old, ox[3 : 3 + n], oy[3 : 3 + n], orows[3 : 3 + n])
+    assert np.array_equal(ox[3 : 3 + n], xs[new_to_old]) and np.array_equal(oy[3 : 3 + n], ys[new_to_old])
+    assert np.array_equal(orows[3 : 3 + n], rows[perm][new_to_old])
+    assert (ox[:3] == -1).all() and (ox[3 + n :] == -1).all() and (orows[3 + n :] == -1).all()
+
+
+def test_sites_into_refuses_an_index_out_of_range():
+    xs = np.arange(4.0)
+    out = np.empty(4), np.empty(4), np.empty(4, np.int32)
+    ok = np.arange(4, dtype=np.int32)
+    with pytest.raises(IndexError):
+        renumber.sites_into(xs, xs, ok, ok, np.array([0, 1, 2, 4], np.int32), *out)
+    with pytest.raises(IndexError):
+        renumber.sites_into(xs, xs, ok[:3], ok, ok, *out)  # perm names row 3 of 3
+    with pytest.raises(ValueError):
+        renumber.sites_into(xs, xs, ok, ok, ok, np.empty(3), out[1], out[2])

@@ -163,9 +163,13 @@ def prepare(
     xs = np.asarray(xs, np.float64)
     ys = np.asarray(ys, np.float64)
     e = scale_exponent(xs, ys) if exponent is None else exponent
-    sx, sy = np.ldexp(xs, -e), np.ldexp(ys, -e)
+    if e == 0:  # scaled already (tvoronoi.halves), or of unit size: no copy
+        sx, sy = np.ascontiguousarray(xs), np.ascontiguousarray(ys)
+    else:
+        sx, sy = np.ldexp(xs, -e), np.ldexp(ys, -e)
     perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed, threads=threads)
-    return Sites(e, perm, np.ascontiguousarray(sx[perm]), np.ascontiguousarray(sy[perm]))
+    ox, oy = renumber.take_sites(sx, sy, perm)
+    return Sites(e, perm, ox, oy)
 
 
 @dataclass(frozen=True)

@@ -96,7 +96,7 @@ def half(
     first.. of ``out``, their triangles at its start (first == 0, the left half) or at its end; mark the
     triangles it keeps (other_box: the other half's bounding box). Returns the slots its triangles take
     (lo, hi), or None when its sites are collinear."""
-    s = engines.prepare(xs[rows], ys[rows], engine=engine, seed=seed, threads=threads, exponent=0)
+    s = engines.prepare(*renumber.take_sites(xs, ys, rows), engine=engine, seed=seed, threads=threads, exponent=0)
     t = engines.triangulate(s, engine=engine)
     if t.tv is None or t.opp is None:
         return None
@@ -113,10 +113,7 @@ def half(
     else:
         new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
         renumber.triangle_order_into(t.tv, t.opp, old_to_new, tv, opp, first, lo, n, threads)
-        # (mode "clip": the indices are in range, and numpy buffers take's output in its checking mode)
-        np.take(s.xs, new_to_old, out=out.xs[mine], mode="clip")
-        np.take(s.ys, new_to_old, out=out.ys[mine], mode="clip")
-        np.take(rows[s.perm], new_to_old, out=out.perm[mine], mode="clip")
+        renumber.sites_into(s.xs, s.ys, rows, s.perm, new_to_old, out.xs[mine], out.ys[mine], out.perm[mine])
         if (t.dup >= 0).any():  # repeated sites: each names a copy that holds the place, in the new numbers
             dup = t.dup[new_to_old]
             out.dup[mine] = np.where(dup >= 0, old_to_new[np.maximum(dup, 0)] + first, -1)

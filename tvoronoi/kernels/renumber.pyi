@@ -31,3 +31,14 @@ def shifted_into(
     tri_base: int,
     inf_out: int,
 ) -> None: ...
+def take_sites(xs: np.ndarray, ys: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+def sites_into(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    rows: np.ndarray,
+    perm: np.ndarray,
+    new_to_old: np.ndarray,
+    out_x: np.ndarray,
+    out_y: np.ndarray,
+    out_rows: np.ndarray,
+) -> None: ...

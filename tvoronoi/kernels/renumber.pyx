@@ -244,3 +244,55 @@ def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1]
     new_to_old, old_to_new = site_order(xs, ys)
     tv2, opp2 = triangle_order(tv, opp, old_to_new, threads)
     return new_to_old, old_to_new, tv2, opp2
+
+
+def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx):
+    """(xs[idx], ys[idx]) as new contiguous arrays, in one pass, without numpy's widening of the int32
+    indices (xs, ys may be strided: the columns of an (n, 2) array). Raises IndexError if an index is
+    out of range."""
+    cdef Py_ssize_t n = xs.shape[0], m = idx.shape[0], k
+    cdef int32_t i
+    cdef bint bad = False
+    if ys.shape[0] != n:
+        raise ValueError("take_sites: xs and ys differ in length")
+    out_x_arr = np.empty(m, np.float64)
+    out_y_arr = np.empty(m, np.float64)
+    cdef double[::1] out_x = out_x_arr, out_y = out_y_arr
+    with nogil:
+        for k in range(m):
+            i = idx[k]
+            if i < 0 or i >= n:
+                bad = True
+                break
+            out_x[k] = xs[i]
+            out_y[k] = ys[i]
+    if bad:
+        raise IndexError(f"take_sites: index {idx[k]} out of range for {n} sites")
+    return out_x_arr, out_y_arr
+
+
+def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] rows, const int32_t[::1] perm,
+               const int32_t[::1] new_to_old, double[::1] out_x, double[::1] out_y, int32_t[::1] out_rows):
+    """A half's sites in their new order, written into its part of the joined arrays (tvoronoi.halves):
+    out_x[k] = xs[j], out_y[k] = ys[j] and out_rows[k] = rows[perm[j]], j = new_to_old[k]. Raises
+    IndexError if an index is out of range."""
+    cdef Py_ssize_t n = xs.shape[0], m = new_to_old.shape[0], n_rows = rows.shape[0], k
+    cdef int32_t j, r
+    cdef bint bad = False
+    if ys.shape[0] != n or perm.shape[0] != n or out_x.shape[0] != m or out_y.shape[0] != m or out_rows.shape[0] != m:
+        raise ValueError("sites_into: the arrays differ in length")
+    with nogil:
+        for k in range(m):
+            j = new_to_old[k]
+            if j < 0 or j >= n:
+                bad = True
+                break
+            r = perm[j]
+            if r < 0 or r >= n_rows:
+                bad = True
+                break
+            out_x[k] = xs[j]
+            out_y[k] = ys[j]
+            out_rows[k] = rows[r]
+    if bad:
+        raise IndexError("sites_into: an index is out of range")
