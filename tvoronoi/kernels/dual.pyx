@@ -91,7 +91,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
     cdef double[:, ::1] centre
     cdef int32_t[:, ::1] tri
-    cdef int t, e, a, b, c, h = 0, m = 0, n_finite = 0, g, k, lo, hi, count
+    cdef int t, e, a, b, c, h = 0, m = 0, n_finite = 0, n_hull, g, k, lo, hi, count
 
     if n < parallel_min:
         threads = 1
@@ -102,22 +102,33 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         # infinite triangle starts at q). On more than one thread, also what each walk will emit, so
         # that the walks can run apart: one half-edge per Delaunay edge out of the site (counted in
         # h_first), and the vertices of the finite triangles whose smallest site it is (v_first)
-        for t in range(n_tri):
+        # (the finite triangles last to first, so that each site keeps its first half-edge in triangle
+        # order by plain stores, no test of what is there; then the hull's, which take precedence)
+        n_hull = 0
+        for t in range(n_tri - 1, -1, -1):
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             if a == inf or b == inf or c == inf:
-                for e in range(3 * t, 3 * t + 3):
-                    if tv[e] != inf and tv[nxt(e)] != inf:
-                        first_e[tv[nxt(e)]] = opp[e]
-                        if threads > 1:
+                n_hull += 1
+                if threads > 1:
+                    for e in range(3 * t, 3 * t + 3):
+                        if tv[e] != inf and tv[nxt(e)] != inf:
                             h_first[tv[e]] += 1
             else:
                 n_finite += 1
-                for e in range(3 * t, 3 * t + 3):
-                    if first_e[tv[e]] < 0:
-                        first_e[tv[e]] = e
+                first_e[c] = 3 * t + 2
+                first_e[b] = 3 * t + 1
+                first_e[a] = 3 * t
                 if threads > 1:
                     h_first[a] += 1; h_first[b] += 1; h_first[c] += 1
                     v_first[smallest(a, b, c)] += 1
+        t = 0
+        while n_hull > 0:
+            if tv[3 * t] == inf or tv[3 * t + 1] == inf or tv[3 * t + 2] == inf:
+                n_hull -= 1
+                for e in range(3 * t, 3 * t + 3):
+                    if tv[e] != inf and tv[nxt(e)] != inf:
+                        first_e[tv[nxt(e)]] = opp[e]
+            t += 1
         if threads > 1:
             # counts -> offsets: a site's half-edges and vertices follow those of the sites before it
             for a in range(n):
