@@ -345,3 +345,45 @@ def test_many_reject_mismatched_shapes():
         orient2d_many(a, a, np.zeros((4, 2)))
     with pytest.raises(ValueError, match="d has shape"):
         incircle_many(a, a, a, np.zeros((3, 3)))
+
+
+def integer_span(values) -> int:
+    """Bits from the lowest set bit of any nonzero value to above the largest: the span the in-circle
+    test's integer tier (tvoronoi_incircle_small) takes up to 30."""
+    nonzero = [Fraction(v) for v in values if v != 0]
+    if not nonzero:
+        return 0
+    low = min(
+        (f.numerator & -f.numerator).bit_length() - 1 - (f.denominator.bit_length() - 1) for f in map(abs, nonzero)
+    )
+    high = max(math.frexp(float(f))[1] for f in map(abs, nonzero))
+    return high - low
+
+
+def test_incircle_integer_tier_on_dyadic_points_near_and_on_circles():
+    """Points whose differences are integers times one power of two, spanning 6 to 38 bits (both sides
+    of the integer tier's 30, where its 64-bit lifts would overflow at 32): on circles through lattice
+    points stretched by an odd factor (cocircular), and moved off them by the last bit, at scales from
+    2^-60 to 2^40. Every sign against rational arithmetic."""
+    rng = random.Random(20261126)
+    circles = [lattice_circle(r) for r in (5, 25, 65)]
+    tier = 0
+    spans = set()
+    for _ in range(4000):
+        bits = rng.randint(0, 32)
+        k = 2 * rng.randint(2 ** max(bits - 2, 0), 2**bits) + 1  # odd: the lowest bit stays set
+        scale = 2.0 ** rng.randint(-60, 40)
+        ox, oy = rng.randint(-(2**bits), 2**bits), rng.randint(-(2**bits), 2**bits)
+        points = [((k * x + ox) * scale, (k * y + oy) * scale) for x, y in rng.sample(rng.choice(circles), 4)]
+        if rng.random() < 0.5:
+            j = rng.randrange(4)
+            points[j] = (points[j][0] + rng.choice([-1, 1]) * scale, points[j][1])
+        coords = flat(points)
+        assert incircle_sign(*coords) == incircle_rational(*coords), coords
+        d = points[3]
+        diffs = [c - d[i % 2] for i, c in enumerate(coords[:6])]
+        if differences_exact(points) and not incircle_filter_decides(*coords):
+            spans.add(integer_span(diffs))
+            tier += integer_span(diffs) <= 30
+    assert tier > 500, f"only {tier} cases reached the integer tier"
+    assert min(spans) < 10 and {29, 30, 31, 32} <= spans, sorted(spans)

@@ -17,7 +17,9 @@
 #      Robust Geometric Predicates, 1997). Settles nearly every call with a handful of flops.
 #   2. short exact: the coordinate differences were computed without rounding (the rule for integer and
 #      grid coordinates, the usual degenerate input), so the determinant is a polynomial in single
-#      doubles: at most 96 expansion components for incircle, 4 for orient2d.
+#      doubles: at most 96 expansion components for incircle, 4 for orient2d. For incircle, first
+#      in 64- and 128-bit integers when the differences are integers times one power of two, each
+#      below 2^30 (tvoronoi_incircle_small: a grid's cocircular squares, a few tens of nanoseconds).
 #   3. long exact: some difference was rounded; each difference is carried as a two-double expansion
 #      (head + tail) and the determinant is multiplied out in full (up to 1536 components).
 #
@@ -47,11 +49,59 @@ cdef extern from *:
     #define TVORONOI_SPLITTER 134217729.0
     #define TVORONOI_CCW_ERRBOUND_A ((3.0 + 16.0 * TVORONOI_EPSILON) * TVORONOI_EPSILON)
     #define TVORONOI_ICC_ERRBOUND_A ((10.0 + 96.0 * TVORONOI_EPSILON) * TVORONOI_EPSILON)
+    #include <stdint.h>
+    #include <string.h>
+    /* The in-circle determinant of exact differences that are all integers times one power of two,
+       each below 2^30 in magnitude (grids, integer and dyadic coordinates: the usual cocircular input):
+       lifts and minors below 2^61 in 64-bit integers, the three products below 2^122 and their sum
+       below 2^124 in 128-bit ones, all exact. Returns the sign, or 2 when the differences do not fit
+       (or the compiler has no 128-bit integers): the caller then multiplies expansions. */
+    static inline int tvoronoi_incircle_small(const double* v) {
+    #if defined(__SIZEOF_INT128__)
+        uint64_t bits, mant[6];
+        int low[6], neg[6], lo = 1 << 20, hi = -(1 << 20), k, ex;
+        int64_t q[6], a_lift, b_lift, c_lift, m_a, m_b, m_c;
+        __int128 det;
+        for (k = 0; k < 6; k++) {
+            memcpy(&bits, &v[k], sizeof bits);
+            ex = (int) ((bits >> 52) & 0x7ff);
+            mant[k] = bits & 0xfffffffffffffULL;
+            neg[k] = (int) (bits >> 63);
+            low[k] = 0;
+            if (ex == 0x7ff || (ex == 0 && mant[k] != 0)) return 2;     /* inf, NaN, subnormal */
+            if (ex == 0) continue;                                       /* a zero */
+            mant[k] |= 1ULL << 52;                                       /* |v| = mant 2^(ex - 1075) */
+            low[k] = ex - 1075;
+            if (low[k] + __builtin_ctzll(mant[k]) < lo) lo = low[k] + __builtin_ctzll(mant[k]);
+            if (low[k] + 53 > hi) hi = low[k] + 53;                      /* |v| < 2^hi */
+        }
+        if (hi < lo) return 0;                                           /* every difference zero */
+        if (hi - lo > 30) return 2;
+        for (k = 0; k < 6; k++) {
+            /* v 2^-lo = mant 2^(low - lo): an integer below 2^30 (the shifted-out bits are zeros) */
+            if (mant[k] == 0) q[k] = 0;
+            else q[k] = (int64_t) (low[k] >= lo ? mant[k] << (low[k] - lo) : mant[k] >> (lo - low[k]));
+            if (neg[k]) q[k] = -q[k];
+        }
+        a_lift = q[0] * q[0] + q[1] * q[1];
+        b_lift = q[2] * q[2] + q[3] * q[3];
+        c_lift = q[4] * q[4] + q[5] * q[5];
+        m_a = q[2] * q[5] - q[4] * q[3];
+        m_b = q[4] * q[1] - q[0] * q[5];
+        m_c = q[0] * q[3] - q[2] * q[1];
+        det = (__int128) a_lift * m_a + (__int128) b_lift * m_b + (__int128) c_lift * m_c;
+        return (det > 0) - (det < 0);
+    #else
+        (void) v;
+        return 2;
+    #endif
+    }
     """
     const double EPSILON "TVORONOI_EPSILON"
     const double SPLITTER "TVORONOI_SPLITTER"
     const double CCW_ERRBOUND_A "TVORONOI_CCW_ERRBOUND_A"
     const double ICC_ERRBOUND_A "TVORONOI_ICC_ERRBOUND_A"
+    int incircle_small "tvoronoi_incircle_small"(const double* v) noexcept nogil
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -476,6 +526,11 @@ cdef inline int incircle_exact(double ax, double ay, double bx, double by, doubl
             or cdx_t != 0.0 or cdy_t != 0.0):
         return incircle_exact_long(adx, adx_t, ady, ady_t, bdx, bdx_t, bdy, bdy_t,
                                    cdx, cdx_t, cdy, cdy_t)
+    cdef double d[6]
+    d[0] = adx; d[1] = ady; d[2] = bdx; d[3] = bdy; d[4] = cdx; d[5] = cdy
+    cdef int small = incircle_small(d)
+    if small != 2:
+        return small
     return incircle_exact_short(adx, ady, bdx, bdy, cdx, cdy)
 
 
