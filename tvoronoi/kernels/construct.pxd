@@ -354,19 +354,21 @@ cdef inline bint settled_long(double a, long double u, long double err, int e, d
     # as settled, with u and its error bound in long double (x87 extended where the platform has it)
     cdef long double xl = <long double> a + u
     cdef double s = <double> xl
-    cdef long double g_hi = <long double> nextafter(s, INFINITY) - s
-    cdef long double g_lo = <long double> s - nextafter(s, -INFINITY)
-    # the sum's own rounding, then the interval against the midpoints (each side formed exactly)
+    # half the smaller gap beside s, from its bits (0 where s is not safely normal: nothing is proved)
+    cdef long double hg = half_gap(s)
+    # the sum's own rounding, then the interval against the midpoints narrowed to the nearer one
+    # (each side formed exactly)
     err = (err + LDBL_EPS * fabsl(xl)) * (1.0 + 4.0 * LDBL_EPS)
-    if not (xl + err < s + 0.5 * g_hi and xl - err > s - 0.5 * g_lo):
+    if not (xl + err < s + hg and xl - err > s - hg):
         return False
     return scaled_back(s, e, out)
 
 
 cdef inline bint circumcentre_long(double ax, double ay, double bx, double by, double cx, double cy, int e,
-                                   double* ux, double* uy) noexcept nogil:
-    # the fast path again in long double, for the few vertices whose rounding the doubles left open;
-    # the same error analysis with the long double unit roundoff
+                                   bint need_x, bint need_y, double* ux, double* uy) noexcept nogil:
+    # the fast path again in long double, for the few vertices whose rounding the doubles left open
+    # (need_x, need_y: the coordinates still open); the same error analysis with the long double unit
+    # roundoff
     cdef long double bax = <long double> bx - ax, bay = <long double> by - ay
     cdef long double cax = <long double> cx - ax, cay = <long double> cy - ay
     cdef long double l = bax * cay, r = bay * cax
@@ -384,8 +386,8 @@ cdef inline bint circumcentre_long(double ax, double ay, double bx, double by, d
     gap = 2.0 * adet * (adet - err_det)
     ex = ((fabsl(nx) * err_det + adet * err_nx) / gap + LDBL_EPS * fabsl(nx / det)) * (1.0 + 1e-6)
     ey = ((fabsl(ny) * err_det + adet * err_ny) / gap + LDBL_EPS * fabsl(ny / det)) * (1.0 + 1e-6)
-    return (settled_long(ax, nx / (2.0 * det), ex, e, ux)
-            and settled_long(ay, ny / (2.0 * det), ey, e, uy))
+    return ((not need_x or settled_long(ax, nx / (2.0 * det), ex, e, ux))
+            and (not need_y or settled_long(ay, ny / (2.0 * det), ey, e, uy)))
 
 
 cdef inline void circumcentre(double ax, double ay, double bx, double by, double cx, double cy, int e,
@@ -396,6 +398,7 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
     cdef double det = l - r, det_sum = fabs(l) + fabs(r)
     cdef double err_det = CCW_ERRBOUND_A * det_sum
     cdef double bb, cc, nx, ny, err_nx, err_ny, ex, ey, adet, gap
+    cdef bint done_x, done_y
     adet = fabs(det)
     # fast path: relative coordinates in doubles, with a bound on their error (see the module notes);
     # skipped when the determinant is too close to its error or values could underflow
@@ -412,10 +415,12 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
         # division's own rounding; a little slack covers the rounding of the bound itself
         ex = ((fabs(nx) * err_det + adet * err_nx) / gap + EPSILON * fabs(nx / det)) * (1.0 + 1e-6)
         ey = ((fabs(ny) * err_det + adet * err_ny) / gap + EPSILON * fabs(ny / det)) * (1.0 + 1e-6)
-        if (settled(ax, nx / (2.0 * det), ex, e, ux)
-                and settled(ay, ny / (2.0 * det), ey, e, uy)):
+        done_x = settled(ax, nx / (2.0 * det), ex, e, ux)
+        done_y = settled(ay, ny / (2.0 * det), ey, e, uy)
+        if done_x and done_y:
             return
-        if circumcentre_long(ax, ay, bx, by, cx, cy, e, ux, uy):
+        # the coordinate the doubles left open (rarely both) again in long double
+        if circumcentre_long(ax, ay, bx, by, cx, cy, e, not done_x, not done_y, ux, uy):
             return
     if circumcentre_relative(ax, ay, bx, by, cx, cy, e, ux, uy):
         return
