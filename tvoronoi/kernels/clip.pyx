@@ -456,13 +456,20 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
     cdef int T = threads if rows >= PARALLEL_MIN_CELLS and threads > 1 else 1
     cell_offsets_arr = np.empty(rows + 1, np.int64)
     cdef int64_t[::1] cell_offsets = cell_offsets_arr
+    cdef int64_t length
     with nogil:
-        for r in range(rows):
-            cell_offsets[r] = total
+        # each row's ring length on the threads (the cells' offsets loaded GATHER_AHEAD rows ahead),
+        # then the offsets by a sum in row order
+        cell_offsets[0] = 0
+        for r in prange(rows, num_threads=T, schedule="static"):
+            if r + GATHER_AHEAD < rows and cell_of_row[r + GATHER_AHEAD] >= 0:
+                prefetch(&offsets[cell_of_row[r + GATHER_AHEAD]])
             c = cell_of_row[r]
-            if c >= 0:
-                total += offsets[c + 1] - offsets[c]
-        cell_offsets[rows] = total
+            cell_offsets[r + 1] = offsets[c + 1] - offsets[c] if c >= 0 else 0
+        for r in range(rows):
+            length = cell_offsets[r + 1]
+            cell_offsets[r + 1] = total + length
+            total += length
     vertices_arr = np.empty(total, np.int32)
     cdef int32_t[::1] out = vertices_arr
     cdef int32_t* out_p = &out[0] if total > 0 else NULL
