@@ -224,6 +224,56 @@ def test_take_sites_is_numpy_indexing_of_both_columns(n, data):
     assert np.array_equal(cx, x) and np.array_equal(cy, y)
 
 
+@settings(max_examples=80, deadline=None)
+@given(
+    n=st.integers(1, 200),
+    exponent=st.sampled_from([-1100, -1074, -1023, -1022, -60, -1, 1, 7, 900, 1022, 1023, 1074, 1100]),
+    mantissa_bits=st.sampled_from([1, 20, 53]),
+    magnitude=st.integers(-1074, 1023),
+    seed=st.integers(0, 2**16),
+)
+def test_take_sites_scales_as_numpy_ldexp_does(n, exponent, mantissa_bits, magnitude, seed):
+    """take_sites(..., exponent) is xs[idx] * 2^-exponent rounded as np.ldexp rounds it, bit for bit:
+    exact for normal results, and the same rounding where the result is subnormal, overflows or
+    underflows to zero, with the factor a normal double or not."""
+    rng = np.random.default_rng(seed)
+    m = rng.integers(1, 2**mantissa_bits, size=(n, 2)).astype(np.float64) * rng.choice([-1.0, 1.0], size=(n, 2))
+    pts = np.ldexp(m, np.clip(magnitude - mantissa_bits + rng.integers(-40, 40, size=(n, 2)), -1074, 1023))
+    pts[rng.random((n, 2)) < 0.1] = 0.0
+    idx = rng.integers(0, n, size=2 * n).astype(np.int32)
+    with np.errstate(over="ignore", under="ignore"):
+        want_x, want_y = np.ldexp(pts[idx, 0], -exponent), np.ldexp(pts[idx, 1], -exponent)
+    x, y = renumber.take_sites(pts[:, 0], pts[:, 1], idx, exponent)
+    assert np.array_equal(x.view(np.int64), want_x.view(np.int64))
+    assert np.array_equal(y.view(np.int64), want_y.view(np.int64))
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    n=st.integers(1, 300),
+    axis=st.sampled_from([0, 1]),
+    grid=st.booleans(),
+    seed=st.integers(0, 2**16),
+)
+def test_split_rows_is_the_two_masks_and_their_boxes(n, axis, grid, seed):
+    """split_rows gives the rows below the split and the others, each in row order, and each part's
+    box, as numpy's masks and reductions do, from strided columns; ties with the split go right."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, 6, size=(n, 2)).astype(np.float64) if grid else rng.normal(size=(n, 2))
+    split = float(pts[rng.integers(0, n), axis]) if rng.random() < 0.8 else float(rng.normal() * 3)
+    rows, n_left, box_l, box_r = renumber.split_rows(pts[:, 0], pts[:, 1], axis, split)
+    below = pts[:, axis] < split
+    assert rows.dtype == np.int32 and n_left == int(below.sum())
+    assert np.array_equal(rows[:n_left], np.flatnonzero(below))
+    assert np.array_equal(rows[n_left:], np.flatnonzero(~below))
+    for part, box in ((below, box_l), (~below, box_r)):
+        if part.any():
+            q = pts[part]
+            assert box == (q[:, 0].min(), q[:, 1].min(), q[:, 0].max(), q[:, 1].max())
+        else:
+            assert box == (np.inf, np.inf, -np.inf, -np.inf)
+
+
 @pytest.mark.parametrize("bad", [-1, 5, 2**31 - 1])
 def test_take_sites_refuses_an_index_out_of_range(bad):
     xs = np.arange(5.0)

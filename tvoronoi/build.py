@@ -39,8 +39,7 @@ def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed:
     (tvoronoi.halves) from SPLIT_MIN_SITES sites on, whatever the thread count (Fortune's sweep, or the
     incremental engine in BRIO order), else whole (triangulate_and_lay_out)."""
     if (engine == "fortune" or insertion == "brio") and len(pts) >= halves.SPLIT_MIN_SITES:
-        sx, sy = np.ldexp(pts[:, 0], -e), np.ldexp(pts[:, 1], -e)
-        t = halves.triangulate(sx, sy, e, engine=engine, seed=seed, threads=threads)
+        t = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, seed=seed, threads=threads)
         if t is not None:
             return t
     s = engines.prepare(

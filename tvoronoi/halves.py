@@ -9,6 +9,7 @@ SPLIT_MIN_SITES sites on (tvoronoi.build).
 from __future__ import annotations
 
 import contextvars
+import math
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -27,16 +28,20 @@ LEAST_SHARE = 0.25
 
 @dataclass(frozen=True)
 class Cut:
-    """The line the sites are cut by: coordinate ``axis`` (0: x, 1: y) below ``split`` on the left."""
+    """The line the sites are cut by: coordinate ``axis`` (0: x, 1: y) below ``split`` on the left; the
+    rows of each side (int32, in row order) and each side's bounding box, in the coordinates' own unit."""
 
     axis: int
     split: float
-    left: np.ndarray  # (n,) bool, the left half's sites
+    left: np.ndarray
+    right: np.ndarray
+    box_left: tuple[float, float, float, float]
+    box_right: tuple[float, float, float, float]
 
 
 def cut(xs: np.ndarray, ys: np.ndarray) -> Cut | None:
     """The cut at the median of the longer side of the sites' box (else of the other side), or None when
-    neither gives two halves of at least LEAST_SHARE of the sites each."""
+    neither gives two halves of at least LEAST_SHARE of the sites each (xs, ys may be strided)."""
     n = len(xs)
     if n < 4:
         return None
@@ -44,11 +49,22 @@ def cut(xs: np.ndarray, ys: np.ndarray) -> Cut | None:
     for axis in (0, 1) if spans[0] >= spans[1] else (1, 0):
         c = xs if axis == 0 else ys
         split = float(np.partition(c, n // 2)[n // 2])
-        left = c < split
-        n_left = int(np.count_nonzero(left))
+        rows, n_left, box_left, box_right = renumber.split_rows(xs, ys, axis, split)
         if min(n_left, n - n_left) >= LEAST_SHARE * n:
-            return Cut(axis, split, left)
+            return Cut(axis, split, rows[:n_left], rows[n_left:], box_left, box_right)
     return None
+
+
+def scaled(c: Cut, exponent: int) -> Cut:
+    """The cut in the unit 2^exponent (exact: the range rule keeps scaled coordinates normal doubles)."""
+    return Cut(
+        c.axis,
+        math.ldexp(c.split, -exponent),
+        c.left,
+        c.right,
+        tuple(math.ldexp(v, -exponent) for v in c.box_left),  # type: ignore[arg-type]
+        tuple(math.ldexp(v, -exponent) for v in c.box_right),  # type: ignore[arg-type]
+    )
 
 
 @dataclass(frozen=True)
@@ -89,14 +105,17 @@ def half(
     out: Joined,
     first: int,
     *,
+    exponent: int,
     seed: int,
     threads: int,
 ):
-    """Order, triangulate and renumber the sites ``rows`` of xs, ys (scaled, input order), as sites
-    first.. of ``out``, their triangles at its start (first == 0, the left half) or at its end; mark the
-    triangles it keeps (other_box: the other half's bounding box). Returns the slots its triangles take
-    (lo, hi), or None when its sites are collinear."""
-    s = engines.prepare(*renumber.take_sites(xs, ys, rows), engine=engine, seed=seed, threads=threads, exponent=0)
+    """Order, triangulate and renumber the sites ``rows`` of xs, ys (input order, scaled here by
+    2^-exponent), as sites first.. of ``out``, their triangles at its start (first == 0, the left half)
+    or at its end; mark the triangles it keeps (c and other_box, the other half's bounding box: scaled).
+    Returns the slots its triangles take (lo, hi), or None when its sites are collinear."""
+    s = engines.prepare(
+        *renumber.take_sites(xs, ys, rows, exponent), engine=engine, seed=seed, threads=threads, exponent=0
+    )
     t = engines.triangulate(s, engine=engine)
     if t.tv is None or t.opp is None:
         return None
@@ -125,41 +144,40 @@ def half(
     return lo, lo + n_tri
 
 
-def box(xs: np.ndarray, ys: np.ndarray, rows: np.ndarray) -> tuple[float, float, float, float]:
-    """The bounding box of the sites ``rows``."""
-    x, y = xs[rows], ys[rows]
-    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
-
-
 def triangulate(
     xs: np.ndarray, ys: np.ndarray, exponent: int, *, engine: str = "incremental", seed: int = 0, threads: int = 1
 ):
-    """The Delaunay triangulation of scaled sites (input order) by halves, renumbered for the dual.
+    """The Delaunay triangulation of sites (input order, unscaled; xs, ys may be strided) scaled by
+    2^-exponent, by halves, renumbered for the dual.
 
     Returns an engines.Triangulation whose ``sites.perm`` maps its sites to input rows, or None when the
     sites do not split (too many on the median lines, a half's sites collinear): the caller then
     triangulates them whole. Two threads work when ``threads`` is 2 or more, each half then ordered on
-    half of them.
+    half of them. Each half's sites are scaled as they are gathered: no scaled copy of all of them.
     """
     c = cut(xs, ys)
     if c is None:
         return None
-    rows_l = np.flatnonzero(c.left).astype(np.int32)
-    rows_r = np.flatnonzero(~c.left).astype(np.int32)
+    c = scaled(c, exponent)
     out = Joined.empty(len(xs))
     jobs = (
-        (rows_l, box(xs, ys, rows_r), 0),
-        (rows_r, box(xs, ys, rows_l), len(rows_l)),
+        (c.left, c.box_right, 0),
+        (c.right, c.box_left, len(c.left)),
     )
     if threads >= 2:
         slots = on_two_threads(
             [
-                partial(half, engine, xs, ys, rows, other, c, out, first, seed=seed, threads=threads // 2)
+                partial(
+                    half, engine, xs, ys, rows, other, c, out, first, exponent=exponent, seed=seed, threads=threads // 2
+                )
                 for rows, other, first in jobs
             ]
         )
     else:
-        slots = [half(engine, xs, ys, rows, other, c, out, first, seed=seed, threads=1) for rows, other, first in jobs]
+        slots = [
+            half(engine, xs, ys, rows, other, c, out, first, exponent=exponent, seed=seed, threads=1)
+            for rows, other, first in jobs
+        ]
     left, right = slots
     if left is None or right is None:
         return None

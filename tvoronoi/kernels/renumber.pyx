@@ -17,6 +17,7 @@ import numpy as np
 from cython.parallel cimport prange
 from libc.stdint cimport int32_t, uint32_t
 from libc.stdlib cimport calloc, free, malloc
+from libc.math cimport INFINITY, ldexp
 from libc.string cimport memcpy
 
 cdef enum:
@@ -246,13 +247,21 @@ def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1]
     return new_to_old, old_to_new, tv2, opp2
 
 
-def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx):
-    """(xs[idx], ys[idx]) as new contiguous arrays, in one pass, without numpy's widening of the int32
-    indices (xs, ys may be strided: the columns of an (n, 2) array). Raises IndexError if an index is
+cdef inline double scaled(double v, int exponent, double factor) noexcept nogil:
+    # v * 2^-exponent, correctly rounded (as numpy's ldexp): by the power of two itself where it is a
+    # normal double, so that the product is one rounding of the exact result
+    return v * factor if -1022 <= exponent <= 1022 else ldexp(v, -exponent)
+
+
+def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx, int exponent=0):
+    """(xs[idx], ys[idx]) * 2^-exponent as new contiguous arrays, in one pass, without numpy's widening of
+    the int32 indices (xs, ys may be strided: the columns of an (n, 2) array); each value is rounded as
+    numpy's ldexp rounds it (exact unless the result is subnormal). Raises IndexError if an index is
     out of range."""
     cdef Py_ssize_t n = xs.shape[0], m = idx.shape[0], k
     cdef int32_t i
     cdef bint bad = False
+    cdef double factor = ldexp(1.0, -exponent)
     if ys.shape[0] != n:
         raise ValueError("take_sites: xs and ys differ in length")
     out_x_arr = np.empty(m, np.float64)
@@ -264,11 +273,65 @@ def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx):
             if i < 0 or i >= n:
                 bad = True
                 break
-            out_x[k] = xs[i]
-            out_y[k] = ys[i]
+            if exponent == 0:
+                out_x[k] = xs[i]
+                out_y[k] = ys[i]
+            else:
+                out_x[k] = scaled(xs[i], exponent, factor)
+                out_y[k] = scaled(ys[i], exponent, factor)
     if bad:
         raise IndexError(f"take_sites: index {idx[k]} out of range for {n} sites")
     return out_x_arr, out_y_arr
+
+
+def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
+    """The rows whose coordinate ``axis`` (0: x, 1: y) is below ``split``, then the others, in one pass.
+
+    Returns (rows, n_left, box_left, box_right): rows (n,) int32, the n_left rows below the split first,
+    then the others, each part in row order; each box (xmin, ymin, xmax, ymax) of its part's sites
+    ((inf, inf, -inf, -inf) for an empty part). xs, ys may be strided (the columns of an (n, 2) array).
+    """
+    cdef Py_ssize_t n = xs.shape[0], k, lo = 0, hi
+    if ys.shape[0] != n:
+        raise ValueError("split_rows: xs and ys differ in length")
+    rows_arr = np.empty(n, np.int32)
+    cdef int32_t[::1] rows = rows_arr
+    cdef int32_t tmp
+    cdef double x, y, c
+    cdef double lx0 = INFINITY, ly0 = INFINITY, lx1 = -INFINITY, ly1 = -INFINITY
+    cdef double rx0 = INFINITY, ry0 = INFINITY, rx1 = -INFINITY, ry1 = -INFINITY
+    cdef bint below
+    hi = n - 1
+    with nogil:
+        # the left rows from the front, the right ones from the back (in reverse, turned round below);
+        # the side by a select, not a branch (the sides of rows in input order are as good as random),
+        # the boxes by branches on the coordinates, which seldom set a new extreme
+        for k in range(n):
+            x = xs[k]
+            y = ys[k]
+            below = (x if axis == 0 else y) < split
+            rows[lo if below else hi] = <int32_t> k
+            lo += below
+            hi -= 1 - below
+            if below:
+                if x < lx0: lx0 = x
+                if x > lx1: lx1 = x
+                if y < ly0: ly0 = y
+                if y > ly1: ly1 = y
+            else:
+                if x < rx0: rx0 = x
+                if x > rx1: rx1 = x
+                if y < ry0: ry0 = y
+                if y > ry1: ry1 = y
+        hi = n - 1
+        k = lo
+        while k < hi:
+            tmp = rows[k]
+            rows[k] = rows[hi]
+            rows[hi] = tmp
+            k += 1
+            hi -= 1
+    return rows_arr, lo, (lx0, ly0, lx1, ly1), (rx0, ry0, rx1, ry1)
 
 
 def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] rows, const int32_t[::1] perm,
