@@ -72,7 +72,7 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
             t1 = t0
             t = build.triangulation(pts, e, engine=engine, insertion="brio", seed=0, threads=threads)
         else:
-            s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e, threads=threads)
+            s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e)
             t1 = time.perf_counter()
             t = build.triangulate_and_lay_out(s, engine=engine, insertion="brio", threads=threads)
         t2 = time.perf_counter()

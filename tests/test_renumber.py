@@ -238,7 +238,9 @@ def test_take_sites_scales_as_numpy_ldexp_does(n, exponent, mantissa_bits, magni
     underflows to zero, with the factor a normal double or not."""
     rng = np.random.default_rng(seed)
     m = rng.integers(1, 2**mantissa_bits, size=(n, 2)).astype(np.float64) * rng.choice([-1.0, 1.0], size=(n, 2))
-    pts = np.ldexp(m, np.clip(magnitude - mantissa_bits + rng.integers(-40, 40, size=(n, 2)), -1074, 1023))
+    pts = np.ldexp(
+        m, np.clip(magnitude - mantissa_bits + rng.integers(-40, 40, size=(n, 2)), -1074, 1023 - mantissa_bits)
+    )
     pts[rng.random((n, 2)) < 0.1] = 0.0
     idx = rng.integers(0, n, size=2 * n).astype(np.int32)
     with np.errstate(over="ignore", under="ignore"):

@@ -42,9 +42,7 @@ def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed:
         t = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, seed=seed, threads=threads)
         if t is not None:
             return t
-    s = engines.prepare(
-        pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=e
-    )
+    s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)
     return triangulate_and_lay_out(s, engine=engine, insertion=insertion, threads=threads)
 
 

@@ -120,19 +120,16 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return perm.astype(np.int32)
 
 
-def engine_order(
-    xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0, threads: int = 1
-) -> np.ndarray:
+def engine_order(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0) -> np.ndarray:
     """The order in which an engine takes the sites: perm[k] is the k-th site (int32).
 
     Fortune's sweep takes them by y then x; the incremental engine in a biased randomized
-    insertion order along a space-filling curve ("brio", its rounds ordered on ``threads`` threads:
-    the same order for any count), or fully at random ("random").
+    insertion order along a space-filling curve ("brio"), or fully at random ("random").
     """
     if engine == "fortune":
         return sweep_order(xs, ys)
     if insertion == "brio":
-        return order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed, threads)
+        return order.brio_order(np.ascontiguousarray(xs), np.ascontiguousarray(ys), seed)
     return np.random.default_rng(seed).permutation(len(xs)).astype(np.int32)
 
 
@@ -156,7 +153,6 @@ def prepare(
     engine: str,
     insertion: str = "brio",
     seed: int = 0,
-    threads: int = 1,
     exponent: int | None = None,
 ) -> Sites:
     """Scale the sites (input order) by 2^-exponent (default: their own scale) and order them for an engine."""
@@ -167,7 +163,7 @@ def prepare(
         sx, sy = np.ascontiguousarray(xs), np.ascontiguousarray(ys)
     else:
         sx, sy = np.ldexp(xs, -e), np.ldexp(ys, -e)
-    perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed, threads=threads)
+    perm = engine_order(sx, sy, engine=engine, insertion=insertion, seed=seed)
     ox, oy = renumber.take_sites(sx, sy, perm)
     return Sites(e, perm, ox, oy)
 
@@ -281,9 +277,8 @@ def run(
     engine: str,
     insertion: str = "brio",
     seed: int = 0,
-    threads: int = 1,
     exponent: int | None = None,
 ) -> Triangulation:
     """prepare, then triangulate: the Delaunay triangulation of sites given in input order."""
-    sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, threads=threads, exponent=exponent)
+    sites = prepare(xs, ys, engine=engine, insertion=insertion, seed=seed, exponent=exponent)
     return triangulate(sites, engine=engine, insertion=insertion)

@@ -113,9 +113,7 @@ def half(
     2^-exponent), as sites first.. of ``out``, their triangles at its start (first == 0, the left half)
     or at its end; mark the triangles it keeps (c and other_box, the other half's bounding box: scaled).
     Returns the slots its triangles take (lo, hi), or None when its sites are collinear."""
-    s = engines.prepare(
-        *renumber.take_sites(xs, ys, rows, exponent), engine=engine, seed=seed, threads=threads, exponent=0
-    )
+    s = engines.prepare(*renumber.take_sites(xs, ys, rows, exponent), engine=engine, seed=seed, exponent=0)
     t = engines.triangulate(s, engine=engine)
     if t.tv is None or t.opp is None:
         return None

@@ -1,37 +1,33 @@
-"""Insertion order of the incremental engine: random rounds of doubling size, each along an adaptive Hilbert curve."""
+"""Insertion order of the incremental engine: random rounds of doubling size, each along a Hilbert curve."""
 
 import numpy as np
 
-from libc.stdint cimport int32_t, uint64_t
+from libc.math cimport INFINITY, floor, log2
+from libc.stdint cimport int8_t, int32_t, uint32_t, uint64_t
 from libc.stdlib cimport malloc, free
+from libc.string cimport memcpy
 
 from tvoronoi.kernels.interrupt cimport poll_signals
-from libc.string cimport memcpy
-from cython.parallel cimport prange
 
 cdef enum:
     # rounds stop halving below this expected size: the first sites form one round (CGAL's threshold in 2D)
     FIRST_ROUND = 64
     # most rounds a 64-bit random word can assign (its trailing zeros)
     MAX_ROUNDS = 64
-    # items of the largest random sample whose median splits a range
-    SAMPLE = 63
-    # ranges of at most this many sites are sorted along the curve's axis instead of split
-    SMALL = 8
-    # ranges of at most this many sites have their extents measured exactly, larger ones sampled
-    EXACT_EXTENT = 32
-    # sites sampled for the extents of a larger range
-    EXTENT_SAMPLE = 16
-    # fewer sites are ordered on one thread
-    PARALLEL_MIN = 1 << 15
-
-# A range longer than this many times its width along the curve's axis is cut in two, not four.
-cdef double ELONGATED = 2.0
-
-
-cdef struct Item:
-    double c[2]         # coordinates x, y
-    int32_t i           # input index
+    # cells of a grid per site it orders (fewer sites share a cell, and fewer cells are ordered again)
+    CELLS_PER_SITE = 4
+    # most bits of a key: a grid of at most 2^30 cells (more sites share cells, ordered again)
+    MAX_KEY_BITS = 30
+    # bits of a key sorted by each pass of the radix sort (a count array of 2^11; two passes up to
+    # 2^20 sites)
+    RADIX_BITS = 11
+    # a cell with more sites is ordered again, on a grid over its own sites
+    CROWDED = 32
+    # at most this many sites are sorted by insertion, more by radix
+    SMALL_SORT = 48
+    # levels of such grids: clusters inside clusters inside ..., deeper than this keep their order in
+    # the last level's cells
+    MAX_DEPTH = 24
 
 
 cdef inline uint64_t next_random(uint64_t* state) noexcept nogil:
@@ -44,175 +40,211 @@ cdef inline uint64_t next_random(uint64_t* state) noexcept nogil:
     return z ^ (z >> 31)
 
 
-cdef inline Py_ssize_t below(uint64_t* state, Py_ssize_t bound) noexcept nogil:
-    """A random integer in [0, bound), bound < 2**32 (multiply-shift)."""
-    return <Py_ssize_t>(((next_random(state) >> 32) * <uint64_t>bound) >> 32)
+cdef struct Keyed:
+    uint32_t key        # the cell's place along the curve
+    int32_t i           # input index
 
 
-cdef inline bint precedes(const Item* a, const Item* b, int axis, double s, double t) noexcept nogil:
-    """a comes strictly before b: by coordinate axis in direction s (+1 or -1), ties by the
-    other coordinate in direction t. Negation is exact, so this is a total order on distinct
-    points, read on the input doubles themselves (no constructed key)."""
-    cdef double p = s * a.c[axis], q = s * b.c[axis]
-    if p != q:
-        return p < q
-    # degenerate case: equal coordinates along the split axis (a row or column of sites)
-    return t * a.c[1 - axis] < t * b.c[1 - axis]
+# The Hilbert curve, one level (two bits) at a time: in curve state q, the quadrant (2 * x bit + y bit)
+# is visited at position DIGIT[q][quadrant] and the next level is in state NEXT[q][quadrant]. State 0
+# runs from (0, 0) to (max, 0) through the quadrants bottom-left, top-left, top-right, bottom-right;
+# the others are it transposed (1), reflected in the other diagonal (2) and turned half round (3).
+# (test_order checks the curve: every cell once, each next to the one before.)
+cdef uint32_t DIGIT[4][4]
+cdef int NEXT[4][4]
+DIGIT[0][:] = [0, 1, 3, 2]
+NEXT[0][:] = [1, 0, 2, 0]
+DIGIT[1][:] = [0, 3, 1, 2]
+NEXT[1][:] = [0, 3, 1, 1]
+DIGIT[2][:] = [2, 1, 3, 0]
+NEXT[2][:] = [2, 2, 0, 3]
+DIGIT[3][:] = [2, 3, 1, 0]
+NEXT[3][:] = [3, 1, 3, 2]
 
 
-cdef Py_ssize_t split(const Item* src, Item* dst, Py_ssize_t lo, Py_ssize_t hi, int axis, double s,
-                      double t, uint64_t* state) noexcept nogil:
-    """Move src[lo:hi] to dst[lo:hi], the items before a pivot near the median first (order
-    precedes(axis, s, t)); returns the cut m: dst[lo:m] comes before or ties with dst[m:hi],
-    and lo < m < hi when there are two items or more. The pivot is the median of a random
-    sample, so the parts are near halves on any input (expected O(log n) levels); the pass
-    writes each item to the front or the back without a branch (no mispredictions)."""
-    cdef Item sample[SAMPLE]
-    cdef Item pivot, tmp
-    cdef Py_ssize_t n = hi - lo, i, k, q, r, front, back, lt
-    cdef int o = 1 - axis
-    cdef double kp, tp, p
-    if n <= 1:
-        if n == 1:
-            dst[lo] = src[lo]
-        return lo
-    # the pivot: the median of a small random sample (insertion sort)
-    r = 3 if n < 256 else (15 if n < 16384 else SAMPLE)
-    for q in range(r):
-        tmp = src[lo + below(state, n)]
-        i = q
-        while i > 0 and precedes(&tmp, &sample[i - 1], axis, s, t):
-            sample[i] = sample[i - 1]
-            i -= 1
-        sample[i] = tmp
-    pivot = sample[r // 2]
-    kp = s * pivot.c[axis]
-    tp = t * pivot.c[o]
-    # the items strictly before the pivot to the front, the others to the back
-    front = lo
-    back = hi - 1
-    for k in range(lo, hi):
-        p = s * src[k].c[axis]
-        lt = (p < kp) | ((p == kp) & (t * src[k].c[o] < tp))
-        dst[back + (front - back) * lt] = src[k]
-        front += lt
-        back -= 1 - lt
-    if front > lo:
-        return front
-    # degenerate case: nothing is before the pivot (it is the first item, or ties with it):
-    # the items not after the pivot to the front
-    back = hi - 1
-    for k in range(lo, hi):
-        p = s * src[k].c[axis]
-        lt = 1 - ((kp < p) | ((kp == p) & (tp < t * src[k].c[o])))
-        dst[back + (front - back) * lt] = src[k]
-        front += lt
-        back -= 1 - lt
-    if front < hi:
-        return front
-    # degenerate case: every item ties with the pivot (repeated points): any cut will do
-    return lo + n // 2
+cdef inline uint32_t hilbert_index(uint32_t x, uint32_t y, int bits) noexcept nogil:
+    """The place of cell (x, y) of a 2^bits square along the Hilbert curve from (0, 0) to (max, 0)."""
+    cdef uint32_t d = 0, quadrant
+    cdef int level, q = 0
+    for level in range(bits - 1, -1, -1):
+        quadrant = (((x >> level) & 1) << 1) | ((y >> level) & 1)
+        d = (d << 2) | DIGIT[q][quadrant]
+        q = NEXT[q][quadrant]
+    return d
 
 
-cdef void sort_small(Item* a, Py_ssize_t lo, Py_ssize_t hi, int axis, double s, double t) noexcept nogil:
-    """Insertion sort of a few items by precedes(axis, s, t): along the curve's axis."""
+cdef inline uint32_t cell_of(double v, double lo, double scale, uint32_t top) noexcept nogil:
+    # the grid column (or row) of coordinate v: floor((v - lo) * scale), kept in [0, top] (a scale that
+    # overflowed to inf for a span of a few subnormals gives inf or NaN here: NaN counts as 0)
+    cdef double q = (v - lo) * scale
+    if not q > 0.0:
+        return 0
+    if q >= top:
+        return top
+    return <uint32_t> q
+
+
+cdef int curve_keys(const double* xs, const double* ys, Keyed* items, Py_ssize_t count) noexcept nogil:
+    """Key items[0:count] by their cell along a curve through a grid of about CELLS_PER_SITE cells a site over
+    their own bounding box, its cells near square: squares of 2^b x 2^b cells side by side along the
+    box's longer side, each along the Hilbert curve from one corner to the next square's. Returns the
+    keys' bits, or -1 if every item is at one place (nothing to order)."""
+    cdef Py_ssize_t k
+    cdef double x0, x1, y0, y1, x, y, w, h, sx, sy, fx, fy
+    cdef int total = 0, b_short, b_long, long_x
+    cdef uint32_t cx, cy, u, v, top_x, top_y
+    x0 = x1 = xs[items[0].i]
+    y0 = y1 = ys[items[0].i]
+    for k in range(1, count):
+        x = xs[items[k].i]
+        y = ys[items[k].i]
+        x0 = x if x < x0 else x0
+        x1 = x if x > x1 else x1
+        y0 = y if y < y0 else y0
+        y1 = y if y > y1 else y1
+    # (halves where a span overflows, as from -1e308 to 1e308: halving is exact but for subnormals, and
+    # the cells only steer the order)
+    fx = 1.0 if x1 - x0 < INFINITY else 0.5
+    fy = 1.0 if y1 - y0 < INFINITY else 0.5
+    x0 *= fx
+    y0 *= fy
+    w = x1 * fx - x0
+    h = y1 * fy - y0
+    if not (w > 0 or h > 0):
+        return -1
+    # about CELLS_PER_SITE cells a site: 2^total cells, total <= MAX_KEY_BITS
+    while total < MAX_KEY_BITS and (<Py_ssize_t> 1 << total) < CELLS_PER_SITE * count:
+        total += 1
+    # cells near square: the longer side gets the bits of its aspect ratio first (w or h may be 0, or
+    # their ratio beyond the double range: then the longer side gets them all)
+    long_x = w >= h
+    b_short = 0
+    if long_x:
+        if h > 0 and w / h < 2.0 ** total:
+            b_short = (total - <int> floor(log2(w / h))) // 2
+    else:
+        if w > 0 and h / w < 2.0 ** total:
+            b_short = (total - <int> floor(log2(h / w))) // 2
+    b_short = 0 if b_short < 0 else b_short
+    b_long = total - b_short
+    top_x = (1u << (b_long if long_x else b_short)) - 1
+    top_y = (1u << (b_short if long_x else b_long)) - 1
+    sx = (top_x + 1.0) / w if w > 0 else 0.0
+    sy = (top_y + 1.0) / h if h > 0 else 0.0
+    for k in range(count):
+        cx = cell_of(xs[items[k].i] * fx, x0, sx, top_x)
+        cy = cell_of(ys[items[k].i] * fy, y0, sy, top_y)
+        u = cx if long_x else cy            # along the longer side
+        v = cy if long_x else cx
+        items[k].key = ((u >> b_short) << (2 * b_short)) \
+            | hilbert_index(u & ((1u << b_short) - 1), v, b_short)
+    return total
+
+
+cdef void radix_sort(Keyed* a, Keyed* tmp, Py_ssize_t count, int bits) noexcept nogil:
+    """Sort a[0:count] stably by key (keys below 2^bits), in passes of RADIX_BITS (tmp: scratch)."""
+    cdef Py_ssize_t k, c
+    cdef Py_ssize_t start[1 << RADIX_BITS]
+    cdef int shift = 0, d
+    cdef Keyed* src = a
+    cdef Keyed* dst = tmp
+    cdef Keyed* swap
+    while shift < bits:
+        for d in range(1 << RADIX_BITS):
+            start[d] = 0
+        for k in range(count):
+            start[(src[k].key >> shift) & ((1 << RADIX_BITS) - 1)] += 1
+        c = 0
+        for d in range(1 << RADIX_BITS):
+            c, start[d] = c + start[d], c
+        for k in range(count):
+            d = (src[k].key >> shift) & ((1 << RADIX_BITS) - 1)
+            dst[start[d]] = src[k]
+            start[d] += 1
+        swap = src
+        src = dst
+        dst = swap
+        shift += RADIX_BITS
+    if src != a:
+        memcpy(a, src, count * sizeof(Keyed))
+
+
+cdef void insertion_sort(Keyed* a, Py_ssize_t count) noexcept nogil:
+    """Sort a[0:count] stably by key (a few items)."""
     cdef Py_ssize_t k, j
-    cdef Item tmp
-    for k in range(lo + 1, hi):
+    cdef Keyed tmp
+    for k in range(1, count):
         tmp = a[k]
         j = k
-        while j > lo and precedes(&tmp, &a[j - 1], axis, s, t):
+        while j > 0 and a[j - 1].key > tmp.key:
             a[j] = a[j - 1]
             j -= 1
         a[j] = tmp
 
 
-cdef void extents(const Item* a, Py_ssize_t lo, Py_ssize_t hi, uint64_t* state, double* e) noexcept nogil:
-    """The extents of a[lo:hi] along x (e[0]) and y (e[1]): exact for a small range, those of a
-    random sample otherwise (they only steer the curve; no exact decision depends on them)."""
-    cdef Py_ssize_t n = hi - lo, k, q
-    cdef double x0, x1, y0, y1, v
-    x0 = x1 = a[lo].c[0]
-    y0 = y1 = a[lo].c[1]
-    for q in range(n - 1 if n <= EXACT_EXTENT else EXTENT_SAMPLE):
-        k = lo + 1 + q if n <= EXACT_EXTENT else lo + below(state, n)
-        v = a[k].c[0]
-        x0 = v if v < x0 else x0
-        x1 = v if v > x1 else x1
-        v = a[k].c[1]
-        y0 = v if v < y0 else y0
-        y1 = v if v > y1 else y1
-    e[0] = x1 - x0
-    e[1] = y1 - y0
-
-
-cdef void hilbert_sort(Item* src, Item* dst, Item* out, Py_ssize_t lo, Py_ssize_t hi, int x, double ux,
-                       double uy, uint64_t* state) noexcept nogil:
-    """Order the items of src[lo:hi] along a Hilbert curve adapted to the points, into
-    out[lo:hi] (out is src or dst; each split moves the range from one to the other).
-
-    Each level splits at the median, along axis x (direction ux) then along the other
-    axis (direction uy), so that every quadrant holds a quarter of the points however
-    they cluster (CGAL's median policy):
-
-        +-----+-----+    quadrants visited 1 2 3 4 (for ux = uy = +1, x the first axis);
-        |  2  |  3  |    1 and 4 are entered transposed (and 4 reversed) so that the
-        +-----+-----+    curve leaves each quadrant next to where it enters the next
-        |  1  |  4  |
-        +-----+-----+
-
-    A range much longer along x than across (a row of sites, a thin strip) is cut in two
-    halves along x instead, both in the same frame, so the curve runs straight through
-    it rather than back and forth across it (as a generalized Hilbert curve does in a
-    long rectangle). A few sites are sorted along x.
-    """
-    cdef int y = 1 - x
-    cdef Py_ssize_t m1, m2, m3
-    cdef double e[2]
-    if hi - lo <= SMALL:
-        # a few sites: in order along the curve's axis
-        if src != out:
-            memcpy(&out[lo], &src[lo], (hi - lo) * sizeof(Item))
-        sort_small(out, lo, hi, x, ux, uy)
+cdef void curve_sort(const double* xs, const double* ys, Keyed* a, Keyed* tmp, Py_ssize_t count,
+                     int depth) noexcept nogil:
+    """Order a[0:count] along the curve of curve_keys, then the sites of each crowded cell again along a
+    curve over their own box (a cluster far smaller than the whole is ordered inside too), up to
+    MAX_DEPTH levels; the sites of a cell with a few of them keep their order."""
+    cdef Py_ssize_t lo, hi
+    cdef int bits
+    if count <= 1:
         return
-    extents(src, lo, hi, state, e)
-    if e[x] > ELONGATED * e[y]:
-        # a long range along the curve: two halves, same frame
-        m2 = split(src, dst, lo, hi, x, ux, uy, state)
-        hilbert_sort(dst, src, out, lo, m2, x, ux, uy, state)
-        hilbert_sort(dst, src, out, m2, hi, x, ux, uy, state)
+    bits = curve_keys(xs, ys, a, count)
+    if bits <= 0:
         return
-    # split in halves along x, then each half in quarters along y (the second half reversed)
-    m2 = split(src, dst, lo, hi, x, ux, uy, state)
-    m1 = split(dst, src, lo, m2, y, uy, ux, state)
-    m3 = split(dst, src, m2, hi, y, -uy, ux, state)
-    # the quarters, each in its own frame of the curve
-    hilbert_sort(src, dst, out, lo, m1, y, uy, ux, state)
-    hilbert_sort(src, dst, out, m1, m2, x, ux, uy, state)
-    hilbert_sort(src, dst, out, m2, m3, x, ux, uy, state)
-    hilbert_sort(src, dst, out, m3, hi, y, -uy, -ux, state)
+    if count <= SMALL_SORT:
+        insertion_sort(a, count)
+    else:
+        radix_sort(a, tmp, count, bits)
+    if depth + 1 >= MAX_DEPTH:
+        return
+    lo = 0
+    while lo < count:
+        hi = lo + 1
+        while hi < count and a[hi].key == a[lo].key:
+            hi += 1
+        if hi - lo > CROWDED:
+            curve_sort(xs, ys, a + lo, tmp + lo, hi - lo, depth + 1)
+        lo = hi
 
 
-def brio_order(const double[::1] xs, const double[::1] ys, seed=0, int threads=1):
+def hilbert_indices(const uint32_t[::1] x, const uint32_t[::1] y, int bits):
+    """The places of cells (x, y) of a 2^bits square along the curve the order follows (exposed for
+    tests): from (0, 0) to (2^bits - 1, 0), each cell next to the one before."""
+    if not 0 <= bits <= 16:
+        raise ValueError(f"hilbert_indices: bits must lie in [0, 16], got {bits}")
+    cdef Py_ssize_t k, n = x.shape[0]
+    if y.shape[0] != n:
+        raise ValueError("hilbert_indices: x and y differ in length")
+    out_arr = np.empty(n, np.uint32)
+    cdef uint32_t[::1] out = out_arr
+    with nogil:
+        for k in range(n):
+            out[k] = hilbert_index(x[k], y[k], bits)
+    return out_arr
+
+
+def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
     """A biased randomized insertion order (Amenta, Choi and Rote), as a permutation.
 
     Each site joins a random round: the last with probability 1/2, the one
     before with 1/4, and so on (the first round expects 64 to 127 sites, or all of them when fewer than 128).
-    Each round is ordered along a Hilbert curve by median splits, so that
-    consecutive sites are neighbours at any scale and clustering: every
-    split is a cut in a total order of the input doubles (by one coordinate,
-    ties by the other), never in rounded keys, so any two distinct sites are
-    separated, however close.
+    The first round is in random order; every other is ordered along one
+    Hilbert curve, so that consecutive sites are neighbours at any scale and
+    clustering: the curve runs through a grid of about CELLS_PER_SITE cells a
+    site over the sites' bounding box (cells near square, however long the
+    box), and the sites of a crowded cell are ordered again on a grid over
+    their own box (a cluster a billionth of the box's size is ordered inside
+    as finely as the box). Keys are sorted by radix, in a few linear passes.
 
     Parameters
     ----------
     xs, ys : (n,) float64
     seed : int
-        Seed of the rounds and of the pivots (taken modulo 2**64); the same
-        seed gives the same order.
-    threads : int
-        The rounds are ordered on this many threads (each with its own stream
-        of pivots): the same order for any count.
+        Seed of the rounds (taken modulo 2**64); the same seed gives the same
+        order.
 
     Returns
     -------
@@ -230,26 +262,27 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0, int threads=1
     >>> sorted(brio_order(np.array([0.0, 1.0, 2.0]), np.array([0.0, 1.0, 0.0]), 0).tolist())
     [0, 1, 2]
     """
-    cdef Py_ssize_t n = xs.shape[0], k, start, end, n_rounds = 0
+    cdef Py_ssize_t n = xs.shape[0], k, n_rounds = 0
     if ys.shape[0] != n:
         raise ValueError(f"xs and ys differ in length ({n} and {ys.shape[0]})")
     if n >= 2 ** 31:
         raise ValueError(f"{n} sites: an int32 permutation holds fewer than 2**31")
-    cdef int32_t[::1] perm = np.empty(n, np.int32)
-    cdef int32_t[::1] round_of = np.empty(n, np.int32)
+    perm_arr = np.empty(n, np.int32)
+    cdef int32_t[::1] perm = perm_arr
+    cdef int8_t[::1] round_of = np.empty(n, np.int8)
     if n == 0:
-        return np.asarray(perm)
-    cdef Item* a = <Item*>malloc(n * sizeof(Item))
-    cdef Item* b = <Item*>malloc(n * sizeof(Item))
+        return perm_arr
+    cdef Keyed* a = <Keyed*>malloc(n * sizeof(Keyed))
+    cdef Keyed* b = <Keyed*>malloc(n * sizeof(Keyed))
     if a == NULL or b == NULL:
         free(a)
         free(b)
         raise MemoryError(f"no memory to order {n} sites")
     cdef uint64_t state = <uint64_t>(int(seed) & 0xFFFFFFFFFFFFFFFF), word
     cdef Py_ssize_t count[MAX_ROUNDS + 1]
-    cdef uint64_t round_state[MAX_ROUNDS + 1]
-    cdef int r, k_round, last, axis
-    cdef double e[2]
+    cdef int r, last
+    cdef Py_ssize_t j
+    cdef int32_t tmp
     try:
         with nogil:
             # the rounds: n/2 sites expected in the last, n/4 in the one before, ..., the rest in the first
@@ -264,36 +297,29 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0, int threads=1
                 while r < last and (word >> r) & 1 == 0:
                     r += 1
                 # r trailing zeros: round last - r, so that round last - r has probability 2^-(r + 1)
-                round_of[k] = last - r
+                round_of[k] = <int8_t> (last - r)
                 count[last - r + 1] += 1
+                a[k].i = <int32_t> k
             for r in range(last + 1):
                 count[r + 1] += count[r]
-            # the sites, round by round (count[r] is where round r starts)
-            for k in range(n):
-                r = round_of[k]
-                a[count[r]].c[0] = xs[k]
-                a[count[r]].c[1] = ys[k]
-                a[count[r]].i = <int32_t>k
-                count[r] += 1
-            # each round along the curve, its first axis the longer side of the whole set; each round
-            # draws its pivots from a stream of its own (the first goes on with the main one), so that
-            # the rounds can be ordered at once, the largest first (round last holds half the sites)
-            extents(a, 0, n, &state, e)
-            axis = 0 if e[0] >= e[1] else 1
-            round_state[0] = state
-            for r in range(1, last + 1):
-                word = state ^ (<uint64_t>r * <uint64_t>0xD1B54A32D192ED03)
-                round_state[r] = next_random(&word)
             poll_signals()
-            for k_round in prange(last + 1, num_threads=threads if n >= PARALLEL_MIN else 1,
-                                  schedule="dynamic", chunksize=1):
-                r = last - k_round
-                poll_signals()
-                hilbert_sort(a, b, a, count[r - 1] if r > 0 else 0, count[r], axis, 1.0, 1.0,
-                             &round_state[r])
+            # every site along one curve (its grid over all the sites, crowded cells again over their
+            # own), then each round takes its sites in that order: each round is ordered along the curve
+            curve_sort(&xs[0], &ys[0], a, b, n, 0)
+            poll_signals()
             for k in range(n):
-                perm[k] = a[k].i
+                r = round_of[a[k].i]
+                perm[count[r]] = a[k].i
+                count[r] += 1
+            # the first round (at most 127 sites: all of them when there are fewer than 128) in random
+            # order, the textbook randomized incremental order: too few sites for their order to cost,
+            # and the seed orders even a small set (count[0] is now where the first round ends)
+            for k in range(count[0] - 1, 0, -1):
+                j = <Py_ssize_t> (((next_random(&state) >> 32) * <uint64_t> (k + 1)) >> 32)
+                tmp = perm[k]
+                perm[k] = perm[j]
+                perm[j] = tmp
     finally:
         free(a)
         free(b)
-    return np.asarray(perm)
+    return perm_arr
