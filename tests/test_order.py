@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from conftest import DATASETS
 from tvoronoi.kernels.order import brio_order, hilbert_indices
@@ -13,6 +15,47 @@ def test_a_permutation_for_every_data_set(name):
     perm = brio_order(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), 0)
     assert perm.dtype == np.int32
     assert np.array_equal(np.sort(perm), np.arange(len(pts)))
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    values=st.lists(st.tuples(finite, finite), min_size=1, max_size=300),
+    repeats=st.integers(0, 3),
+    seed=st.integers(-(2**70), 2**70),
+)
+def test_a_permutation_of_any_finite_doubles(values, repeats, seed):
+    """Any finite doubles (subnormals, +-0, spans that overflow, repeated points, boxes of any aspect):
+    the order is a permutation, the same for the same seed."""
+    pts = np.array(values * (1 + repeats), np.float64)
+    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+    perm = brio_order(xs, ys, seed)
+    assert perm.dtype == np.int32 and np.array_equal(np.sort(perm), np.arange(len(xs)))
+    assert np.array_equal(brio_order(xs, ys, seed), perm)
+
+
+@pytest.mark.parametrize("levels", [3, 20, 30])
+def test_clusters_inside_clusters_are_ordered_inside(rng, levels):
+    """Nested clusters at the origin, each 1e-9 the width of the one around it (30 levels: 1e-261),
+    2,000 sites at each level: a permutation; and up to MAX_DEPTH levels of nesting, consecutive sites
+    of the innermost cluster's part of the last round are near at its own scale (each crowded cell is
+    ordered again on its own box). Deeper nesting keeps its order in the last level's cells."""
+    n = 2000
+    width = 1e-9 ** (levels - 1)
+    xs = np.concatenate([1e-9**k * rng.random(n) for k in range(levels)])
+    ys = np.concatenate([1e-9**k * rng.random(n) for k in range(levels)])
+    perm = brio_order(xs, ys, 0)
+    assert np.array_equal(np.sort(perm), np.arange(len(xs)))
+    if levels <= 20:
+        # consecutive sites of the order that are both in the innermost cluster (each round takes its
+        # sites of that cluster one after the other): about width / sqrt(1000) apart along a curve, a
+        # third of the width in a random order
+        inner = perm >= (levels - 1) * n
+        pairs = np.flatnonzero(inner[:-1] & inner[1:])
+        step = np.hypot(xs[perm[pairs + 1]] - xs[perm[pairs]], ys[perm[pairs + 1]] - ys[perm[pairs]]).mean()
+        assert len(pairs) > n // 2 and step < width / 10, (step, width)
 
 
 def test_same_seed_same_order(rng):
