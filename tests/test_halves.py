@@ -181,6 +181,24 @@ def test_a_large_build_goes_by_halves_and_threads_agree(engine):
     assert np.array_equal(w.cell_points[w.cell_vertices], two.cell_points[two.cell_vertices])
 
 
+def test_coordinates_near_the_double_range_cut_without_overflow():
+    """Sites from -1e308 to 1e308 in x and -1.7e308 to 1.7e308 in y, above the size that splits: the
+    cut measures its spans without overflow (no warning, even as an error), cuts the longer side (y),
+    and both thread counts give the same Diagram."""
+    import warnings
+
+    rng = np.random.default_rng(12)
+    n = halves.SPLIT_MIN_SITES + 4464
+    pts = np.c_[1e308 * rng.uniform(-1, 1, n), 1.7e308 * rng.uniform(-1, 1, n)]
+    box = (-1.79e308, -1.79e308, 1.79e308, 1.79e308)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = halves.cut(pts[:, 0], pts[:, 1])
+        assert c is not None and c.axis == 1
+        one, two = api.voronoi(pts, bbox=box, threads=1), api.voronoi(pts, bbox=box, threads=2)
+    assert_same_diagram(one, two)
+
+
 def test_no_cut_when_the_median_line_holds_most_sites():
     """Most sites on one vertical and one horizontal line: no balanced cut, the whole triangulation."""
     y = np.arange(100.0)

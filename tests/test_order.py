@@ -58,6 +58,15 @@ def test_clusters_inside_clusters_are_ordered_inside(rng, levels):
         assert len(pairs) > n // 2 and step < width / 10, (step, width)
 
 
+@pytest.mark.parametrize("n", [5, 60, 127, 200])
+def test_the_seed_orders_a_small_set_too(rng, n):
+    """Fewer than 128 sites are one round, in random order: another seed, another order (a round
+    along the curve alone would not depend on the seed)."""
+    xs, ys = rng.random(n), rng.random(n)
+    orders = {tuple(brio_order(xs, ys, seed)) for seed in range(8)}
+    assert len(orders) > 1
+
+
 def test_same_seed_same_order(rng):
     xs, ys = rng.random(5000), rng.random(5000)
     assert np.array_equal(brio_order(xs, ys, 7), brio_order(xs, ys, 7))
@@ -127,7 +136,7 @@ def mean_step(xs, ys, perm, n):
     return np.hypot(np.diff(xs[last]), np.diff(ys[last])).mean()
 
 
-@pytest.mark.parametrize("width", [1.0, 1e-9, 1e-300])
+@pytest.mark.parametrize("width", [1.0, 1e-9, 1e-300, 1e-310])
 def test_consecutive_sites_are_near_at_any_scale(rng, width):
     """A square cluster of this width and two far sites: consecutive sites of a round are as near
     as in a uniform square (a curve of fixed resolution over the sites' box puts the whole cluster

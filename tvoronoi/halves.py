@@ -45,7 +45,8 @@ def cut(xs: np.ndarray, ys: np.ndarray) -> Cut | None:
     n = len(xs)
     if n < 4:
         return None
-    spans = (float(xs.max() - xs.min()), float(ys.max() - ys.min()))
+    # (half spans: a span of the unscaled coordinates may overflow, as from -1e308 to 1e308)
+    spans = (float(xs.max()) / 2 - float(xs.min()) / 2, float(ys.max()) / 2 - float(ys.min()) / 2)
     for axis in (0, 1) if spans[0] >= spans[1] else (1, 0):
         c = xs if axis == 0 else ys
         split = float(np.partition(c, n // 2)[n // 2])

@@ -40,6 +40,12 @@ cdef inline uint64_t next_random(uint64_t* state) noexcept nogil:
     return z ^ (z >> 31)
 
 
+# spans below TINY_SPAN (2^-900) are measured times TINY_SCALE (2^600): a grid's scale (cells / span)
+# stays finite
+cdef double TINY_SPAN = 2.0 ** -900
+cdef double TINY_SCALE = 2.0 ** 600
+
+
 cdef struct Keyed:
     uint32_t key        # the cell's place along the curve
     int32_t i           # input index
@@ -103,9 +109,10 @@ cdef int curve_keys(const double* xs, const double* ys, Keyed* items, Py_ssize_t
         y0 = y if y < y0 else y0
         y1 = y if y > y1 else y1
     # (halves where a span overflows, as from -1e308 to 1e308: halving is exact but for subnormals, and
-    # the cells only steer the order)
-    fx = 1.0 if x1 - x0 < INFINITY else 0.5
-    fy = 1.0 if y1 - y0 < INFINITY else 0.5
+    # the cells only steer the order; times 2^600 where a span is so small that a cell's scale would
+    # overflow: such sites are all below about 1e-289, so the product is exact and finite)
+    fx = 0.5 if not x1 - x0 < INFINITY else (TINY_SCALE if 0 < x1 - x0 < TINY_SPAN else 1.0)
+    fy = 0.5 if not y1 - y0 < INFINITY else (TINY_SCALE if 0 < y1 - y0 < TINY_SPAN else 1.0)
     x0 *= fx
     y0 *= fy
     w = x1 * fx - x0
@@ -311,9 +318,9 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
                 r = round_of[a[k].i]
                 perm[count[r]] = a[k].i
                 count[r] += 1
-            # the first round (at most 127 sites: all of them when there are fewer than 128) in random
-            # order, the textbook randomized incremental order: too few sites for their order to cost,
-            # and the seed orders even a small set (count[0] is now where the first round ends)
+            # the first round (64 to 127 sites expected, or all of them when there are fewer than 128) in
+            # random order, the textbook randomized incremental order: too few sites for their order to
+            # cost, and the seed orders even a small set (count[0] is now where the first round ends)
             for k in range(count[0] - 1, 0, -1):
                 j = <Py_ssize_t> (((next_random(&state) >> 32) * <uint64_t> (k + 1)) >> 32)
                 tmp = perm[k]
