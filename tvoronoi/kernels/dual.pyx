@@ -61,8 +61,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         (vertex n is the vertex at infinity).
     exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
         returned in the user's unit, each coordinate correctly rounded.
-    threads : int, threads for the circumcentres and the cocircular test (the result is the same
-        for any count), when there are at least parallel_min sites.
+    threads : int, threads for the walks (each computing the vertices it numbers) and the cocircular
+        test (the result is the same for any count), when there are at least parallel_min sites.
     walk_chunk : int, sites walked in a row by one thread (tests make it small, so that most lookups
         wait for the pass after the walks).
     clip_room : bool, leave room after the vertices for the points clip.clip_cells adds on the box
@@ -150,10 +150,13 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
     w.vor = &vor[0]; w.vid = &vid[0]; w.tri = tri_rows
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
+    w.xs = &xs[0]; w.ys = &ys[0]; w.e = exponent; w.centre = &centre[0, 0] if n_finite > 0 else NULL
+    cdef int h0
 
     with nogil:
         # the walks: one per site, in the sites' order, each making its cell's half-edges and numbering
-        # the vertices it meets first; on one thread, one after the other
+        # (and computing) the vertices it meets first; on one thread, one after the other, each cell's
+        # zero-length edges found as soon as its walk ends
         if threads == 1:
             h = 0
             m = 0
@@ -164,8 +167,15 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     prefetch(&tv[first_e[a + AHEAD]])
                     prefetch(&opp[first_e[a + AHEAD]])
                 h_first[a] = h
+                h0 = h
                 h, m = walk_site(&w, a, h, m, 0)
+                n_zero += zero_after_walk(&w, h0, h, &zero[0])
             h_first[n] = h
+            if n_zero > 0:
+                # the twins of the edges marked, now that every twin is made
+                for g in range(h):
+                    if zero[g]:
+                        zero[he_twin[g]] = 1
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; an
             # origin or twin that another run may not have made yet is left as its Delaunay triangle or
@@ -194,21 +204,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             if h_first[a + 1] > h_first[a]:
                 face_edge[a] = h_first[a]
 
-        # every vertex: the correctly rounded circumcentre of its triangle (construct.circumcentre);
-        # in blocks, so that signals are seen between them
-        lo = 0
-        while lo < m:
-            poll_signals()
-            hi = lo + BLOCK if lo + BLOCK < m else m
-            for g in prange(lo, hi, num_threads=threads, schedule="static"):
-                circumcentre(xs[tri[g, 0]], ys[tri[g, 0]], xs[tri[g, 1]], ys[tri[g, 1]],
-                             xs[tri[g, 2]], ys[tri[g, 2]], exponent, &centre[g, 0], &centre[g, 1])
-            lo = hi
-
         # zero-length edges: equal exact centres round to equal doubles, so only edges whose ends
         # have equal rounded centres can join cocircular triangles; the exact in-circle test decides
+        # (on one thread, found after each walk above)
         lo = 0
-        while lo < h:
+        while lo < h and threads > 1:
             poll_signals()
             hi = lo + BLOCK if lo + BLOCK < h else h
             for g in prange(lo, hi, num_threads=threads, schedule="static"):
@@ -252,6 +252,10 @@ cdef struct Walk:
     int32_t* he_origin
     int32_t* he_twin
     int32_t* he_face
+    const double* xs
+    const double* ys
+    int e
+    double* centre
 
 
 cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) noexcept nogil:
@@ -262,7 +266,8 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
     triangles whose smallest site is a are numbered from m on, as met. Sites from done_from up to a
     have been walked: a vertex or twin of an earlier site is looked up; one of a site before done_from
     (another thread's) is left as -2 - triangle or -1 - Delaunay half-edge, looked up later. The
-    triangle on the right of a->b is the one the walk left at the step before.
+    triangle on the right of a->b is the one the walk left at the step before. A vertex is computed
+    (construct.circumcentre) where it is numbered, while its sites are at hand.
     """
     # (locals, so that the stores below do not make the compiler read the struct again)
     cdef const int32_t* tv = w.tv
@@ -294,6 +299,8 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
                 if low == a:
                     vid[t] = m
                     tri[3 * m] = r0; tri[3 * m + 1] = r1; tri[3 * m + 2] = r2
+                    circumcentre(w.xs[r0], w.ys[r0], w.xs[r1], w.ys[r1], w.xs[r2], w.ys[r2], w.e,
+                                 &w.centre[2 * m], &w.centre[2 * m + 1])
                     he_origin[h] = m
                     m += 1
                 elif low >= done_from:
@@ -317,6 +324,37 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
     return h, m
 
 
+cdef inline int zero_after_walk(Walk* w, int h0, int h1, signed char* zero) noexcept nogil:
+    """zero_length for the half-edges h0..h1 - 1 that one walk (on one thread) just made, while they are
+    at hand: every vertex of the cell is known, and a twin not made yet is that of an edge tested from
+    here (its half-edge of smaller index). Marks those half-edges alone (their twins once all are made);
+    returns the count marked."""
+    cdef int g, vr, vl, a, b, count = 0
+    for g in range(h0, h1):
+        if w.he_twin[g] >= 0:
+            continue                # the twin came first: tested from there
+        vr = w.he_origin[g]
+        vl = w.he_origin[g + 1 if g + 1 < h1 else h0]
+        if vr < 0 or vl < 0:
+            continue
+        if w.centre[2 * vr] != w.centre[2 * vl] or w.centre[2 * vr + 1] != w.centre[2 * vl + 1]:
+            continue
+        a = w.he_face[g]
+        b = w.tv[-1 - w.he_twin[g]]      # the twin's Delaunay half-edge b->a
+        if cocircular(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys):
+            zero[g] = 1
+            count += 1
+    return count
+
+
+cdef inline bint cocircular(int a, int b, const int32_t* t_right, const int32_t* t_left, const double* xs,
+                            const double* ys) noexcept nogil:
+    # the triangles on both sides of Delaunay edge a-b share their circumcircle (exactly)
+    cdef int c = third(t_right, a, b), d = third(t_left, a, b)
+    # degenerate case: four cocircular sites
+    return incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0
+
+
 cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:
     # the half-edge after g around its cell: the following one while the face is the same, else the first
     if g + 1 < h and he_face[g + 1] == he_face[g]:
@@ -330,17 +368,12 @@ cdef inline int zero_length(int g, int h, const int32_t* he_origin, const int32_
                             signed char* zero) noexcept nogil:
     # is half-edge g (and its twin) of length zero, between cocircular triangles? Marks both; returns
     # the count marked. Each edge is tested once, from its half-edge of smaller index.
-    cdef int vr = he_origin[g], vl = he_origin[next_in_cell(g, h, he_face, face_edge)], a, b, c, d
+    cdef int vr = he_origin[g], vl = he_origin[next_in_cell(g, h, he_face, face_edge)]
     if vr < 0 or vl < 0 or he_twin[g] < g:
         return 0
     if centre[2 * vr] != centre[2 * vl] or centre[2 * vr + 1] != centre[2 * vl + 1]:
         return 0
-    a = he_face[g]
-    b = he_face[he_twin[g]]
-    c = third(&tri[3 * vr], a, b)
-    d = third(&tri[3 * vl], a, b)
-    # degenerate case: four cocircular sites
-    if incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) != 0:
+    if not cocircular(he_face[g], he_face[he_twin[g]], &tri[3 * vr], &tri[3 * vl], xs, ys):
         return 0
     zero[g] = 1
     zero[he_twin[g]] = 1
