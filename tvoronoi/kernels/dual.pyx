@@ -3,7 +3,7 @@
 import numpy as np
 
 from cython.parallel cimport prange
-from libc.stdint cimport int32_t
+from libc.stdint cimport int32_t, uint64_t
 
 from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -61,8 +61,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         (vertex n is the vertex at infinity).
     exponent : int, the sites are in a unit 2^-exponent of the user's: vertices are
         returned in the user's unit, each coordinate correctly rounded.
-    threads : int, threads for the walks (each computing the vertices it numbers) and the cocircular
-        test (the result is the same for any count), when there are at least parallel_min sites.
+    threads : int, threads for the walks (each computing the vertices it numbers and testing its cell
+        for zero-length edges; the result is the same for any count), when there are at least
+        parallel_min sites.
     walk_chunk : int, sites walked in a row by one thread (tests make it small, so that most lookups
         wait for the pass after the walks).
     clip_room : bool, leave room after the vertices for the points clip.clip_cells adds on the box
@@ -144,7 +145,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     centre = centre_buf
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
-    cdef int n_zero = 0
+    cdef int n_zero = 0, n_marked = 0
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
     cdef Walk w
     w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
@@ -155,8 +156,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
     with nogil:
         # the walks: one per site, in the sites' order, each making its cell's half-edges and numbering
-        # (and computing) the vertices it meets first; on one thread, one after the other, each cell's
-        # zero-length edges found as soon as its walk ends
+        # (and computing) the vertices it meets first, then testing its cell for zero-length edges
+        # (zero_after_walk); on one thread, one after the other
         if threads == 1:
             h = 0
             m = 0
@@ -169,13 +170,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 h_first[a] = h
                 h0 = h
                 h, m = walk_site(&w, a, h, m, 0)
-                n_zero += zero_after_walk(&w, h0, h, &zero[0])
+                n_marked += zero_after_walk(&w, a, h0, h, 0, &zero[0])
             h_first[n] = h
-            if n_zero > 0:
-                # the twins of the edges marked, now that every twin is made
-                for g in range(h):
-                    if zero[g]:
-                        zero[he_twin[g]] = 1
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; an
             # origin or twin that another run may not have made yet is left as its Delaunay triangle or
@@ -189,6 +185,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         prefetch(&tv[first_e[a + AHEAD]])
                         prefetch(&opp[first_e[a + AHEAD]])
                     walk_site(&w, a, h_first[a], v_first[a], a - (a - lo) % walk_chunk)
+                    n_marked += zero_after_walk(&w, a, h_first[a], h_first[a + 1], a - (a - lo) % walk_chunk,
+                                                &zero[0])
                 lo = hi
             lo = 0
             while lo < h:
@@ -204,17 +202,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             if h_first[a + 1] > h_first[a]:
                 face_edge[a] = h_first[a]
 
-        # zero-length edges: equal exact centres round to equal doubles, so only edges whose ends
-        # have equal rounded centres can join cocircular triangles; the exact in-circle test decides
-        # (on one thread, found after each walk above)
-        lo = 0
-        while lo < h and threads > 1:
-            poll_signals()
-            hi = lo + BLOCK if lo + BLOCK < h else h
-            for g in prange(lo, hi, num_threads=threads, schedule="static"):
-                n_zero += zero_length(g, h, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
-                                      &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0])
-            lo = hi
+        # the edges the walks marked: those left open decided now that every origin is known, and the
+        # twins of the zero-length ones marked (a twin comes after its edge)
+        if n_marked > 0:
+            n_zero = settle_zero(h, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0], &centre[0, 0],
+                                 &tri[0, 0], &xs[0], &ys[0], &zero[0])
     if n_zero > 0:
         parent = np.arange(max(m, 1), dtype=np.int32)
         with nogil:
@@ -324,27 +316,65 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
     return h, m
 
 
-cdef inline int zero_after_walk(Walk* w, int h0, int h1, signed char* zero) noexcept nogil:
-    """zero_length for the half-edges h0..h1 - 1 that one walk (on one thread) just made, while they are
-    at hand: every vertex of the cell is known, and a twin not made yet is that of an edge tested from
-    here (its half-edge of smaller index). Marks those half-edges alone (their twins once all are made);
-    returns the count marked."""
-    cdef int g, vr, vl, a, b, count = 0
+cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero) noexcept nogil:
+    """zero_length for the half-edges h0..h1 - 1 of site a's cell, right after its walk (done_from: as
+    in walk_site), while they are at hand. An edge is tested from its half-edge of smaller index, the
+    one whose twin's site comes later; a twin made already, or one of an earlier site, is skipped.
+    Marks 1 a zero-length edge, 2 one whose ends another thread's walk numbers (settle_zero decides
+    it); returns the count marked. The vertices a walk numbers are computed by then: those of sites
+    from done_from to a, walked before on this thread."""
+    cdef int g, vr, vl, b, count = 0
     for g in range(h0, h1):
         if w.he_twin[g] >= 0:
             continue                # the twin came first: tested from there
+        b = w.tv[-1 - w.he_twin[g]]      # the twin's Delaunay half-edge b->a
+        if b < a:
+            continue                # (another thread's earlier run)
         vr = w.he_origin[g]
         vl = w.he_origin[g + 1 if g + 1 < h1 else h0]
-        if vr < 0 or vl < 0:
+        if vr == -1 or vl == -1:
+            continue                # an end at infinity
+        if vr < -1 or vl < -1:
+            zero[g] = 2             # numbered by an earlier run: decided once it is known
+            count += 1
             continue
         if w.centre[2 * vr] != w.centre[2 * vl] or w.centre[2 * vr + 1] != w.centre[2 * vl + 1]:
             continue
-        a = w.he_face[g]
-        b = w.tv[-1 - w.he_twin[g]]      # the twin's Delaunay half-edge b->a
         if cocircular(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys):
             zero[g] = 1
             count += 1
     return count
+
+
+cdef int settle_zero(int h, const int32_t* he_origin, const int32_t* he_twin, const int32_t* he_face,
+                     const int32_t* face_edge, const double* centre, const int32_t* tri, const double* xs,
+                     const double* ys, signed char* zero) noexcept nogil:
+    # after the walks, with every origin and twin known: the edges left open (2) tested, and both
+    # half-edges of every zero-length edge marked 1; returns the count of half-edges marked. Eight
+    # flags at a time where none is set.
+    cdef int g, k, count = 0
+    cdef const uint64_t* words = <const uint64_t*> zero
+    for k in range(h // 8):
+        if words[k] == 0:
+            continue
+        for g in range(8 * k, 8 * k + 8):
+            count += settle_one(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    for g in range(h - h % 8, h):
+        count += settle_one(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    return count
+
+
+cdef inline int settle_one(int g, int h, const int32_t* he_origin, const int32_t* he_twin,
+                           const int32_t* he_face, const int32_t* face_edge, const double* centre,
+                           const int32_t* tri, const double* xs, const double* ys,
+                           signed char* zero) noexcept nogil:
+    if zero[g] == 2:
+        zero[g] = 0
+        return zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    if zero[g] == 1 and he_twin[g] > g:
+        zero[he_twin[g]] = 1
+        return 2
+    return 0
 
 
 cdef inline bint cocircular(int a, int b, const int32_t* t_right, const int32_t* t_left, const double* xs,
