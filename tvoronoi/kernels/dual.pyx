@@ -11,6 +11,15 @@ from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.prefetch cimport prefetch
 
+cdef extern from *:
+    """
+    /* set bit g of a bit array that several threads set bits of */
+    static inline void tvoronoi_set_bit(unsigned char* bits, int g) {
+        __atomic_fetch_or(&bits[g >> 3], (unsigned char) (1u << (g & 7)), __ATOMIC_RELAXED);
+    }
+    """
+    void set_bit "tvoronoi_set_bit"(unsigned char* bits, int g) noexcept nogil
+
 
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
@@ -145,6 +154,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     centre = centre_buf
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
+    # the edges a walk could not test (their ends another thread's walk numbers), a bit each: a few
+    # at the ends of the runs, scattered, so not in `zero`, whose pages are seldom written
+    cdef unsigned char[::1] open_bits = np.zeros(8 * ((n_he_d + 63) // 64 + 1), np.uint8)
     cdef int n_zero = 0, n_marked = 0
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
     cdef Walk w
@@ -170,7 +182,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 h_first[a] = h
                 h0 = h
                 h, m = walk_site(&w, a, h, m, 0)
-                n_marked += zero_after_walk(&w, a, h0, h, 0, &zero[0])
+                n_marked += zero_after_walk(&w, a, h0, h, 0, &zero[0], &open_bits[0])
             h_first[n] = h
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; an
@@ -186,7 +198,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         prefetch(&opp[first_e[a + AHEAD]])
                     walk_site(&w, a, h_first[a], v_first[a], a - (a - lo) % walk_chunk)
                     n_marked += zero_after_walk(&w, a, h_first[a], h_first[a + 1], a - (a - lo) % walk_chunk,
-                                                &zero[0])
+                                                &zero[0], &open_bits[0])
                 lo = hi
             lo = 0
             while lo < h:
@@ -206,7 +218,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         # twins of the zero-length ones marked (a twin comes after its edge)
         if n_marked > 0:
             n_zero = settle_zero(h, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0], &centre[0, 0],
-                                 &tri[0, 0], &xs[0], &ys[0], &zero[0])
+                                 &tri[0, 0], &xs[0], &ys[0], &zero[0], &open_bits[0])
     if n_zero > 0:
         parent = np.arange(max(m, 1), dtype=np.int32)
         with nogil:
@@ -316,12 +328,13 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
     return h, m
 
 
-cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero) noexcept nogil:
+cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero,
+                                unsigned char* open_bits) noexcept nogil:
     """zero_length for the half-edges h0..h1 - 1 of site a's cell, right after its walk (done_from: as
     in walk_site), while they are at hand. An edge is tested from its half-edge of smaller index, the
     one whose twin's site comes later; a twin made already, or one of an earlier site, is skipped.
-    Marks 1 a zero-length edge, 2 one whose ends another thread's walk numbers (settle_zero decides
-    it); returns the count marked. The vertices a walk numbers are computed by then: those of sites
+    Marks a zero-length edge 1 in zero, and one whose ends another thread's walk numbers in open_bits
+    (settle_zero decides it); returns the count marked. The vertices a walk numbers are computed by then: those of sites
     from done_from to a, walked before on this thread."""
     cdef int g, vr, vl, b, count = 0
     for g in range(h0, h1):
@@ -335,7 +348,7 @@ cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, s
         if vr == -1 or vl == -1:
             continue                # an end at infinity
         if vr < -1 or vl < -1:
-            zero[g] = 2             # numbered by an earlier run: decided once it is known
+            set_bit(open_bits, g)   # numbered by an earlier run: decided once it is known
             count += 1
             continue
         if w.centre[2 * vr] != w.centre[2 * vl] or w.centre[2 * vr + 1] != w.centre[2 * vl + 1]:
@@ -348,29 +361,30 @@ cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, s
 
 cdef int settle_zero(int h, const int32_t* he_origin, const int32_t* he_twin, const int32_t* he_face,
                      const int32_t* face_edge, const double* centre, const int32_t* tri, const double* xs,
-                     const double* ys, signed char* zero) noexcept nogil:
-    # after the walks, with every origin and twin known: the edges left open (2) tested, and both
-    # half-edges of every zero-length edge marked 1; returns the count of half-edges marked. Eight
-    # flags at a time where none is set.
+                     const double* ys, signed char* zero, const unsigned char* open_bits) noexcept nogil:
+    # after the walks, with every origin and twin known: the edges left open tested, and both
+    # half-edges of every zero-length edge marked 1; returns the count of half-edges marked (words
+    # with no flag set skipped whole)
     cdef int g, k, count = 0
-    cdef const uint64_t* words = <const uint64_t*> zero
+    cdef const uint64_t* words = <const uint64_t*> open_bits
+    for k in range((h + 63) // 64):
+        if words[k] == 0:
+            continue
+        for g in range(64 * k, min(64 * k + 64, h)):
+            if open_bits[g >> 3] & (1 << (g & 7)):
+                count += zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    words = <const uint64_t*> zero
     for k in range(h // 8):
         if words[k] == 0:
             continue
         for g in range(8 * k, 8 * k + 8):
-            count += settle_one(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+            count += mark_twin(g, he_twin, zero)
     for g in range(h - h % 8, h):
-        count += settle_one(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+        count += mark_twin(g, he_twin, zero)
     return count
 
 
-cdef inline int settle_one(int g, int h, const int32_t* he_origin, const int32_t* he_twin,
-                           const int32_t* he_face, const int32_t* face_edge, const double* centre,
-                           const int32_t* tri, const double* xs, const double* ys,
-                           signed char* zero) noexcept nogil:
-    if zero[g] == 2:
-        zero[g] = 0
-        return zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+cdef inline int mark_twin(int g, const int32_t* he_twin, signed char* zero) noexcept nogil:
     if zero[g] == 1 and he_twin[g] > g:
         zero[he_twin[g]] = 1
         return 2
