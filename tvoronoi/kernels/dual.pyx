@@ -330,19 +330,20 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
 
 cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero,
                                 unsigned char* open_bits) noexcept nogil:
-    """zero_length for the half-edges h0..h1 - 1 of site a's cell, right after its walk (done_from: as
-    in walk_site), while they are at hand. An edge is tested from its half-edge of smaller index, the
-    one whose twin's site comes later; a twin made already, or one of an earlier site, is skipped.
-    Marks a zero-length edge 1 in zero, and one whose ends another thread's walk numbers in open_bits
-    (settle_zero decides it); returns the count marked. The vertices a walk numbers are computed by then: those of sites
-    from done_from to a, walked before on this thread."""
+    """zero_length for the half-edges h0..h1 - 1 of site a's cell, right after its walk, while they are
+    at hand (done_from: as in walk_site; the vertices of the sites from done_from to a are computed by
+    then). Equal exact centres round to equal doubles, so only an edge whose ends have equal rounded
+    centres can join cocircular triangles; the exact in-circle test decides. An edge is tested from
+    its half-edge of smaller index, the one whose twin's site comes later. Marks a zero-length edge 1
+    in zero, and one whose ends an earlier run numbers (on another thread) in open_bits, for
+    settle_zero; returns the count marked."""
     cdef int g, vr, vl, b, count = 0
     for g in range(h0, h1):
         if w.he_twin[g] >= 0:
             continue                # the twin came first: tested from there
         b = w.tv[-1 - w.he_twin[g]]      # the twin's Delaunay half-edge b->a
         if b < a:
-            continue                # (another thread's earlier run)
+            continue                # the twin's site came first (in an earlier run): tested there
         vr = w.he_origin[g]
         vl = w.he_origin[g + 1 if g + 1 < h1 else h0]
         if vr == -1 or vl == -1:
