@@ -1,7 +1,7 @@
 """Builds on several threads give the same Diagram, bit for bit, as on one.
 
-The split phases are the Voronoi vertices and the cocircular test (dual.voronoi_from_delaunay) and the
-clipping of the cells (clip.clip_cells). The API tests use enough sites for the clipper to split; the
+The split phases are the dual's walks, which compute the Voronoi vertices and test their cells for
+zero-length edges (dual.voronoi_from_delaunay), and the clipping of the cells (clip.clip_cells). The API tests use enough sites for the clipper to split; the
 kernel tests force the split on every adversarial family, small as they are.
 """
 
@@ -120,3 +120,68 @@ def test_kernels_split_on_every_family(name):
         assert not np.shares_memory(got[0], other)
         for x, y in zip(got[:3], cells[0][:3]):
             assert np.array_equal(x, y)
+
+
+def test_walks_in_any_runs_find_the_same_zero_length_edges():
+    """Hypothesis hunts over small integer and rounded point sets (cocircular quadruples everywhere,
+    repeats, collinear runs): the dual on 2 or 3 threads with walks in runs of any length, where a
+    walk leaves open the edges whose ends an earlier run numbers, equals the one-thread dual, and its
+    zero-length edges are exactly the Delaunay edges between cocircular triangles."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    @st.composite
+    def sites(draw):
+        side = draw(st.integers(2, 12))
+        k = draw(st.integers(3, 160))
+        pts = draw(st.lists(st.tuples(st.integers(0, side), st.integers(0, side)), min_size=k, max_size=k))
+        pts = np.array(pts, float)
+        angle = draw(st.sampled_from([0.0, 0.5, 1.0]))
+        if angle:  # a lattice turned and rounded: cocircular ties that only the exact tests see
+            c, s = np.cos(angle), np.sin(angle)
+            pts = np.round(pts @ np.array([[c, -s], [s, c]]), draw(st.integers(0, 3)))
+        return pts
+
+    @settings(max_examples=150, deadline=None)
+    @given(sites(), st.integers(1, 9), st.integers(2, 3))
+    def check(pts, chunk, threads):
+        e = engines.scale_exponent(pts)
+        t = engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
+        if t.flat:
+            return
+        s = t.sites
+        one = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, 1)
+        many = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, walk_chunk=chunk)
+        for key in one:
+            assert np.array_equal(one[key], many[key]), key
+        # every Voronoi edge left has two distinct ends (the zero-length ones are all gone) ...
+        h, nxt_origin = one["he_origin"], np.empty_like(one["he_origin"])
+        face, first = one["he_face"], one["face_edge"]
+        last = np.r_[face[1:] != face[:-1], True]
+        nxt_origin[~last] = h[1:][~last[:-1]]
+        nxt_origin[last] = h[first[face[last]]]
+        both = (h >= 0) & (nxt_origin >= 0)
+        assert np.all(h[both] != nxt_origin[both])
+        # ... and as many vertices as the triangles have distinct circumcircles (exactly, in rationals)
+        assert len(one["vertices"]) == distinct_circles(s.xs, s.ys, t.tv)
+
+    check()
+
+
+def distinct_circles(xs, ys, tv) -> int:
+    """The number of distinct circumcircles of the finite triangles, in exact rational arithmetic:
+    a merged vertex per group of cocircular triangles that share edges (groups of a Delaunay
+    triangulation with one circle are connected), so distinct circles and merged vertices agree."""
+    from fractions import Fraction
+
+    n = len(xs)
+    circles = set()
+    for t in np.asarray(tv).reshape(-1, 3):
+        if n in t:
+            continue
+        (ax, ay), (bx, by), (cx, cy) = ((Fraction(xs[i]), Fraction(ys[i])) for i in t)
+        d = 2 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+        ux = ((ax * ax + ay * ay) * (by - cy) + (bx * bx + by * by) * (cy - ay) + (cx * cx + cy * cy) * (ay - by)) / d
+        uy = ((ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)) / d
+        circles.add((ux, uy))
+    return len(circles)
