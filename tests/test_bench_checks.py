@@ -3,6 +3,11 @@ distribution it is timed on, at any scale of the coordinates, and they fail on a
 
 from __future__ import annotations
 
+import re
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.spatial
@@ -35,3 +40,33 @@ def test_the_vertex_check_fails_on_vertices_off_by_a_factor():
     wrong = dict(out, vertices=np.ldexp(out["vertices"], 1))  # as the harness once read them
     with pytest.raises(tools.CheckFailed, match="not equidistant"):
         tools.check_tv_full(wrong, pts, box, tree)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_kernel_times_accounts_for_the_build(engine):
+    """benchmarks/kernel_times.py (in a process of its own: it wraps the kernel modules' functions):
+    the engine's kernels, the dual and the clipper are in its table, and on one thread their calls
+    add up to no more than the build."""
+    root = Path(__file__).resolve().parents[1]
+    res = subprocess.run(
+        [
+            sys.executable,
+            str(root / "benchmarks" / "kernel_times.py"),
+            "--n",
+            "5000",
+            "--engine",
+            engine,
+            "--repeats",
+            "2",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    )
+    build = float(re.search(r"build: ([\d.]+) ms", res.stdout).group(1))
+    rows = dict(re.findall(r"^\| ([\w.]+) \| ([\d.]+) \|", res.stdout, re.M))
+    first = "incremental.triangulate" if engine == "incremental" else "fortune.sweep"
+    for kernel in (first, "dual.voronoi_from_delaunay", "clip.clip_cells"):
+        assert kernel in rows, (kernel, res.stdout)
+    assert 0 < sum(float(ms) for ms in rows.values()) <= build
