@@ -18,7 +18,7 @@ and edges, no cells), Qhull (`scipy.spatial.Delaunay`, the triangulation alone),
 made as CGAL objects, then inserted; both timed) and, up to --geos-max sites, GEOS
 (`shapely.voronoi_polygons`, cells). The peak memory of a whole `tvoronoi.voronoi()` build is measured
 in a fresh process for each engine (its maximum resident set, less that of the same process before the
-build).
+build), and so is the time of that first build, where all of the process's memory is fresh.
 
     python benchmarks/phases.py --sizes 1M --out benchmarks/results/phases
 """
@@ -131,6 +131,7 @@ def others(pts: np.ndarray, geos_max: int) -> dict:
 
 PEAK = """
 import sys
+import time
 sys.path.insert(0, {repo!r})
 from benchmarks.phases import points
 import tvoronoi
@@ -144,16 +145,21 @@ def hwm():
 
 pts = points({dist!r}, {n})
 before = hwm()
+t0 = time.perf_counter()
 tvoronoi.voronoi(pts, engine={engine!r}, threads={threads})
-print((hwm() - before) / 1024)
+seconds = time.perf_counter() - t0
+print((hwm() - before) / 1024, seconds)
 """
 
 
-def build_peak(dist: str, n: int, engine: str, threads: int) -> float:
-    """MiB a whole build adds to a fresh process's peak."""
+def fresh_build(dist: str, n: int, engine: str, threads: int) -> tuple[float, float]:
+    """(MiB a whole build adds to a fresh process's peak, the seconds of that first build). A process's
+    first build is slower than the warm ones the phases time: on a virtual machine whose host takes
+    back freed memory, its first touches of memory cost the most (one build per process: the batch)."""
     code = PEAK.format(repo=str(Path(__file__).resolve().parent.parent), dist=dist, n=n, engine=engine, threads=threads)
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=subprocess_env(), check=True)
-    return float(res.stdout.strip())
+    peak, seconds = res.stdout.split()
+    return float(peak), float(seconds)
 
 
 def fmt_ns(seconds: float | None, n: int) -> str:
@@ -197,9 +203,9 @@ def main(argv=None) -> None:
                         "tool": f"tvoronoi {engine}",
                         "threads": threads,
                         **{p: med[p] for p in (*PHASES, "total", "system")},
-                        "peak_mib": build_peak(dist, n, engine, threads),
                     }
                 )
+                rows[-1]["peak_mib"], rows[-1]["first_build"] = fresh_build(dist, n, engine, threads)
                 print(
                     f"{dist:>13} n={n_pts:>9,} {engine:>11} threads={threads}: "
                     + " ".join(f"{p}={(med[p] or 0.0) * 1e3:.0f}ms" for p in (*PHASES, "total", "system")),
@@ -224,7 +230,9 @@ def report(rows: list[dict], info: dict) -> str:
         "ordered within tri: order reads -). The other tools are "
         "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
         "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
-        "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process. System: the "
+        "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process; first build: "
+        "that build's time (the process's first, where its memory is fresh; the phases are warm builds, "
+        "as are the other tools' calls). System: the "
         "kernel's time within a build (all threads, ms), mostly first touches of fresh memory: on a "
         "virtual machine whose host takes back freed memory it varies from run to run, and explains "
         "most of the swings of the phases.",
@@ -236,8 +244,8 @@ def report(rows: list[dict], info: dict) -> str:
             lines += [
                 f"## {dist}, n = {n:,}",
                 "",
-                "| build | threads | order | tri | dual | cells | total | system ms | peak MiB |",
-                "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+                "| build | threads | order | tri | dual | cells | total | system ms | peak MiB | first build |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             for r in sub:
                 if "order" in r:
@@ -246,12 +254,14 @@ def report(rows: list[dict], info: dict) -> str:
                         + " | ".join(fmt_ns(r[p], n) for p in PHASES)
                         + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | "
                         + (f"{r['system'] * 1e3:.0f}" if "system" in r else "")
-                        + f" | {r['peak_mib']:.0f} |"
+                        + f" | {r['peak_mib']:.0f} | "
+                        + (f"{r['first_build'] * 1e3:.0f} ms" if "first_build" in r else "")
+                        + " |"
                     )
             for r in sub:
                 if "order" not in r:
                     lines.append(
-                        f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | | |"
+                        f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | | | |"
                     )
             lines.append("")
     return "\n".join(lines)
