@@ -182,6 +182,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 h_first[a] = h
                 h0 = h
                 h, m = walk_site(&w, a, h, m, 0)
+                if h > h0:
+                    face_edge[a] = h0
                 n_marked += zero_after_walk(&w, a, h0, h, 0, &zero[0], &open_bits[0])
             h_first[n] = h
         else:
@@ -197,6 +199,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         prefetch(&tv[first_e[a + AHEAD]])
                         prefetch(&opp[first_e[a + AHEAD]])
                     walk_site(&w, a, h_first[a], v_first[a], a - (a - lo) % walk_chunk)
+                    if h_first[a + 1] > h_first[a]:
+                        face_edge[a] = h_first[a]
                     n_marked += zero_after_walk(&w, a, h_first[a], h_first[a + 1], a - (a - lo) % walk_chunk,
                                                 &zero[0], &open_bits[0])
                 lo = hi
@@ -210,15 +214,13 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     if he_twin[g] < 0:
                         he_twin[g] = vor[-1 - he_twin[g]]
                 lo = hi
-        for a in range(n):
-            if h_first[a + 1] > h_first[a]:
-                face_edge[a] = h_first[a]
 
         # the edges the walks marked: those left open decided now that every origin is known, and the
         # twins of the zero-length ones marked (a twin comes after its edge)
-        if n_marked > 0:
-            n_zero = settle_zero(h, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0], &centre[0, 0],
-                                 &tri[0, 0], &xs[0], &ys[0], &zero[0], &open_bits[0])
+        # (no finite triangle: no vertex, so nothing marked or open)
+        if n_finite > 0 and (n_marked > 0 or threads > 1):
+            n_zero = settle_zero(h, threads > 1, n_marked > 0, &he_origin[0], &he_twin[0], &he_face[0],
+                                 &face_edge[0], &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0], &open_bits[0])
     if n_zero > 0:
         parent = np.arange(max(m, 1), dtype=np.int32)
         with nogil:
@@ -336,7 +338,7 @@ cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, s
     centres can join cocircular triangles; the exact in-circle test decides. An edge is tested from
     its half-edge of smaller index, the one whose twin's site comes later. Marks a zero-length edge 1
     in zero, and one whose ends an earlier run numbers (on another thread) in open_bits, for
-    settle_zero; returns the count marked."""
+    settle_zero; returns the count marked in zero."""
     cdef int g, vr, vl, b, count = 0
     for g in range(h0, h1):
         if w.he_twin[g] >= 0:
@@ -350,7 +352,6 @@ cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, s
             continue                # an end at infinity
         if vr < -1 or vl < -1:
             set_bit(open_bits, g)   # numbered by an earlier run: decided once it is known
-            count += 1
             continue
         if w.centre[2 * vr] != w.centre[2 * vl] or w.centre[2 * vr + 1] != w.centre[2 * vl + 1]:
             continue
@@ -360,20 +361,26 @@ cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, s
     return count
 
 
-cdef int settle_zero(int h, const int32_t* he_origin, const int32_t* he_twin, const int32_t* he_face,
-                     const int32_t* face_edge, const double* centre, const int32_t* tri, const double* xs,
-                     const double* ys, signed char* zero, const unsigned char* open_bits) noexcept nogil:
-    # after the walks, with every origin and twin known: the edges left open tested, and both
-    # half-edges of every zero-length edge marked 1; returns the count of half-edges marked (words
-    # with no flag set skipped whole)
+cdef int settle_zero(int h, bint any_open, bint any_zero, const int32_t* he_origin, const int32_t* he_twin,
+                     const int32_t* he_face, const int32_t* face_edge, const double* centre, const int32_t* tri,
+                     const double* xs, const double* ys, signed char* zero,
+                     const unsigned char* open_bits) noexcept nogil:
+    # after the walks, with every origin and twin known: the edges left open tested (any_open: the
+    # walks ran on more than one thread), and both half-edges of every zero-length edge marked 1
+    # (any_zero: a walk marked one; an open edge found zero has both marked already); returns the
+    # count of half-edges marked, 0 when none is. Words with no flag set are skipped whole: `zero`'s
+    # pages are read only when a walk wrote to them.
     cdef int g, k, count = 0
     cdef const uint64_t* words = <const uint64_t*> open_bits
-    for k in range((h + 63) // 64):
-        if words[k] == 0:
-            continue
-        for g in range(64 * k, min(64 * k + 64, h)):
-            if open_bits[g >> 3] & (1 << (g & 7)):
-                count += zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    if any_open:
+        for k in range((h + 63) // 64):
+            if words[k] == 0:
+                continue
+            for g in range(64 * k, min(64 * k + 64, h)):
+                if open_bits[g >> 3] & (1 << (g & 7)):
+                    count += zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
+    if not any_zero:
+        return count
     words = <const uint64_t*> zero
     for k in range(h // 8):
         if words[k] == 0:
