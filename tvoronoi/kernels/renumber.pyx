@@ -300,12 +300,18 @@ def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
     cdef double x, y, c
     cdef double lx0 = INFINITY, ly0 = INFINITY, lx1 = -INFINITY, ly1 = -INFINITY
     cdef double rx0 = INFINITY, ry0 = INFINITY, rx1 = -INFINITY, ry1 = -INFINITY
+    cdef double lx, ly, rx, ry
+    cdef double up[2]
+    cdef double down[2]
     cdef bint below
+    up[0] = INFINITY; up[1] = -0.0          # [not below, below]
+    down[0] = -INFINITY; down[1] = -0.0
     hi = n - 1
     with nogil:
         # the left rows from the front, the right ones from the back (in reverse, turned round below);
-        # the side by a select, not a branch (the sides of rows in input order are as good as random),
-        # the boxes by branches on the coordinates, which seldom set a new extreme
+        # no branch on the side (the sides of rows in input order are as good as random): the row by a
+        # select, each box's bounds by min and max over every site, the other side's moved to +-inf by
+        # adding up[side] or down[side] (-0.0 leaves any coordinate as it is, a signed zero too)
         for k in range(n):
             x = xs[k]
             y = ys[k]
@@ -313,16 +319,22 @@ def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
             rows[lo if below else hi] = <int32_t> k
             lo += below
             hi -= 1 - below
-            if below:
-                if x < lx0: lx0 = x
-                if x > lx1: lx1 = x
-                if y < ly0: ly0 = y
-                if y > ly1: ly1 = y
-            else:
-                if x < rx0: rx0 = x
-                if x > rx1: rx1 = x
-                if y < ry0: ry0 = y
-                if y > ry1: ry1 = y
+            lx = x + up[below]
+            ly = y + up[below]
+            rx = x + up[1 - below]
+            ry = y + up[1 - below]
+            lx0 = lx if lx < lx0 else lx0
+            ly0 = ly if ly < ly0 else ly0
+            rx0 = rx if rx < rx0 else rx0
+            ry0 = ry if ry < ry0 else ry0
+            lx = x + down[below]
+            ly = y + down[below]
+            rx = x + down[1 - below]
+            ry = y + down[1 - below]
+            lx1 = lx if lx > lx1 else lx1
+            ly1 = ly if ly > ly1 else ly1
+            rx1 = rx if rx > rx1 else rx1
+            ry1 = ry if ry > ry1 else ry1
         hi = n - 1
         k = lo
         while k < hi:
