@@ -229,3 +229,63 @@ def test_scale_exponent_is_that_of_the_largest_magnitude(values, more):
     arrays = [np.array(values), np.array(more)]
     top = max(abs(v) for v in values + more)
     assert scale_exponent(*arrays) == (math.frexp(top)[1] if top > 0 else 0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    rows=st.lists(
+        st.tuples(
+            st.floats(width=64) | st.sampled_from([0.0, -0.0, 5e-324, -1e308]),
+            st.floats(width=64) | st.sampled_from([0.0, -0.0, 5e-324, -1e308]),
+        ),
+        max_size=40,
+    )
+)
+def test_point_bounds_is_numpys_reductions_in_one_pass(rows):
+    """The one-pass kernel: the count of non-finite values; else the box as numpy's reductions give it
+    (the first row's value among equal extremes, a zero's sign included) and the least nonzero
+    magnitude."""
+    from tvoronoi.kernels.bounds import point_bounds
+
+    pts = np.array(rows, np.float64).reshape(-1, 2)
+    n_bad, *box, smallest = point_bounds(pts)
+    assert n_bad == int((~np.isfinite(pts)).sum())
+    if n_bad or len(pts) == 0:
+        return
+    want = [math.inf, math.inf, -math.inf, -math.inf]
+    for x, y in pts.tolist():
+        want = [min(want[0], x), min(want[1], y), max(want[2], x), max(want[3], y)]  # (first of equals)
+    assert np.array_equal(np.array(box).view(np.int64), np.array(want).view(np.int64))
+    assert box == [pts[:, 0].min(), pts[:, 1].min(), pts[:, 0].max(), pts[:, 1].max()]
+    mags = np.abs(pts[pts != 0])
+    assert smallest == (mags.min() if mags.size else math.inf)
+
+
+def test_checked_points_range_verdict_is_check_ranges():
+    """checked_points reads the range rule off the one pass (the least nonzero magnitude against the
+    scale): it refuses exactly what check_range, comparing every value, refuses, and names the same row;
+    its bounds are the box, and default_bbox from them is default_bbox from the points."""
+    from tvoronoi.api import RANGE_BITS, checked_points, default_bbox
+    from tvoronoi.engines import scale_exponent
+    from tvoronoi.errors import CoordinateRangeError
+
+    rng = np.random.default_rng(27)
+    for _ in range(400):
+        e = int(rng.integers(-900, 900))
+        pts = rng.random((int(rng.integers(1, 30)), 2)) * 2.0**e * rng.choice([-1, 1], (1, 2))
+        for _ in range(int(rng.integers(0, 3))):
+            i, j = rng.integers(0, len(pts)), rng.integers(0, 2)
+            top = scale_exponent(pts)
+            pts[i, j] = rng.choice(
+                [0.0, -0.0, 2.0 ** (top - RANGE_BITS), -(2.0 ** (top - RANGE_BITS - 1)), 2.0 ** (top - RANGE_BITS - 3)]
+            )
+        expected = _reference_range_fault(pts, scale_exponent(pts))
+        if expected is None:
+            out, bounds = checked_points(pts)
+            assert np.array_equal(out, pts) and out.flags.c_contiguous
+            assert bounds == (pts[:, 0].min(), pts[:, 1].min(), pts[:, 0].max(), pts[:, 1].max())
+            assert default_bbox(out, bounds) == default_bbox(out) == _reference_bbox(pts)
+        else:
+            with pytest.raises(CoordinateRangeError) as info:
+                checked_points(pts)
+            assert info.value.rows[0] == expected[0]

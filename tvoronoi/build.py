@@ -22,24 +22,27 @@ def build_arrays():
     return pages.mapped()
 
 
-def build_diagram(pts: np.ndarray, box, *, engine: str, insertion: str, seed: int, threads: int = 1) -> Diagram:
-    """Build the Diagram of checked points (n, 2) in the checked box (threads: see api.voronoi)."""
-    e = engines.scale_exponent(pts)
+def build_diagram(
+    pts: np.ndarray, box, *, engine: str, insertion: str, seed: int, threads: int = 1, bounds=None
+) -> Diagram:
+    """Build the Diagram of checked points (n, 2) in the checked box (threads: see api.voronoi;
+    bounds: the points' own box when known, api.checked_points)."""
+    e = engines.scale_exponent(pts if bounds is None else bounds)
     engines.check_box_scale(box, e)
     with build_arrays():
-        t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads)
+        t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads, bounds=bounds)
         pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
         s, out = t.sites, t.voronoi(threads, clip_room=True)
         del t  # the triangulation is not needed to clip
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 
 
-def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed: int, threads: int):
+def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed: int, threads: int, bounds=None):
     """The triangulation of checked points, scaled by 2^-e, laid out for the dual: by halves
     (tvoronoi.halves) from SPLIT_MIN_SITES sites on, whatever the thread count (Fortune's sweep, or the
     incremental engine in BRIO order), else whole (triangulate_and_lay_out)."""
     if (engine == "fortune" or insertion == "brio") and len(pts) >= halves.SPLIT_MIN_SITES:
-        t = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, seed=seed, threads=threads)
+        t = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, seed=seed, threads=threads, bounds=bounds)
         if t is not None:
             return t
     s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, insertion=insertion, seed=seed, exponent=e)

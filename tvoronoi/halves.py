@@ -39,14 +39,17 @@ class Cut:
     box_right: tuple[float, float, float, float]
 
 
-def cut(xs: np.ndarray, ys: np.ndarray) -> Cut | None:
+def cut(xs: np.ndarray, ys: np.ndarray, bounds=None) -> Cut | None:
     """The cut at the median of the longer side of the sites' box (else of the other side), or None when
-    neither gives two halves of at least LEAST_SHARE of the sites each (xs, ys may be strided)."""
+    neither gives two halves of at least LEAST_SHARE of the sites each (xs, ys may be strided; bounds:
+    the sites' box (xmin, ymin, xmax, ymax) when known)."""
     n = len(xs)
     if n < 4:
         return None
+    if bounds is None:
+        bounds = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
     # (half spans: a span of the unscaled coordinates may overflow, as from -1e308 to 1e308)
-    spans = (float(xs.max()) / 2 - float(xs.min()) / 2, float(ys.max()) / 2 - float(ys.min()) / 2)
+    spans = (bounds[2] / 2 - bounds[0] / 2, bounds[3] / 2 - bounds[1] / 2)
     for axis in (0, 1) if spans[0] >= spans[1] else (1, 0):
         c = xs if axis == 0 else ys
         split = float(np.partition(c, n // 2)[n // 2])
@@ -144,7 +147,14 @@ def half(
 
 
 def triangulate(
-    xs: np.ndarray, ys: np.ndarray, exponent: int, *, engine: str = "incremental", seed: int = 0, threads: int = 1
+    xs: np.ndarray,
+    ys: np.ndarray,
+    exponent: int,
+    *,
+    engine: str = "incremental",
+    seed: int = 0,
+    threads: int = 1,
+    bounds=None,
 ):
     """The Delaunay triangulation of sites (input order, unscaled; xs, ys may be strided) scaled by
     2^-exponent, by halves, renumbered for the dual.
@@ -153,8 +163,9 @@ def triangulate(
     sites do not split (too many on the median lines, a half's sites collinear): the caller then
     triangulates them whole. Two threads work when ``threads`` is 2 or more, each half then ordered on
     half of them. Each half's sites are scaled as they are gathered: no scaled copy of all of them.
+    bounds: the sites' box (xmin, ymin, xmax, ymax), unscaled, when known (api.checked_points).
     """
-    c = cut(xs, ys)
+    c = cut(xs, ys, bounds)
     if c is None:
         return None
     c = scaled(c, exponent)
