@@ -10,6 +10,7 @@ import tvoronoi
 from conftest import DATASETS, GENERAL_POSITION
 from invariants import validate
 from oracle import assert_matches_oracle
+from tests import adversarial
 from tvoronoi.engines import sweep_order
 from tvoronoi.kernels import fortune, incremental
 
@@ -140,3 +141,63 @@ def test_sweep_order_is_a_stable_sort_by_y_then_x(rows):
     pts = np.array(rows, np.float64)
     want = np.argsort(pts[:, 1] + 1j * pts[:, 0], kind="stable")
     assert np.array_equal(sweep_order(pts[:, 0], pts[:, 1]), want)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# locating sites from hints (beach_line.locate_hinted): the same arcs as the tree's search
+
+
+def _sweep_both_ways(pts):
+    order = sweep_order(pts[:, 0], pts[:, 1])
+    xs, ys = np.ascontiguousarray(pts[order, 0]), np.ascontiguousarray(pts[order, 1])
+    return fortune.sweep(xs, ys), fortune.sweep(xs, ys, hints=False)
+
+
+def _assert_same_sweep(hinted, tree):
+    assert hinted["status"] == tree["status"] == fortune.STATUS_OK
+    for key in ("steps", "flips", "near_ties", "exact_tests"):
+        assert hinted[key] == tree[key], key
+    for key in ("tv", "opp", "dup"):
+        assert np.array_equal(hinted.get(key), tree.get(key)), key
+    assert tree["located"][0] == 0
+
+
+@pytest.mark.parametrize("family", sorted(adversarial.FAMILIES))
+def test_hinted_location_is_the_trees_on_every_hard_family(family):
+    """Every adversarial family (lattices in several orientations, cocircular rings, near-collinear rows,
+    rounded curves, repeats): the sweep with hints makes the same triangles, twins and counts, bit for
+    bit, as the sweep that searches the tree for every site."""
+    hinted, tree = _sweep_both_ways(adversarial.make(family, adversarial.SEED).points)
+    _assert_same_sweep(hinted, tree)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(3, 400),
+    span=st.sampled_from([3, 8, 40, 1000]),
+    turn=st.sampled_from([0.0, 0.3, 1.0]),
+    seed=st.integers(0, 2**16),
+)
+def test_hinted_location_is_the_trees_on_small_integer_sets(n, span, turn, seed):
+    """Small integer coordinates (many sites on one row, on one breakpoint, cocircular), turned and
+    rounded: ties at breakpoints are left to the tree, so the sweep is the same either way."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, span, size=(n, 2)).astype(np.float64)
+    c, s = np.cos(turn), np.sin(turn)
+    pts = np.round(pts @ np.array([[c, -s], [s, c]]), 3)
+    hinted, tree = _sweep_both_ways(pts)
+    if tree["status"] == fortune.STATUS_OK and "tv" in tree:
+        _assert_same_sweep(hinted, tree)
+
+
+@pytest.mark.parametrize("dist", ["uniform", "gaussian", "clustered"])
+def test_hints_locate_nearly_every_site(dist):
+    """The hints work: on 50,000 sites of each distribution, at least 97% are located by a short walk,
+    and the result is the tree's."""
+    from tvoronoi.generators import generate
+
+    hinted, tree = _sweep_both_ways(generate(dist, 50_000, seed=5))
+    _assert_same_sweep(hinted, tree)
+    walks, descents = hinted["located"]
+    assert walks + descents == 50_000 - 1  # (the first site starts the beach line)
+    assert walks >= 0.97 * 50_000

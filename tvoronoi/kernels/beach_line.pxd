@@ -1,6 +1,7 @@
 # Fortune's beach line (fortune.pyx): the arcs left to right, as an AVL tree (in the Sweep's arrays) and a
 # doubly linked list; positions are given, never searched by key, except where a new site is located
-# (exactly: parabola_order and coordinate comparisons). Inline helpers, compiled into the fortune module.
+# (exactly: parabola_order and coordinate comparisons), by a short walk along the list from a hint, else
+# down the tree. Inline helpers, compiled into the fortune module.
 
 from libc.stdint cimport int8_t
 
@@ -157,6 +158,7 @@ cdef inline void remove_arc(Sweep* s, int z) noexcept nogil:
     if child != NONE:
         s.parent[child] = p
     rebalance_up(s, p)
+    s.arc_site[z] = NONE
     s.free_arcs[s.n_free] = z
     s.n_free += 1
 
@@ -181,6 +183,91 @@ cdef inline int breakpoint_side(Sweep* s, int a, int b, double px, double py) no
         return 1          # degenerate case: both on the sweep row; p comes after them
     o = parabola_order(ax, ay, bx, by, px, py)
     return -1 if o > 0 else (1 if o < 0 else 0)
+
+
+cdef enum:
+    WALK_MAX = 8        # arcs a walk from a hint may pass before the tree is searched instead
+
+
+cdef inline int hint_slot(Sweep* s, double px) noexcept nogil:
+    """The strip of x that px lies in (0 .. n_hint - 1)."""
+    cdef double f = (px - s.hint_x0) * s.hint_scale
+    if not (f >= 0.0):
+        return 0
+    if f >= s.n_hint - 1:
+        return s.n_hint - 1
+    return <int> f
+
+
+cdef inline void set_hint(Sweep* s, double x, int arc) noexcept nogil:
+    """Arc (live) is where a site at x would be located now, or near it."""
+    cdef int k
+    if s.n_hint == 0:
+        return              # no hints: every site down the tree
+    k = hint_slot(s, x)
+    s.hint[k] = arc
+    s.hint_site[k] = s.arc_site[arc]
+
+
+cdef inline int walk_to_arc(Sweep* s, int h, double px, double py) noexcept nogil:
+    """The arc above p by a walk along the beach line from the live arc h: the arc whose breakpoints
+    have p strictly between them; NONE when p lies on a breakpoint, or further than WALK_MAX arcs.
+
+    Strictly between its breakpoints, the arc is the only one that locate_arc can return (the
+    breakpoints are in order along the line), so either way gives the same arc. At a breakpoint the
+    tree's search decides, as it always has.
+    """
+    cdef int a, c, k, side
+    # (a step left shows that p is left of the new arc's right breakpoint, a step right that it is right
+    # of its left one: neither is tested again)
+    cdef bint left_known = False, right_known = False
+    for k in range(WALK_MAX):
+        a = s.arc_prev[h]
+        if a != NONE and not left_known:
+            side = breakpoint_side(s, s.arc_site[a], s.arc_site[h], px, py)
+            if side < 0:
+                h = a
+                right_known = True
+                continue
+            if side == 0:
+                return NONE
+        c = s.arc_next[h]
+        if c != NONE and not right_known:
+            side = breakpoint_side(s, s.arc_site[h], s.arc_site[c], px, py)
+            if side > 0:
+                h = c
+                left_known = True
+                continue
+            if side == 0:
+                return NONE
+        return h
+    return NONE
+
+
+cdef inline int locate_hinted(Sweep* s, double px, double py) noexcept nogil:
+    """locate_arc, by a walk from the hint of p's strip (else of a strip beside it) when it holds a live
+    arc and the walk settles; else down the tree. Counts each way in n_walks and n_descents."""
+    cdef int k, h, v
+    if s.n_hint == 0:
+        s.n_descents += 1
+        return locate_arc(s, px, py)
+    k = hint_slot(s, px)
+    h = s.hint[k]
+    if h == NONE or s.arc_site[h] != s.hint_site[k]:
+        # a stale hint: the next strip's, else the one before's
+        if k + 1 < s.n_hint and s.hint[k + 1] != NONE and s.arc_site[s.hint[k + 1]] == s.hint_site[k + 1]:
+            h = s.hint[k + 1]
+        elif k > 0 and s.hint[k - 1] != NONE and s.arc_site[s.hint[k - 1]] == s.hint_site[k - 1]:
+            h = s.hint[k - 1]
+        else:
+            h = NONE
+    if h != NONE:
+        v = walk_to_arc(s, h, px, py)
+        if v != NONE:
+            s.n_walks += 1
+            return v
+    s.n_descents += 1
+    return locate_arc(s, px, py)
 
 
 cdef inline int locate_arc(Sweep* s, double px, double py) noexcept nogil:

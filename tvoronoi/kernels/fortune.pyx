@@ -24,7 +24,7 @@ from tvoronoi.kernels.sweep_state cimport (
     Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
     OK, BROKEN, NO_MEMORY, NO_REPAIR,
 )
-from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_arc
+from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_hinted, set_hint
 from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, site_first
 
 # The sweep line y = L moves upwards; sites are numbered in event order
@@ -281,7 +281,7 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
         s.status = BROKEN           # more arcs or edges than n sites can make
         return
     # find the arc above the site and split it in two around a new arc
-    b = locate_arc(s, px, py)
+    b = locate_hinted(s, px, py)
     site_b = s.arc_site[b]
     cancel_event(s, b)
     # split b into b, p, b2; the new edge starts on b's parabola right above p
@@ -295,6 +295,7 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
     s.arc_edge[b2] = s.arc_edge[b]
     s.arc_edge[b] = r
     s.arc_edge[p] = r
+    set_hint(s, px, p)
     check_circle(s, b)
     check_circle(s, b2)
 
@@ -330,6 +331,7 @@ cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     cancel_event(s, l)
     cancel_event(s, r)
     remove_arc(s, arc)
+    set_hint(s, s.ev_x[ev], l)
     s.arc_edge[l] = rec
     check_circle(s, l)
     check_circle(s, r)
@@ -455,7 +457,7 @@ cdef int repair(Sweep* s, int32_t* stack, int8_t* queued, int max_flips) noexcep
     return flips
 
 
-def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
+def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True):
     """Fortune's sweep over sites sorted by (y, x).
 
     Parameters
@@ -465,6 +467,10 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     stop_after : int
         Stop after this many events (site, repeat and circle events count
         one each) and return the sweep's state; -1 runs to the end.
+    hints : bool
+        Locate each site by a walk along the beach line from an arc met
+        lately near its x (beach_line.locate_hinted); False: always down the
+        tree. The same arcs either way (tests compare them).
 
     Returns
     -------
@@ -475,7 +481,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     ``flips`` (exact repairs), ``near_ties`` (comparisons the double filter
     left to the rises, those left to the double-double filter, events whose fine top
     was computed), ``exact_tests`` (site and circle comparisons left to exact
-    integers), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    integers), ``located`` (sites located by a walk from a hint, by the
+    tree), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
@@ -536,6 +543,22 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
     s.free_events = &free_events[0]; s.n_free_ev = 0
     s.free_arcs = &free_arcs[0]; s.n_free = 0
+    # the hints: strips of equal width across the sites' x, about sqrt(n) of them (a strip then holds
+    # an arc or two of the beach line over uniform sites; a new site finds a live arc in its strip or
+    # one beside it more than 99% of the time, on clustered sites too)
+    s.n_hint = 1
+    while hints and s.n_hint < sqrt(n) and s.n_hint < (1 << 22):
+        s.n_hint *= 2
+    hint_arr = np.full(2 * s.n_hint, NONE, np.int32)
+    cdef int32_t[::1] hint = hint_arr
+    s.hint = &hint[0]
+    s.hint_site = &hint[s.n_hint]
+    s.hint_x0 = float(np.min(xs)) if n else 0.0
+    cdef double x_span = float(np.max(xs)) - s.hint_x0 if n else 0.0
+    s.hint_scale = s.n_hint / x_span if x_span > 0.0 else 0.0
+    if not hints:
+        s.n_hint = 0
+    s.n_walks = 0; s.n_descents = 0
     s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]; s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
     s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]; s.n_recs = 0
     s.tv = &tv[0]; s.opp = &opp[0]; s.n_tri = 0
@@ -560,7 +583,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1):
         s.ev_fine = NULL
     out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
            "last": (s.last_kind, s.last_site, s.last_tri),
-           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle)}
+           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle), "located": (s.n_walks, s.n_descents)}
     if s.status != OK:
         return out
     cdef bint finished = next_site == n and s.n_heap == 0

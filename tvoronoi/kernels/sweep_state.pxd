@@ -43,6 +43,15 @@ cdef struct Sweep:
     int first_arc
     int32_t* free_arcs     # slots of removed arcs, reused so the live beach line stays in cache
     int n_free
+    # where to start locating a site: for each of n_hint strips of x, an arc made or kept there lately,
+    # and its site (the arc's slot may since have been freed, or reused for another site elsewhere)
+    int32_t* hint
+    int32_t* hint_site
+    int n_hint
+    double hint_x0
+    double hint_scale
+    long n_walks
+    long n_descents
     # circle events: position (top of the circle, rounded, and an interval that surely holds it),
     # centre, arc; a binary heap of their ids
     double* ev_y
