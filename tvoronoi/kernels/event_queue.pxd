@@ -12,9 +12,9 @@ from tvoronoi.kernels.fortune cimport ev_less_near, site_first_near
 # the exact order of events
 
 cdef inline void event_sites(Sweep* s, int ev, double* tri) noexcept nogil:
-    """The coordinates of the three sites of event ev (the arc and its two neighbours, counter-clockwise)."""
-    cdef int arc = s.ev_arc[ev]
-    cdef int a = s.arc_site[s.arc_prev[arc]], b = s.arc_site[arc], c = s.arc_site[s.arc_next[arc]]
+    """The coordinates of the three sites of event ev (the arc and its two neighbours when it was
+    scheduled, counter-clockwise: an event taken from its arc keeps its order until it is rescheduled)."""
+    cdef int a = s.ev_sites[3 * ev], b = s.ev_sites[3 * ev + 1], c = s.ev_sites[3 * ev + 2]
     tri[0] = s.x[a]; tri[1] = s.y[a]
     tri[2] = s.x[b]; tri[3] = s.y[b]
     tri[4] = s.x[c]; tri[5] = s.y[c]
@@ -76,16 +76,21 @@ cdef inline void heap_push(Sweep* s, int ev) noexcept nogil:
     sift_up(s, s.n_heap - 1)
 
 
+cdef inline void heap_fix(Sweep* s, int k) noexcept nogil:
+    """The event at heap slot k has a new position in the order: up or down to its place."""
+    if k > 0 and ev_less(s, s.heap[k], s.heap[(k - 1) // 2]):
+        sift_up(s, k)
+    else:
+        sift_down(s, k)
+
+
 cdef inline void heap_remove(Sweep* s, int ev) noexcept nogil:
     """Take event ev out of the heap and free its slot."""
     cdef int k = s.ev_pos[ev]
     s.n_heap -= 1
     if k < s.n_heap:
         heap_set(s, k, s.heap[s.n_heap])
-        if k > 0 and ev_less(s, s.heap[k], s.heap[(k - 1) // 2]):
-            sift_up(s, k)
-        else:
-            sift_down(s, k)
+        heap_fix(s, k)
     s.free_events[s.n_free_ev] = ev
     s.n_free_ev += 1
 
@@ -94,3 +99,11 @@ cdef inline void cancel_event(Sweep* s, int arc) noexcept nogil:
     if s.arc_event[arc] != NONE:
         heap_remove(s, s.arc_event[arc])
         s.arc_event[arc] = NONE
+
+
+cdef inline int take_event(Sweep* s, int arc) noexcept nogil:
+    """The arc's pending event (NONE if none), taken from the arc but left in the heap for check_circle
+    to reschedule in place or remove: one heap operation where a removal and a push were two."""
+    cdef int ev = s.arc_event[arc]
+    s.arc_event[arc] = NONE
+    return ev

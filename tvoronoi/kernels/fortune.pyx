@@ -25,7 +25,9 @@ from tvoronoi.kernels.sweep_state cimport (
     OK, BROKEN, NO_MEMORY, NO_REPAIR,
 )
 from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_hinted, set_hint
-from tvoronoi.kernels.event_queue cimport event_sites, heap_push, cancel_event, site_first
+from tvoronoi.kernels.event_queue cimport (
+    event_sites, heap_push, heap_fix, heap_remove, cancel_event, take_event, site_first,
+)
 
 # The sweep line y = L moves upwards; sites are numbered in event order
 # (by y, then x). Each arc of the beach line is a node of an AVL tree (in
@@ -182,17 +184,25 @@ cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
 # ---------------------------------------------------------------------------------------------------------
 # circle events: scheduling one
 
-cdef void check_circle(Sweep* s, int arc) noexcept nogil:
-    """Schedule the circle event of arc if its two breakpoints converge."""
+cdef void check_circle(Sweep* s, int arc, int old) noexcept nogil:
+    """Schedule the circle event of arc if its two breakpoints converge. old: the arc's former event,
+    taken from it (take_event) but still in the heap, or NONE: the new event takes its slot and moves
+    from its place in the heap, or it leaves the heap if there is no new event."""
     cdef int l = s.arc_prev[arc], r = s.arc_next[arc], a, b, c, ev
     if l == NONE or r == NONE:
+        if old != NONE:
+            heap_remove(s, old)
         return
     a = s.arc_site[l]
     b = s.arc_site[arc]
     c = s.arc_site[r]
     if a == c or orient2d(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c]) <= 0:
+        if old != NONE:
+            heap_remove(s, old)
         return
-    if s.n_free_ev > 0:
+    if old != NONE:
+        ev = old
+    elif s.n_free_ev > 0:
         s.n_free_ev -= 1
         ev = s.free_events[s.n_free_ev]
     elif s.n_events < s.cap_ev:
@@ -212,10 +222,16 @@ cdef void check_circle(Sweep* s, int arc) noexcept nogil:
                    &s.ev_rise[3 * ev], &s.ev_rise[3 * ev + 1], &s.ev_rise[3 * ev + 2], &s.ev_x[ev], &s.ev_cy[ev])
         s.ev_fine_state[ev] = FINE_UNKNOWN | RISE_KNOWN
     s.ev_arc[ev] = arc
+    s.ev_sites[3 * ev] = a
+    s.ev_sites[3 * ev + 1] = b
+    s.ev_sites[3 * ev + 2] = c
     s.ev_class[ev] = s.n_classes
     s.n_classes += 1
     s.arc_event[arc] = ev
-    heap_push(s, ev)
+    if old != NONE:
+        heap_fix(s, s.ev_pos[ev])
+    else:
+        heap_push(s, ev)
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -252,7 +268,7 @@ cdef inline void attach(Sweep* s, int r, int e) noexcept nogil:
 
 cdef void site_event(Sweep* s, int i) noexcept nogil:
     cdef double px = s.x[i], py = s.y[i]
-    cdef int b, p, b2, r, site_b
+    cdef int b, p, b2, r, site_b, old
     cdef double dy
     s.sweep_y = py
     s.last_site = i
@@ -283,7 +299,7 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
     # find the arc above the site and split it in two around a new arc
     b = locate_hinted(s, px, py)
     site_b = s.arc_site[b]
-    cancel_event(s, b)
+    old = take_event(s, b)          # b's event goes: rescheduled for b's left part, or removed
     # split b into b, p, b2; the new edge starts on b's parabola right above p
     dy = s.y[site_b] - py
     r = new_record(s, site_b, i, px,
@@ -296,13 +312,13 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
     s.arc_edge[b] = r
     s.arc_edge[p] = r
     set_hint(s, px, p)
-    check_circle(s, b)
-    check_circle(s, b2)
+    check_circle(s, b, old)
+    check_circle(s, b2, NONE)
 
 
 cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     cdef int arc = s.ev_arc[ev], l = s.arc_prev[arc], r = s.arc_next[arc]
-    cdef int a, b, c, t, rec
+    cdef int a, b, c, t, rec, old_l, old_r
     if (l == NONE or r == NONE or s.arc_edge[l] == NONE or s.arc_edge[arc] == NONE
             or s.n_tri >= s.cap_tri or s.n_recs >= s.cap_rec):
         s.status = BROKEN           # an event of an arc at the end of the beach line, or too many
@@ -328,13 +344,13 @@ cdef void circle_event(Sweep* s, int ev) noexcept nogil:
     s.last_site = b
     s.last_tri = t
     cancel_event(s, arc)            # the event itself leaves the heap
-    cancel_event(s, l)
-    cancel_event(s, r)
+    old_l = take_event(s, l)        # the neighbours' events: rescheduled in place, or removed
+    old_r = take_event(s, r)
     remove_arc(s, arc)
     set_hint(s, s.ev_x[ev], l)
     s.arc_edge[l] = rec
-    check_circle(s, l)
-    check_circle(s, r)
+    check_circle(s, l, old_l)
+    check_circle(s, r, old_r)
 
 
 cdef int step(Sweep* s, int* next_site) noexcept nogil:
@@ -500,6 +516,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
         "ev_fine_state": np.empty(cap_ev, np.int8),
         "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
+        "ev_sites": np.empty(3 * cap_ev, np.int32),
         "ev_class": np.empty(cap_ev, np.int64),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
@@ -518,7 +535,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     cdef double[::1] ev_y = arrays["ev_y"], ev_x = arrays["ev_x"], ev_cy = arrays["ev_cy"]
     cdef double[::1] ev_span = arrays["ev_span"], ev_rise = arrays["ev_rise"]
     cdef int8_t[::1] ev_fine_state = arrays["ev_fine_state"]
-    cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"]
+    cdef int32_t[::1] ev_arc = arrays["ev_arc"], heap = arrays["heap"], ev_sites = arrays["ev_sites"]
     cdef int64_t[::1] ev_class = arrays["ev_class"]
     cdef int32_t[::1] rec_a = arrays["rec_a"], rec_b = arrays["rec_b"]
     cdef int32_t[::1] rec_e0 = arrays["rec_e0"], rec_e1 = arrays["rec_e1"]
@@ -532,7 +549,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     s.left = &left[0]; s.right = &right[0]; s.parent = &parent[0]; s.height = &height[0]
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
-    s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]
+    s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]; s.ev_sites = &ev_sites[0]
     s.ev_class = &ev_class[0]; s.n_classes = 0
     s.ev_span = &ev_span[0]
     s.ev_rise = &ev_rise[0]

@@ -62,6 +62,7 @@ cdef struct Sweep:
     int8_t* ev_fine_state   # FINE_UNKNOWN, FINE_OK, FINE_NONE, | RISE_KNOWN
     double* ev_rise         # base, rise, rise error (3 per event), where RISE_KNOWN
     int32_t* ev_arc
+    int32_t* ev_sites       # the three sites of each event's circle (3 per event), as they were scheduled
     int64_t* ev_class       # events proven to have equal tops share a class (numbers never reused)
     int64_t n_classes
     int32_t* heap
