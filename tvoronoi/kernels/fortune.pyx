@@ -473,6 +473,23 @@ cdef int repair(Sweep* s, int32_t* stack, int8_t* queued, int max_flips) noexcep
     return flips
 
 
+cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap_arcs, int cap_ev, int cap_rec,
+                      int cap_tri) noexcept nogil:
+    """The counters and scalars of a sweep that has not begun, for both entries (sweep, sweep_triangles),
+    which set every array; no hints (n_hint 0: every site located down the tree) until the caller
+    gives some."""
+    s.x = x; s.y = y; s.n = n
+    s.root = NONE; s.n_arcs = 0; s.first_arc = NONE; s.n_free = 0
+    s.n_hint = 0; s.hint = NULL; s.hint_site = NULL; s.hint_x0 = 0.0; s.hint_scale = 0.0
+    s.n_walks = 0; s.n_descents = 0
+    s.n_classes = 0; s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0
+    s.n_recs = 0; s.n_tri = 0
+    s.row_mode = False; s.row_last = NONE
+    s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
+    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
+    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
+
+
 def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True):
     """Fortune's sweep over sites sorted by (y, x).
 
@@ -542,48 +559,40 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     cdef double[::1] rec_x = arrays["rec_x"], rec_y = arrays["rec_y"]
     cdef int32_t[::1] tv = arrays["tv"], opp = arrays["opp"], dup = arrays["dup"]
     cdef Sweep s
-    s.x = &xs[0] if n else NULL
-    s.y = &ys[0] if n else NULL
-    s.n = n
+    start_state(&s, &xs[0] if n else NULL, &ys[0] if n else NULL, n, cap_arcs, cap_ev, cap_rec, cap_tri)
     s.arc_site = &arc_site[0]; s.arc_prev = &arc_prev[0]; s.arc_next = &arc_next[0]
     s.left = &left[0]; s.right = &right[0]; s.parent = &parent[0]; s.height = &height[0]
     s.arc_event = &arc_event[0]; s.arc_edge = &arc_edge[0]
-    s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
     s.ev_y = &ev_y[0]; s.ev_x = &ev_x[0]; s.ev_cy = &ev_cy[0]; s.ev_arc = &ev_arc[0]; s.ev_sites = &ev_sites[0]
-    s.ev_class = &ev_class[0]; s.n_classes = 0
+    s.ev_class = &ev_class[0]
     s.ev_span = &ev_span[0]
     s.ev_rise = &ev_rise[0]
     s.ev_fine_state = &ev_fine_state[0]
     s.ev_fine = <double*>malloc(3 * cap_ev * sizeof(double))
     if s.ev_fine == NULL:
         raise MemoryError("Fortune's sweep: event buffers")
-    s.ev_pos = &ev_pos[0]; s.heap = &heap[0]; s.n_heap = 0; s.n_events = 0
-    s.free_events = &free_events[0]; s.n_free_ev = 0
-    s.free_arcs = &free_arcs[0]; s.n_free = 0
+    s.ev_pos = &ev_pos[0]; s.heap = &heap[0]
+    s.free_events = &free_events[0]
+    s.free_arcs = &free_arcs[0]
+    s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]; s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
+    s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]
+    s.tv = &tv[0]; s.opp = &opp[0]
+    s.dup = &dup[0] if n else NULL
     # the hints: strips of equal width across the sites' x, about sqrt(n) of them (a strip then holds
     # an arc or two of the beach line over uniform sites; a new site finds a live arc in its strip or
     # one beside it more than 99% of the time, on clustered sites too)
-    s.n_hint = 1
-    while hints and s.n_hint < sqrt(n) and s.n_hint < (1 << 22):
-        s.n_hint *= 2
-    hint_arr = np.full(2 * s.n_hint, NONE, np.int32)
+    cdef int n_hint = 1
+    while n_hint < sqrt(n) and n_hint < (1 << 22):
+        n_hint *= 2
+    hint_arr = np.full(2 * n_hint, NONE, np.int32)
     cdef int32_t[::1] hint = hint_arr
-    s.hint = &hint[0]
-    s.hint_site = &hint[s.n_hint]
-    s.hint_x0 = float(np.min(xs)) if n else 0.0
-    cdef double x_span = float(np.max(xs)) - s.hint_x0 if n else 0.0
-    s.hint_scale = s.n_hint / x_span if x_span > 0.0 else 0.0
-    if not hints:
-        s.n_hint = 0
-    s.n_walks = 0; s.n_descents = 0
-    s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]; s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
-    s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]; s.n_recs = 0
-    s.tv = &tv[0]; s.opp = &opp[0]; s.n_tri = 0
-    s.dup = &dup[0] if n else NULL
-    s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
-    s.row_mode = False; s.row_last = NONE
-    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
+    cdef double x_span = float(np.max(xs)) - float(np.min(xs)) if n else 0.0
+    if hints:
+        s.n_hint = n_hint
+        s.hint = &hint[0]
+        s.hint_site = &hint[n_hint]
+        s.hint_x0 = float(np.min(xs)) if n else 0.0
+        s.hint_scale = n_hint / x_span if x_span > 0.0 else 0.0
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
     # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
@@ -698,7 +707,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     memory comes from malloc.
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
-    cdef int n_i32 = 11 * cap_arcs + 4 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
+    cdef int n_i32 = 11 * cap_arcs + 7 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
     cdef int n_f64 = 9 * cap_ev + 2 * cap_rec
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
@@ -712,7 +721,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     if ib == NULL or fb == NULL or bb == NULL or fine == NULL or classes == NULL:
         free(ib); free(fb); free(bb); free(fine); free(classes)
         return -1
-    s.x = x; s.y = y; s.n = n
+    start_state(&s, x, y, n, cap_arcs, cap_ev, cap_rec, cap_tri)
     s.arc_site = p; p += cap_arcs
     s.arc_prev = p; p += cap_arcs
     s.arc_next = p; p += cap_arcs
@@ -723,7 +732,8 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.arc_edge = p; p += cap_arcs
     s.free_arcs = p; p += 3 * cap_arcs
     s.ev_arc = p; p += cap_ev
-    s.ev_class = classes; s.n_classes = 0
+    s.ev_sites = p; p += 3 * cap_ev
+    s.ev_class = classes
     s.ev_pos = p; p += cap_ev
     s.heap = p; p += cap_ev
     s.free_events = p; p += cap_ev
@@ -748,12 +758,6 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.ev_rise = q; q += 3 * cap_ev
     s.rec_x = q; q += cap_rec
     s.rec_y = q
-    s.root = NONE; s.n_arcs = 0; s.first_arc = NONE
-    s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0; s.n_free = 0; s.n_recs = 0; s.n_tri = 0
-    s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
-    s.row_mode = False; s.row_last = NONE
-    s.cap_arcs = cap_arcs; s.cap_ev = cap_ev; s.cap_rec = cap_rec; s.cap_tri = cap_tri
-    s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):
