@@ -201,3 +201,20 @@ def test_hints_locate_nearly_every_site(dist):
     walks, descents = hinted["located"]
     assert walks + descents == 50_000 - 1  # (the first site starts the beach line)
     assert walks >= 0.97 * 50_000
+
+
+def test_hints_outlast_outliers_and_give_way_to_the_tree():
+    """The strips span the middle 99.8% of the sites' x: a dense cluster with a few far outliers is
+    still located by walks. Two clusters far apart leave each one strip or two, where walks seldom
+    settle: the hints are given up after a trial, and the tree locates the rest. The same sweep as the
+    tree's either way."""
+    rng = np.random.default_rng(8)
+    outliers = np.r_[0.5 + 1e-3 * rng.random((20_000, 2)), rng.random((20, 2)) * 1000]
+    hinted, tree = _sweep_both_ways(outliers)
+    _assert_same_sweep(hinted, tree)
+    assert hinted["located"][0] >= 0.9 * len(outliers)
+    far = np.r_[1e-3 * rng.random((10_000, 2)), 1000 + 1e-3 * rng.random((10_000, 2))]
+    hinted, tree = _sweep_both_ways(far)
+    _assert_same_sweep(hinted, tree)
+    walks, descents = hinted["located"]
+    assert descents > 0.9 * len(far)

@@ -187,6 +187,7 @@ cdef inline int breakpoint_side(Sweep* s, int a, int b, double px, double py) no
 
 cdef enum:
     WALK_MAX = 8        # arcs a walk from a hint may pass before the tree is searched instead
+    HINTS_TRIAL = 2048  # sites searched in the tree before the hints may be given up (most sites were)
 
 
 cdef inline int hint_slot(Sweep* s, double px) noexcept nogil:
@@ -246,7 +247,8 @@ cdef inline int walk_to_arc(Sweep* s, int h, double px, double py) noexcept nogi
 
 cdef inline int locate_hinted(Sweep* s, double px, double py) noexcept nogil:
     """locate_arc, by a walk from the hint of p's strip (else of a strip beside it) when it holds a live
-    arc and the walk settles; else down the tree. Counts each way in n_walks and n_descents."""
+    arc and the walk settles; else down the tree. Counts each way in n_walks and n_descents, and gives
+    the hints up (n_hint = 0) once the tree has located more sites than the walks, past HINTS_TRIAL."""
     cdef int k, h, v
     if s.n_hint == 0:
         s.n_descents += 1
@@ -267,6 +269,8 @@ cdef inline int locate_hinted(Sweep* s, double px, double py) noexcept nogil:
             s.n_walks += 1
             return v
     s.n_descents += 1
+    if s.n_descents > HINTS_TRIAL and s.n_descents > s.n_walks:
+        s.n_hint = 0        # the strips do not fit these sites (clusters far apart): the tree alone from now
     return locate_arc(s, px, py)
 
 
