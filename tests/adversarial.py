@@ -218,6 +218,34 @@ def rounded_gaussian(n: int = 2000, *, decimals: int = 1, seed: int = SEED) -> C
     return Case(_pts(np.round(rng.normal(0.0, 1.0, (n, 2)), decimals)), note=f"gaussian, {decimals} decimals")
 
 
+def decimal_pythagorean(n: int = 2000, *, decimals: int = 3, seed: int = SEED) -> Case:
+    """Groups of five sites at decimal centres plus (3, 4), (-4, 3), (5, 0), (0, -5), (-3, -4) in the last
+    decimal, rounded: cocircular in decimals, not quite in binary, so the Voronoi vertices of a group
+    lie within an ulp of each other (some round to one point, some to neighbouring doubles)."""
+    rng = np.random.default_rng(seed)
+    q = 10.0**-decimals
+    offsets = np.array([[3, 4], [-4, 3], [5, 0], [0, -5], [-3, -4]], float) * q
+    centres = np.round(rng.uniform(0.0, 1.0, (n // 5, 2)), decimals)
+    return Case(
+        _pts(np.round((centres[:, None, :] + offsets[None]).reshape(-1, 2), decimals)),
+        note=f"decimal circles of 5, {decimals} decimals",
+    )
+
+
+def decimal_circles(circles: int = 150, *, decimals: int = 3, seed: int = SEED) -> Case:
+    """Integer points of the circles of radius 5, 13, 25 and 65 in units of the last decimal, around
+    decimal centres (most of each circle's points kept): up to 12 sites on a decimal circle."""
+    rng = np.random.default_rng(seed)
+    q = 10.0**-decimals
+    circles_at = [lattice_circle_points(r * r) for r in (5, 13, 25, 65)]
+    centres = np.round(rng.uniform(0.0, 200 * q, (circles, 2)), decimals)
+    parts = []
+    for c in centres:
+        ring = circles_at[rng.integers(0, len(circles_at))]
+        parts.append(np.round(c + ring[rng.random(len(ring)) < 0.6] * q, decimals))
+    return Case(_pts(np.concatenate(parts)), note=f"{circles} decimal circles, {decimals} decimals")
+
+
 # ---------------------------------------------------------------------------------------------
 # circles
 
@@ -457,6 +485,11 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "uniform_3dec": partial(rounded_uniform, 2000, decimals=3),
     "gaussian_1dec": partial(rounded_gaussian, 2000, decimals=1),
     "gaussian_2dec": partial(rounded_gaussian, 2000, decimals=2),
+    "decimal_pythagorean_3dec": partial(decimal_pythagorean, 1000, decimals=3),
+    "decimal_pythagorean_2dec_offset": lambda seed=SEED: Case(
+        decimal_pythagorean(600, decimals=2, seed=seed).points + 1000.0, note="decimal circles of 5 at 1000"
+    ),
+    "decimal_circles_3dec": partial(decimal_circles, 60, decimals=3),
     # circles
     "circle_rounded": partial(circle_rounded, 500),
     "circle_rounded_offset": partial(circle_rounded, 300, radius=1e-3, centre=(1e4, -1e4)),

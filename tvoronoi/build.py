@@ -62,29 +62,6 @@ def triangulate_and_lay_out(s: engines.Sites, *, engine: str, insertion: str, th
         return engines.spatial(t, threads, layout.result())
 
 
-def one_point_origins(he_origin: np.ndarray, pairs, m: int) -> np.ndarray:
-    """he_origin for the clipper: each group of distinct vertices that round to one point (the dual's
-    ``same_points``, joined by edges) named by its smallest number, so that every ring names that
-    point the same way, whichever of them its walk met (the rings are then merged and straightened by
-    the point's value alone, the same for both engines). he_origin itself when there are none."""
-    if pairs is None or len(pairs) == 0:
-        return he_origin
-    parent = np.arange(m, dtype=np.int32)
-
-    def root(v: int) -> int:
-        while parent[v] != v:
-            v = int(parent[v])
-        return v
-
-    for a, b in pairs.tolist():
-        ra, rb = root(a), root(b)
-        parent[max(ra, rb)] = min(ra, rb)
-    named = parent.copy()
-    for v in np.unique(pairs).tolist():
-        named[v] = root(v)
-    return np.where(he_origin >= 0, named[np.maximum(he_origin, 0)], he_origin).astype(np.int32)
-
-
 def assemble(
     pts, box, e, perm, exs, eys, out, *, engine, present=None, first_row_holds=True, threads: int = 1
 ) -> Diagram:
@@ -116,7 +93,7 @@ def assemble(
         exs,
         eys,
         out["vertices"],
-        one_point_origins(out["he_origin"], out.get("same_points"), len(out["vertices"])),
+        out["he_origin"],
         out["he_twin"],
         out["he_face"],
         out["face_edge"],

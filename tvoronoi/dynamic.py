@@ -11,7 +11,7 @@ from tvoronoi.api import as_bbox, as_points, check_engine, check_range, default_
 from tvoronoi.build import assemble
 from tvoronoi.diagram import Diagram
 from tvoronoi.errors import TvoronoiError
-from tvoronoi.kernels import dual, dynamic
+from tvoronoi.kernels import clip, dual, dynamic
 
 
 def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
@@ -24,6 +24,36 @@ def check_coordinate(x: float, y: float, e: int) -> tuple[float, float]:
         raise TvoronoiError(f"coordinates must be finite, got ({x!r}, {y!r})")
     check_range(np.array([[x, y]]), e, what="the new site", scale_of="the diagram")
     return x, y
+
+
+# a cell is read with the cells within this many Delaunay steps: a bent ring among them means the batch
+# build's straightening may reach it
+SETTLE_RADIUS = 2
+
+
+def settled_cell(mesh: dynamic.DynamicMesh, i: int, bbox, e: int) -> np.ndarray:
+    """Cell i of the mesh as the batch build makes it (tvoronoi.build): clipped and, where rounding made
+    rings cross themselves, straightened (clip.straighten) as the batch straightens every ring.
+
+    A merge changes a ring only through a bent ring that shares one of its points (its own or a
+    neighbour's), and a ring that was not bent bends only through such a merge: a chain of bends moves
+    one cell a round. The usual case has no bent ring within SETTLE_RADIUS steps: the cell as clipped.
+    Otherwise those cells are straightened together, the patch grown until every ring it bends lies
+    two steps inside its edge (or it holds the whole mesh). A chain of three rounds or more arriving
+    from beyond SETTLE_RADIUS would not be seen; the hunts (56,000 sessions on rounded lattices) met
+    none."""
+    radius = SETTLE_RADIUS
+    x0, y0, x1, y1 = bbox
+    ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
+    while patch is not None:
+        _ids, steps, offsets, xy = patch
+        was_bent = np.zeros(len(steps), np.int8)
+        new_offsets, rings = clip.straighten(xy, offsets, np.arange(len(xy), dtype=np.int32), bbox, was_bent)
+        if int(steps.max()) < radius or not (was_bent.view(bool) & (steps >= radius - 1)).any():
+            return xy[rings[new_offsets[0] : new_offsets[1]]]
+        radius *= 2
+        ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
+    return ring
 
 
 class DynamicVoronoi:
@@ -266,7 +296,7 @@ class DynamicDiagram:
         if not o._alive[i] or i in o._primary:
             return np.empty((0, 2))
         if o._mesh is not None:
-            return o._mesh.cell(i, *self.bbox, o._e)
+            return settled_cell(o._mesh, i, self.bbox, o._e)
         if o._flat is None:
             o._flat = self.to_diagram()
         return o._flat.cell_polygon(i)

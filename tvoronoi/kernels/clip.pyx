@@ -6,12 +6,12 @@ from libc.math cimport hypot
 from libc.stdlib cimport calloc, malloc, free
 from libc.string cimport memcpy, memmove
 from cython.parallel cimport prange
-from libc.stdint cimport int32_t, int64_t
+from libc.stdint cimport int32_t, int64_t, uint64_t
 from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
-    finish_ring, first_right_turn, turn, convex_ring,
+    finish_ring, first_right_turn, turn, convex_ring, bent,
 )
 from tvoronoi.kernels.prefetch cimport prefetch
 
@@ -260,12 +260,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     points = pts_buf[:n_pts]
     offs = np.asarray(offsets)
     if n_bent:
-        kind = np.full(n_pts, 2, np.int8)               # an interior vertex
-        on_side = (np.abs(np.asarray(vcx)[:m]) == 1) | (np.abs(np.asarray(vcy)[:m]) == 1)
-        kind[:m][on_side] = 1                            # a vertex on the boundary
-        kind[m:corner0] = 1                              # a crossing
-        kind[corner0:] = 0                               # a corner
-        offs, rings = straighten(points, offs, rings, kind)
+        offs, rings = straighten(points, offs, rings, (xmin, ymin, xmax, ymax))
     return points, offs, rings, status
 
 
@@ -532,24 +527,30 @@ def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
     return np.asarray(ids)
 
 
-def straighten(const double[:, ::1] points, offsets, rings, const signed char[::1] kind):
+def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed char[::1] was_bent=None):
     """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
     cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
     neighbours and an edge of the ring crosses another).
 
     In a ring that is not simple, each vertex at a right turn is merged with the nearer of its two
     ring neighbours, in every ring that has it (so neighbouring cells keep matching edges); merges keep
-    the point that is a corner, else one on the box boundary, else the lowest (y, then x), so the
-    result depends on the geometry alone, not on an engine's numbering. Repeats until every ring is
-    simple: every cell is then a simple counter-clockwise polygon, and such a subdivision covers the
-    box exactly once. A cell can vanish (all its vertices merged): a cell thinner than the rounding
-    everywhere.
+    the point that is a corner of the box (x0, y0, x1, y1), else one on its boundary, else the lowest
+    (y, then x). Points are named by their values, so the result depends on the values alone, not on
+    an engine's numbering. Repeats until every ring is simple: every cell is then a simple
+    counter-clockwise polygon, and such a subdivision covers the box exactly once. A cell can vanish
+    (all its vertices merged): a cell thinner than the rounding everywhere.
 
+    was_bent: optional (cells,) int8, set to 1 for every ring found bent in some round.
     Returns the new (offsets, rings).
     """
     cdef Py_ssize_t n_pts = points.shape[0]
-    parent_arr = np.arange(n_pts, dtype=np.int32)
+    cdef const signed char[::1] kind
+    # every point starts named by its value: distinct points that rounded to one value (exact vertices
+    # closer than rounding, with no edge between them; a crossing on a vertex) are one point to the
+    # merges, whichever of them a ring's walk met
+    parent_arr = value_names(points)
     cdef int32_t[::1] parent = parent_arr
+    kind = point_kinds(points, box_tuple)
     cdef const double* xy = &points[0, 0]
     cdef int32_t[::1] rv
     cdef int64_t[::1] ov
@@ -566,8 +567,10 @@ def straighten(const double[:, ::1] points, offsets, rings, const signed char[::
             cnt = <int> (ov[i + 1] - lo)
             if cnt == 0:
                 continue
-            if first_right_turn(&rv[lo], cnt, xy) < 0 or ring_is_simple(&rv[lo], cnt, xy):
+            if not bent(&rv[lo], cnt, xy):
                 continue
+            if was_bent is not None:
+                was_bent[i] = 1
             for k in range(cnt):
                 v = rv[lo + k]
                 u = rv[lo + (k + cnt - 1) % cnt]
@@ -603,6 +606,49 @@ def straighten(const double[:, ::1] points, offsets, rings, const signed char[::
     return offsets, rings
 
 
+def point_kinds(const double[:, ::1] points, box_tuple):
+    """Per point, by its value: 0 a corner of the box (x0, y0, x1, y1), 1 on a side, 2 inside (the
+    order in which straighten keeps points)."""
+    xmin, ymin, xmax, ymax = [float(v) for v in box_tuple]
+    x = np.asarray(points[:, 0])
+    y = np.asarray(points[:, 1])
+    on_x = (x == xmin) | (x == xmax)
+    on_y = (y == ymin) | (y == ymax)
+    return np.where(on_x & on_y, 0, np.where(on_x | on_y, 1, 2)).astype(np.int8)
+
+
+def value_names(const double[:, ::1] points):
+    """name[p]: the first point with the same value as point p (signed zeros equal), by one pass over
+    a hash table: the names depend on the values alone, not on which of equal points a ring holds."""
+    cdef Py_ssize_t n = points.shape[0], size = 16, p, q, slot
+    while size < 2 * n:
+        size *= 2
+    names_arr = np.empty(n, np.int32)
+    table_arr = np.full(size, -1, np.int32)
+    cdef int32_t[::1] name = names_arr
+    cdef int32_t[::1] table = table_arr
+    cdef double x, y
+    cdef uint64_t bx, by, mask = <uint64_t> (size - 1)
+    with nogil:
+        for p in range(n):
+            x = points[p, 0] + 0.0                  # -0.0 + 0.0 is +0.0: one key for both zeros
+            y = points[p, 1] + 0.0
+            memcpy(&bx, &x, 8)
+            memcpy(&by, &y, 8)
+            bx = (bx ^ (by * <uint64_t> 0x9E3779B97F4A7C15)) * <uint64_t> 0xC2B2AE3D27D4EB4F
+            slot = <Py_ssize_t> ((bx ^ (bx >> 29)) & mask)
+            name[p] = <int32_t> p
+            while table[slot] >= 0:
+                q = table[slot]
+                if points[q, 0] == x and points[q, 1] == y:
+                    name[p] = <int32_t> q
+                    break
+                slot = (slot + 1) & (size - 1)
+            if name[p] == p:
+                table[slot] = <int32_t> p
+    return names_arr
+
+
 cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_offsets, int32_t[::1] nv,
                     const double* xy):
     cdef int i, k, n_cells = ov.shape[0] - 1
@@ -615,33 +661,6 @@ cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_off
             nv[out + j] = rv[lo + j]
         out += finish_ring(&nv[out], k, xy)
     new_offsets[n_cells] = out
-
-
-cdef bint ring_is_simple(const int32_t* ring, int k, const double* xy) noexcept nogil:
-    # no two edges that do not follow each other meet (exact; rings are small, pairs are checked)
-    cdef int a, b
-    for a in range(k):
-        for b in range(a + 2, k):
-            if a == 0 and b == k - 1:
-                continue
-            if segments_meet(xy, ring[a], ring[(a + 1) % k], ring[b], ring[(b + 1) % k]):
-                return False
-    return True
-
-
-cdef inline bint on_segment(const double* xy, int p, int q, int r) noexcept nogil:
-    # r, collinear with p and q, lies within their bounding box
-    return (min(xy[2 * p], xy[2 * q]) <= xy[2 * r] <= max(xy[2 * p], xy[2 * q])
-            and min(xy[2 * p + 1], xy[2 * q + 1]) <= xy[2 * r + 1] <= max(xy[2 * p + 1], xy[2 * q + 1]))
-
-
-cdef bint segments_meet(const double* xy, int p, int q, int r, int s) noexcept nogil:
-    cdef int o1 = turn(xy, p, q, r), o2 = turn(xy, p, q, s)
-    cdef int o3 = turn(xy, r, s, p), o4 = turn(xy, r, s, q)
-    if o1 * o2 < 0 and o3 * o4 < 0:
-        return True
-    return ((o1 == 0 and on_segment(xy, p, q, r)) or (o2 == 0 and on_segment(xy, p, q, s))
-            or (o3 == 0 and on_segment(xy, r, s, p)) or (o4 == 0 and on_segment(xy, r, s, q)))
 
 
 cdef inline bint before(const double* xy, const signed char[::1] kind, int p, int q) noexcept nogil:
@@ -664,6 +683,15 @@ cdef inline int find(int32_t* parent, int p) noexcept nogil:
         parent[p] = root
         p = up
     return root
+
+
+def finished_ring(const double[:, ::1] points, ring) -> np.ndarray:
+    """finish_ring (clipper.pxd) of a ring of point numbers: the repeats and spikes dropped, from the
+    lowest point (for tests)."""
+    out = np.array(ring, np.int32)
+    cdef int32_t[::1] r = out
+    cdef int k = finish_ring(&r[0], <int> len(out), &points[0, 0]) if len(out) else 0
+    return out[:k]
 
 
 def bisector_crossing(double ax, double ay, double bx, double by, double t, bint along_y, int e=0) -> float:

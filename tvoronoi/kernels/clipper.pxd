@@ -475,6 +475,17 @@ cdef inline bint folds_back(const double* pts, int a, int b, int c) noexcept nog
     return turn(pts, a, b, c) == 0
 
 
+cdef inline int lowest(const int32_t* ring, int n, const double* pts) noexcept nogil:
+    """The position of a ring's lowest point (smallest y, then x; its first place if it repeats)."""
+    cdef int k, p, q, start = 0
+    for k in range(1, n):
+        p = ring[k]
+        q = ring[start]
+        if pts[2 * p + 1] < pts[2 * q + 1] or (pts[2 * p + 1] == pts[2 * q + 1] and pts[2 * p] < pts[2 * q]):
+            start = k
+    return start
+
+
 cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
     """Make a ring of rounded points a valid polygon and give it its canonical start.
 
@@ -482,8 +493,16 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
     the ring folds back on itself: exact vertices closer than doubles can separate round onto one line
     (the collapse the output documents). The ring then starts at its lowest point (smallest y, then x),
     so that every engine writes the same ring. Returns the count (0 if fewer than three points remain).
+
+    The drops are made from the lowest point on, not from wherever the ring's walk began: where they
+    could come out two ways (points zigzagging along one line), the choice reads the values alone.
     """
-    cdef int k, j = 0, start = 0, p, q, guard
+    cdef int k, j = 0, start = lowest(ring, n, pts), p, q, guard
+    if start > 0:
+        reverse(ring, 0, start)
+        reverse(ring, start, n)
+        reverse(ring, 0, n)
+    start = 0
     for k in range(n):
         p = ring[k]
         if j > 0 and same_point(pts, ring[j - 1], p):
@@ -510,11 +529,7 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
             break
     if j < 3:
         return 0
-    for k in range(1, j):
-        p = ring[k]
-        q = ring[start]
-        if pts[2 * p + 1] < pts[2 * q + 1] or (pts[2 * p + 1] == pts[2 * q + 1] and pts[2 * p] < pts[2 * q]):
-            start = k
+    start = lowest(ring, j, pts)
     # rotate left by start (three reversals)
     reverse(ring, 0, start)
     reverse(ring, start, j)
@@ -576,3 +591,36 @@ cdef inline int first_right_turn(const int32_t* ring, int n, const double* pts) 
         if turn(pts, ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]) < 0:
             return k
     return -1
+
+
+cdef inline bint ring_is_simple(const int32_t* ring, int k, const double* xy) noexcept nogil:
+    # no two edges that do not follow each other meet (exact; rings are small, pairs are checked)
+    cdef int a, b
+    for a in range(k):
+        for b in range(a + 2, k):
+            if a == 0 and b == k - 1:
+                continue
+            if segments_meet(xy, ring[a], ring[(a + 1) % k], ring[b], ring[(b + 1) % k]):
+                return False
+    return True
+
+
+cdef inline bint on_segment(const double* xy, int p, int q, int r) noexcept nogil:
+    # r, collinear with p and q, lies within their bounding box
+    return (min(xy[2 * p], xy[2 * q]) <= xy[2 * r] <= max(xy[2 * p], xy[2 * q])
+            and min(xy[2 * p + 1], xy[2 * q + 1]) <= xy[2 * r + 1] <= max(xy[2 * p + 1], xy[2 * q + 1]))
+
+
+cdef inline bint segments_meet(const double* xy, int p, int q, int r, int s) noexcept nogil:
+    cdef int o1 = turn(xy, p, q, r), o2 = turn(xy, p, q, s)
+    cdef int o3 = turn(xy, r, s, p), o4 = turn(xy, r, s, q)
+    if o1 * o2 < 0 and o3 * o4 < 0:
+        return True
+    return ((o1 == 0 and on_segment(xy, p, q, r)) or (o2 == 0 and on_segment(xy, p, q, s))
+            or (o3 == 0 and on_segment(xy, r, s, p)) or (o4 == 0 and on_segment(xy, r, s, q)))
+
+
+cdef inline bint bent(const int32_t* ring, int n, const double* pts) noexcept nogil:
+    """A finished ring that rounding made cross itself (a right turn, and two edges meet): the rings
+    the clipper straightens."""
+    return first_right_turn(ring, n, pts) >= 0 and not ring_is_simple(ring, n, pts)

@@ -157,8 +157,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     # the edges a walk could not test (their ends another thread's walk numbers), a bit each: a few
     # at the ends of the runs, scattered, so not in `zero`, whose pages are seldom written
     cdef unsigned char[::1] open_bits = np.zeros(8 * ((n_he_d + 63) // 64 + 1), np.uint8)
-    cdef int n_zero = 0, n_marked = 0, n_same = 0
-    cdef long long marks = 0
+    cdef int n_zero = 0, n_marked = 0
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
     cdef Walk w
     w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
@@ -185,7 +184,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 h, m = walk_site(&w, a, h, m, 0)
                 if h > h0:
                     face_edge[a] = h0
-                marks += zero_after_walk(&w, a, h0, h, 0, &zero[0], &open_bits[0])
+                n_marked += zero_after_walk(&w, a, h0, h, 0, &zero[0], &open_bits[0])
             h_first[n] = h
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; an
@@ -202,7 +201,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     walk_site(&w, a, h_first[a], v_first[a], a - (a - lo) % walk_chunk)
                     if h_first[a + 1] > h_first[a]:
                         face_edge[a] = h_first[a]
-                    marks += zero_after_walk(&w, a, h_first[a], h_first[a + 1], a - (a - lo) % walk_chunk,
+                    n_marked += zero_after_walk(&w, a, h_first[a], h_first[a + 1], a - (a - lo) % walk_chunk,
                                                 &zero[0], &open_bits[0])
                 lo = hi
             lo = 0
@@ -218,13 +217,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
         # the edges the walks marked: those left open decided now that every origin is known, and the
         # twins of the zero-length ones marked (a twin comes after its edge)
-        n_same = <int> (marks >> 32)
-        n_marked = <int> (marks - ((<long long> n_same) << 32))
         # (no finite triangle: no vertex, so nothing marked or open)
         if n_finite > 0 and (n_marked > 0 or threads > 1):
             n_zero = settle_zero(h, threads > 1, n_marked > 0, &he_origin[0], &he_twin[0], &he_face[0],
-                                 &face_edge[0], &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0], &open_bits[0],
-                                 &n_same)
+                                 &face_edge[0], &centre[0, 0], &tri[0, 0], &xs[0], &ys[0], &zero[0], &open_bits[0])
     if n_zero > 0:
         parent = np.arange(max(m, 1), dtype=np.int32)
         with nogil:
@@ -232,8 +228,6 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                                    &zero[0], &parent[0], &vid[0], &vor[0], &centre[0, 0])
 
     out = {
-        "same_points": same_point_pairs(h, m, he_origin, he_twin, he_face, face_edge, centre_buf) if n_same else
-                       np.empty((0, 2), np.int32),
         "vertices": centre_buf[:m],
         "he_origin": np.asarray(he_origin)[:h],
         "he_twin": np.asarray(he_twin)[:h],
@@ -336,7 +330,7 @@ cdef inline (int, int) walk_site(Walk* w, int a, int h, int m, int done_from) no
     return h, m
 
 
-cdef inline long long zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero,
+cdef inline int zero_after_walk(Walk* w, int a, int h0, int h1, int done_from, signed char* zero,
                                       unsigned char* open_bits) noexcept nogil:
     """zero_length for the half-edges h0..h1 - 1 of site a's cell, right after its walk, while they are
     at hand (done_from: as in walk_site; the vertices of the sites from done_from to a are computed by
@@ -344,10 +338,9 @@ cdef inline long long zero_after_walk(Walk* w, int a, int h0, int h1, int done_f
     centres can join cocircular triangles; the exact in-circle test decides. An edge is tested from
     its half-edge of smaller index, the one whose twin's site comes later. Marks a zero-length edge 1
     in zero, and one whose ends an earlier run numbers (on another thread) in open_bits, for
-    settle_zero. Returns the count marked in zero, plus 2^32 times the count of edges between two
-    distinct vertices that round to one point (not cocircular: see same_point_pairs)."""
+    settle_zero. Returns the count marked in zero. (Distinct vertices that round to one point, nearly
+    cocircular sites, are kept apart: the clipper names rounded points by their values.)"""
     cdef int g, vr, vl, b, count = 0
-    cdef long long same = 0
     for g in range(h0, h1):
         if w.he_twin[g] >= 0:
             continue                # the twin came first: tested from there
@@ -366,20 +359,17 @@ cdef inline long long zero_after_walk(Walk* w, int a, int h0, int h1, int done_f
         if cocircular(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys):
             zero[g] = 1
             count += 1
-        else:
-            same += 1               # degenerate case: two vertices closer than doubles can separate
-    return count + (same << 32)
+    return count
 
 
 cdef int settle_zero(int h, bint any_open, bint any_zero, const int32_t* he_origin, const int32_t* he_twin,
                      const int32_t* he_face, const int32_t* face_edge, const double* centre, const int32_t* tri,
                      const double* xs, const double* ys, signed char* zero,
-                     const unsigned char* open_bits, int* n_same) noexcept nogil:
+                     const unsigned char* open_bits) noexcept nogil:
     # after the walks, with every origin and twin known: the edges left open tested (any_open: the
     # walks ran on more than one thread), and both half-edges of every zero-length edge marked 1
     # (any_zero: a walk marked one; an open edge found zero has both marked already); returns the
-    # count of half-edges marked, 0 when none is; an open edge between two vertices that round to one
-    # point but are not cocircular counts in n_same. Words with no flag set are skipped whole: `zero`'s
+    # count of half-edges marked, 0 when none is. Words with no flag set are skipped whole: `zero`'s
     # pages are read only when a walk wrote to them.
     cdef int g, k, count = 0
     cdef const uint64_t* words = <const uint64_t*> open_bits
@@ -389,8 +379,7 @@ cdef int settle_zero(int h, bint any_open, bint any_zero, const int32_t* he_orig
                 continue
             for g in range(64 * k, min(64 * k + 64, h)):
                 if open_bits[g >> 3] & (1 << (g & 7)):
-                    count += zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero,
-                                         n_same)
+                    count += zero_length(g, h, he_origin, he_twin, he_face, face_edge, centre, tri, xs, ys, zero)
     if not any_zero:
         return count
     words = <const uint64_t*> zero
@@ -402,24 +391,6 @@ cdef int settle_zero(int h, bint any_open, bint any_zero, const int32_t* he_orig
     for g in range(h - h % 8, h):
         count += mark_twin(g, he_twin, zero)
     return count
-
-
-def same_point_pairs(int h, int m, const int32_t[::1] he_origin, const int32_t[::1] he_twin,
-                     const int32_t[::1] he_face, const int32_t[::1] face_edge, const double[:, ::1] centre):
-    """The edges whose two ends are distinct vertices that round to one point (degenerate case: sites
-    nearly cocircular, as decimals rounded to binary make them; cocircular ends are one vertex
-    already), as (k, 2) int32 pairs of vertex numbers, each edge once. The clipper takes each such group
-    as one point (build.assemble), so that every ring names a point the same way."""
-    cdef int g, o, d
-    pairs = []
-    for g in range(h):
-        if he_twin[g] < g:
-            continue
-        o = he_origin[g]
-        d = he_origin[next_in_cell(g, h, &he_face[0], &face_edge[0])]
-        if o >= 0 and d >= 0 and o != d and centre[o, 0] == centre[d, 0] and centre[o, 1] == centre[d, 1]:
-            pairs.append((o, d))
-    return np.array(pairs, np.int32).reshape(-1, 2)
 
 
 cdef inline int mark_twin(int g, const int32_t* he_twin, signed char* zero) noexcept nogil:
@@ -447,9 +418,9 @@ cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t
 cdef inline int zero_length(int g, int h, const int32_t* he_origin, const int32_t* he_twin,
                             const int32_t* he_face, const int32_t* face_edge, const double* centre,
                             const int32_t* tri, const double* xs, const double* ys,
-                            signed char* zero, int* n_same) noexcept nogil:
+                            signed char* zero) noexcept nogil:
     # is half-edge g (and its twin) of length zero, between cocircular triangles? Marks both; returns
-    # the count marked (ends that round to one point but are not cocircular: n_same + 1). Each edge is
+    # the count marked. Each edge is
     # tested once, from its half-edge of smaller index.
     cdef int vr = he_origin[g], vl = he_origin[next_in_cell(g, h, he_face, face_edge)]
     if vr < 0 or vl < 0 or he_twin[g] < g:
@@ -457,7 +428,6 @@ cdef inline int zero_length(int g, int h, const int32_t* he_origin, const int32_
     if centre[2 * vr] != centre[2 * vl] or centre[2 * vr + 1] != centre[2 * vl + 1]:
         return 0
     if not cocircular(he_face[g], he_face[he_twin[g]], &tri[3 * vr], &tri[3 * vl], xs, ys):
-        n_same[0] += 1
         return 0
     zero[g] = 1
     zero[he_twin[g]] = 1

@@ -5,17 +5,16 @@ import math
 import numpy as np
 
 from libc.stdint cimport int8_t, int32_t, int64_t, uint64_t
-from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
 from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between
 from tvoronoi.kernels.location cimport jump_note, jump_start, locate
 from tvoronoi.kernels.cavity cimport find_cavity
 from tvoronoi.kernels.fill cimport insert_site, fill_cavity
-from libc.stdlib cimport malloc, free
+from libc.stdlib cimport malloc, realloc, free
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge,
-    walk_cell, finish_ring,
+    walk_cell, finish_ring, bent, convex_ring,
 )
 from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.fortune cimport sweep_triangles
@@ -64,6 +63,8 @@ cdef class DynamicMesh:
     cdef int32_t* vmark             # scratch marks per site, and the epoch that makes them current
     cdef int32_t mark_epoch
     cdef int32_t* nextb             # scratch: the boundary edge leaving each site
+    cdef signed char* settled       # per site: its cell, as clipped, is known not bent (cells_near)
+    cdef tuple settled_box          # the box those cells were clipped to
     cdef int cap_v, cap_t
     cdef object jump_cells          # the jump grid's array (location.jump_start), made by load
     cdef Scratch scratch            # scratch of one update, grown to the largest hole or region met
@@ -112,7 +113,8 @@ cdef class DynamicMesh:
                 "tv": (3 * cap_t, np.int32), "opp": (3 * cap_t, np.int32), "stamp": (cap_t, np.int32),
                 "cavity": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
                 "bnd_twin": (cap_t + 2, np.int32), "free_tri": (cap_t, np.int32),
-                "changed": (cap_t + 2, np.int32), "vmark": (cap_v, np.int32), "nextb": (cap_v, np.int32)}
+                "changed": (cap_t + 2, np.int32), "vmark": (cap_v, np.int32), "nextb": (cap_v, np.int32),
+                "settled": (cap_v, np.int8)}
         new = {}
         for name, (size, dtype) in spec.items():
             arr = np.full(size, -1, dtype) if dtype is np.int32 else np.zeros(size, dtype)
@@ -130,6 +132,8 @@ cdef class DynamicMesh:
         cdef int32_t[::1] vmark = new["vmark"], nextb = new["nextb"]
         self.vmark = &vmark[0]
         self.nextb = &nextb[0]
+        cdef signed char[::1] settled = new["settled"]
+        self.settled = &settled[0]
         self.m.x = &x[0]
         self.m.y = &y[0]
         self.wx = &x[0]
@@ -209,6 +213,7 @@ cdef class DynamicMesh:
     def set_site(self, int site, double x, double y):
         """Place a site (not yet in the mesh), e.g. a repeated point that stays outside it."""
         self._reserve(site)
+        self.settled[site] = 0
         self.wx[site] = x
         self.wy[site] = y
 
@@ -229,6 +234,7 @@ cdef class DynamicMesh:
         jump_note(&self.m, site)
         self.m.changed[self.m.n_changed] = site
         self.m.n_changed += 1
+        self.unsettle()
         return -1
 
     def remove(self, int site):
@@ -243,6 +249,7 @@ cdef class DynamicMesh:
                 status = remove_by_sweep(&self.m, site, &self.scratch)
             if status == STATUS_NOT_SWEPT or status == STATUS_NO_MEMORY:
                 status = remove_site(&self.m, site, &self.scratch)
+        self.unsettle()
         return status
 
     # -- the same updates the way of Fortune's engine: sweep the changed region, splice the result --
@@ -269,6 +276,7 @@ cdef class DynamicMesh:
         self.swept_ok = status == 1
         self.m.changed[self.m.n_changed] = site
         self.m.n_changed += 1
+        self.unsettle()
         return -1
 
     def remove_swept(self, int site):
@@ -284,12 +292,15 @@ cdef class DynamicMesh:
                 swept = False
                 status = remove_site(&self.m, site, &self.scratch)
         self.swept_ok = swept
+        self.unsettle()
         return status
 
     def relabel(self, int old, int new):
         """Give the vertex of site old to site new (a repeated point taking over its place)."""
         cdef int e0, e
         self._reserve(new)
+        self.settled[old] = 0
+        self.settled[new] = 0
         self.wx[new] = self.m.x[old]
         self.wy[new] = self.m.y[old]
         e0 = self.m.vedge[old]
@@ -350,6 +361,126 @@ cdef class DynamicMesh:
             out[i, 1] = buf.pts[2 * buf.ring[i] + 1]
         free_cell_buffers(&buf)
         return out
+
+    cdef void unsettle(self) noexcept:
+        # the cells the last update changed are no longer known not bent
+        cdef int k
+        for k in range(self.m.n_changed):
+            if self.m.changed[k] >= 0 and self.m.changed[k] != INF_VERTEX:
+                self.settled[self.m.changed[k]] = 0
+
+    def cells_near(self, int site, double xmin, double ymin, double xmax, double ymax, int exponent,
+                   int radius):
+        """The cell of a site, as cell() reads it, and whether the batch build's straightening could
+        change it: when a cell of a site within `radius` Delaunay steps (the site's own included) is
+        bent (clipper.bent), also the cells of all those sites, for the caller to straighten.
+
+        Returns (ring, None), or (ring, (ids, steps, offsets, xy)): the sites breadth first from this
+        one (int32), their steps from it (int32), and their rings as rows of xy from offsets[k] to
+        offsets[k + 1] (int64). A site whose cell misses the box has an empty ring."""
+        cdef Box box = make_box(xmin, ymin, xmax, ymax, exponent)
+        cdef CellBuffers buf
+        cdef CentreMemo memo
+        cdef int32_t* ids = NULL
+        cdef int32_t* steps = NULL
+        cdef int32_t* grown
+        cdef int n_ids = 0, cap = 0, head = 0, star, max_star = 0, e0, e, j, k, i, any_bent = 0
+        cdef int32_t epoch
+        if self.m.vedge[site] < 0:
+            return np.empty((0, 2)), None
+        if self.settled_box != (xmin, ymin, xmax, ymax, exponent):
+            self.arrays["settled"][:] = 0
+            self.settled_box = (xmin, ymin, xmax, ymax, exponent)
+        self.mark_epoch += 1
+        epoch = self.mark_epoch
+        # breadth first from the site, to `radius` steps; the largest star sizes the buffers
+        cap = 64
+        ids = <int32_t*> malloc(cap * sizeof(int32_t))
+        steps = <int32_t*> malloc(cap * sizeof(int32_t))
+        if ids == NULL or steps == NULL:
+            free(ids); free(steps)
+            raise MemoryError("no memory for the cells around a site")
+        ids[0] = site
+        steps[0] = 0
+        n_ids = 1
+        self.vmark[site] = epoch
+        while head < n_ids:
+            i = ids[head]
+            e0 = self.m.vedge[i]
+            e = e0
+            star = 0
+            while True:
+                star += 1
+                j = self.m.tv[nxt(e)]
+                if steps[head] < radius and j != self.m.inf and self.vmark[j] != epoch:
+                    if n_ids == cap:
+                        cap *= 2
+                        grown = <int32_t*> realloc(ids, cap * sizeof(int32_t))
+                        if grown != NULL:
+                            ids = grown
+                        grown = <int32_t*> realloc(steps, cap * sizeof(int32_t)) if grown != NULL else NULL
+                        if grown == NULL:
+                            free(ids); free(steps)
+                            raise MemoryError("no memory for the cells around a site")
+                        steps = grown
+                    self.vmark[j] = epoch
+                    ids[n_ids] = j
+                    steps[n_ids] = steps[head] + 1
+                    n_ids += 1
+                e = self.m.opp[prv(e)]
+                if e == e0:
+                    break
+            max_star = max(max_star, star)
+            head += 1
+        if not alloc_cell_buffers(&buf, max_star):
+            free_cell_buffers(&buf); free(ids); free(steps)
+            raise MemoryError(f"no memory for the cell of a site with {max_star} neighbours")
+        try:
+            # the usual case: no bent ring; the site's own ring is read last, so it stays in buf (the
+            # others only when not known already: cells stay known until an update changes them)
+            memo_clear(&memo)
+            with nogil:
+                for i in range(n_ids - 1, -1, -1):
+                    if i > 0 and self.settled[ids[i]]:
+                        continue
+                    k = -1
+                    if i > 0:
+                        k = interior_ring(&self.m, ids[i], &box, &memo, buf.pts, buf.ring)
+                        if k > 0 and convex_ring(buf.ring, k, buf.pts) == k:
+                            self.settled[ids[i]] = 1     # every turn strictly left: not bent
+                            continue
+                        if k > 0:
+                            k = finish_ring(buf.ring, k, buf.pts)
+                    if k < 0:
+                        k = cell_ring(&self.m, ids[i], &box, &buf)
+                    if k > 0 and bent(buf.ring, k, buf.pts):
+                        any_bent = 1
+                    else:
+                        self.settled[ids[i]] = 1
+            ring = np.empty((max(k, 0), 2))
+            for j in range(k):
+                ring[j, 0] = buf.pts[2 * buf.ring[j]]
+                ring[j, 1] = buf.pts[2 * buf.ring[j] + 1]
+            if not any_bent:
+                return ring, None
+            offsets = np.zeros(n_ids + 1, np.int64)
+            chunks = []
+            for i in range(n_ids):
+                with nogil:
+                    k = cell_ring(&self.m, ids[i], &box, &buf)
+                xy = np.empty((max(k, 0), 2))
+                for j in range(k):
+                    xy[j, 0] = buf.pts[2 * buf.ring[j]]
+                    xy[j, 1] = buf.pts[2 * buf.ring[j] + 1]
+                chunks.append(xy)
+                offsets[i + 1] = offsets[i] + max(k, 0)
+            out_ids = np.array(<int32_t[:n_ids]> ids, np.int32)
+            out_steps = np.array(<int32_t[:n_ids]> steps, np.int32)
+            return ring, (out_ids, out_steps, offsets, np.concatenate(chunks))
+        finally:
+            free_cell_buffers(&buf)
+            free(ids)
+            free(steps)
 
     def neighbours(self, int site):
         """Sites joined to this one by a Delaunay edge, counter-clockwise."""
@@ -711,6 +842,67 @@ cdef void free_cell_buffers(CellBuffers* b) noexcept nogil:
     free(b.ring); free(b.pts); free(b.pt_side); free(b.vcx); free(b.vcy); free(b.c_start); free(b.c_end)
     free(b.c_entry); free(b.c_exit); free(b.c_has); free(b.nbx); free(b.nby); free(b.da); free(b.db)
     free(b.dc)
+
+
+cdef enum:
+    MEMO_SLOTS = 256        # circumcentres remembered while the cells around a site are read (cells_near)
+
+
+cdef struct CentreMemo:
+    int32_t tri[MEMO_SLOTS]
+    double cx[MEMO_SLOTS]
+    double cy[MEMO_SLOTS]
+    int used
+
+
+cdef inline void memo_clear(CentreMemo* memo) noexcept nogil:
+    cdef int k
+    for k in range(MEMO_SLOTS):
+        memo.tri[k] = -1
+    memo.used = 0
+
+
+cdef inline void memo_centre(Mesh* m, int t, int e, CentreMemo* memo, double* x, double* y) noexcept nogil:
+    """The correctly rounded circumcentre of finite triangle t (the same double whichever corner it is
+    read from), computed once per cells_near while the memo has room."""
+    cdef int a = m.tv[3 * t], b = m.tv[3 * t + 1], c = m.tv[3 * t + 2], slot, probes
+    slot = <int> ((<uint64_t> t * 2654435761u) % MEMO_SLOTS)
+    for probes in range(MEMO_SLOTS // 2):
+        if memo.tri[slot] == t:
+            x[0] = memo.cx[slot]
+            y[0] = memo.cy[slot]
+            return
+        if memo.tri[slot] < 0:
+            break
+        slot = (slot + 1) % MEMO_SLOTS
+    circumcentre(m.x[a], m.y[a], m.x[b], m.y[b], m.x[c], m.y[c], e, x, y)
+    if memo.tri[slot] < 0 and memo.used < MEMO_SLOTS // 2:
+        memo.tri[slot] = t
+        memo.cx[slot] = x[0]
+        memo.cy[slot] = y[0]
+        memo.used += 1
+
+
+cdef int interior_ring(Mesh* m, int site, Box* box, CentreMemo* memo, double* pts, int32_t* ring) noexcept nogil:
+    """The cell of site when every vertex is finite and strictly inside the box: its circumcentres in
+    order, as cell_ring would read them before finish_ring (pts and ring as there). -1 when the cell
+    has a hull gap or a vertex not strictly inside the box: cell_ring clips it."""
+    cdef int e0 = m.vedge[site], e = e0, k = 0
+    cdef double x, y
+    while True:
+        if is_infinite(m, e // 3):
+            return -1
+        memo_centre(m, e // 3, box.e, memo, &x, &y)
+        if not (box.xmin < x < box.xmax and box.ymin < y < box.ymax):
+            return -1
+        pts[2 * k] = x
+        pts[2 * k + 1] = y
+        ring[k] = k
+        k += 1
+        e = m.opp[prv(e)]
+        if e == e0:
+            break
+    return k
 
 
 cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
