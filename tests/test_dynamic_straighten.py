@@ -124,3 +124,31 @@ def test_a_bent_neighbourhood_is_straightened_with_the_cells_around_it():
         assert ids[0] == i and steps[0] == 0 and set(steps.tolist()) <= {0, 1, 2}
         assert np.array_equal(xy[offsets[0] : offsets[1]], ring)
         assert np.array_equal(ring, mesh.cell(i, *dv.bbox, dv._e))
+
+
+def test_every_cell_by_triangles_finds_the_bent_cells_each_cell_finds():
+    """A new mesh's cells are looked at by triangles (sure_cells: a cell strictly inside the box with
+    every turn strictly left is not bent), the cells an update changed one by one: both name the same
+    bent cells, on the recorded session and on the hunt's families that bend rings."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import adversarial
+
+    meshes = []
+    with np.load(DYNAMIC_FIXTURES[0]) as z:
+        dv = DynamicVoronoi(z["start"])
+        for kind, index, xy in zip(z["kind"].tolist(), z["index"].tolist(), z["xy"]):
+            (dv.insert(*xy) if kind == 0 else dv.move(index, *xy) if kind == 1 else dv.remove(index))
+        meshes.append(dv)
+    for name in ("circle_rounded_offset", "rotated_grid_45deg", "triangular30_noise1e-15", "decimal_circles_3dec"):
+        case = adversarial.make(name)
+        meshes.append(DynamicVoronoi(case.points, bbox=case.bbox))
+    found = 0
+    for dv in meshes:
+        box = (*dv.bbox, dv._e)
+        by_triangles = dv._mesh.bent_sites(*box, True)
+        one_by_one = dv._mesh.bent_sites(*box, False)
+        assert np.array_equal(by_triangles, one_by_one)
+        found += len(one_by_one)
+    assert found > 0

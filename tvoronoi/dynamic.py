@@ -35,13 +35,14 @@ def settled_cell(mesh: dynamic.DynamicMesh, i: int, bbox, e: int) -> np.ndarray:
     """Cell i of the mesh as the batch build makes it (tvoronoi.build): clipped and, where rounding made
     rings cross themselves, straightened (clip.straighten) as the batch straightens every ring.
 
-    A merge changes a ring only through a bent ring that shares one of its points (its own or a
-    neighbour's), and a ring that was not bent bends only through such a merge: a chain of bends moves
-    one cell a round. The usual case has no bent ring within SETTLE_RADIUS steps: the cell as clipped.
-    Otherwise those cells are straightened together, the patch grown until every ring it bends lies
-    two steps inside its edge (or it holds the whole mesh). A chain of three rounds or more arriving
-    from beyond SETTLE_RADIUS would not be seen; the hunts (56,000 sessions on rounded lattices) met
-    none."""
+    The mesh keeps count of its bent cells (DynamicMesh.cells_near looks again at the cells each update
+    changed, and at every cell of a new mesh): with none, the cell as clipped. A merge changes a ring
+    only through a bent ring that shares one of its points (its own or a neighbour's), and a ring that
+    was not bent bends only through such a merge: a chain of bends moves one cell a round. So with no
+    bent cell within SETTLE_RADIUS steps, again the cell as clipped; otherwise those cells are
+    straightened together, the patch grown until every ring it bends lies two steps inside its edge (or
+    it holds the whole mesh). A chain of three rounds or more arriving from beyond SETTLE_RADIUS would
+    not be seen; the hunts (66,000 sessions on rounded lattices) met none."""
     radius = SETTLE_RADIUS
     x0, y0, x1, y1 = bbox
     ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)

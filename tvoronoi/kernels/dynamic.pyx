@@ -11,15 +11,21 @@ from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite, strictly_between
 from tvoronoi.kernels.location cimport jump_note, jump_start, locate
 from tvoronoi.kernels.cavity cimport find_cavity
 from tvoronoi.kernels.fill cimport insert_site, fill_cavity
-from libc.stdlib cimport malloc, realloc, free
-from tvoronoi.kernels.clipper cimport (
-    Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge,
-    walk_cell, finish_ring, bent, convex_ring,
+from libc.stdlib cimport malloc, calloc, realloc, free
+from libc.string cimport memset
+from tvoronoi.kernels.clipper cimport Box, make_box
+from tvoronoi.kernels.local_cell cimport (
+    CellBuffers, CentreMemo, alloc_cell_buffers, free_cell_buffers, cell_ring, cell_is_bent, memo_clear,
+    sure_cells,
 )
-from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.fortune cimport sweep_triangles
 
 cdef enum:
+    UNKNOWN = 0             # ring_state of a site: not looked at (or not in the mesh)
+    NOT_BENT = 1
+    BENT = 2
+    QUEUED = 3              # changed since it was looked at; listed in DynamicMesh.queued
+    MEMO_RESET = 32         # look_again forgets its memoised circumcentres after this many cells
     INF_VERTEX = 0x7FFFFFFE  # the vertex at infinity of a dynamic mesh (site ids stay below it)
     EAR_LIMIT = 64          # holes of up to this many sides are filled ear by ear (O(k^2) tests);
                             # larger ones by the Delaunay triangles of their sites, spliced in
@@ -63,13 +69,22 @@ cdef class DynamicMesh:
     cdef int32_t* vmark             # scratch marks per site, and the epoch that makes them current
     cdef int32_t mark_epoch
     cdef int32_t* nextb             # scratch: the boundary edge leaving each site
-    cdef signed char* settled       # per site: its cell, as clipped, is known not bent (cells_near)
-    cdef tuple settled_box          # the box those cells were clipped to
+    # which cells rounding bent (the rings the batch build straightens), kept for cells_near: per site
+    # UNKNOWN, NOT_BENT, BENT or QUEUED (changed since, listed in `queued`); the count of BENT; whether
+    # every cell must be looked at again (a new mesh, a new box); the box they were clipped to
+    cdef signed char* ring_state
+    cdef int32_t* queued
+    cdef int n_queued, n_bent
+    cdef bint recheck_all
+    cdef tuple state_box
+    cdef CellBuffers look_buf       # look_again's buffers, kept: room for stars of look_room triangles
+    cdef int look_room
     cdef int cap_v, cap_t
     cdef object jump_cells          # the jump grid's array (location.jump_start), made by load
     cdef Scratch scratch            # scratch of one update, grown to the largest hole or region met
 
     def __cinit__(self):
+        self.look_room = 0
         self.scratch.ints = NULL
         self.scratch.n_ints = 0
         self.scratch.reals = NULL
@@ -79,6 +94,8 @@ cdef class DynamicMesh:
         self.scratch.limit = -1
 
     def __dealloc__(self):
+        if self.look_room > 0:
+            free_cell_buffers(&self.look_buf)
         free(self.scratch.ints)
         free(self.scratch.reals)
         free(self.scratch.keys)
@@ -89,6 +106,9 @@ cdef class DynamicMesh:
         self.arrays = {}
         self.m.n_finite = 0
         self.mark_epoch = 0
+        self.n_queued = 0
+        self.n_bent = 0
+        self.recheck_all = True
         self.m.n_tri = 0
         self.m.n_free = 0
         self.m.last = -1
@@ -114,7 +134,7 @@ cdef class DynamicMesh:
                 "cavity": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
                 "bnd_twin": (cap_t + 2, np.int32), "free_tri": (cap_t, np.int32),
                 "changed": (cap_t + 2, np.int32), "vmark": (cap_v, np.int32), "nextb": (cap_v, np.int32),
-                "settled": (cap_v, np.int8)}
+                "ring_state": (cap_v, np.int8), "queued": (cap_v, np.int32)}
         new = {}
         for name, (size, dtype) in spec.items():
             arr = np.full(size, -1, dtype) if dtype is np.int32 else np.zeros(size, dtype)
@@ -132,8 +152,10 @@ cdef class DynamicMesh:
         cdef int32_t[::1] vmark = new["vmark"], nextb = new["nextb"]
         self.vmark = &vmark[0]
         self.nextb = &nextb[0]
-        cdef signed char[::1] settled = new["settled"]
-        self.settled = &settled[0]
+        cdef signed char[::1] ring_state = new["ring_state"]
+        cdef int32_t[::1] queued = new["queued"]
+        self.ring_state = &ring_state[0]
+        self.queued = &queued[0]
         self.m.x = &x[0]
         self.m.y = &y[0]
         self.wx = &x[0]
@@ -180,6 +202,8 @@ cdef class DynamicMesh:
                 self.m.n_finite += 1
                 self.m.last = k
         self._grid(xs, ys, ids)
+        self.recheck_all = True          # every cell is new
+        self.n_queued = 0
 
     def _grid(self, const double[::1] xs, const double[::1] ys, const int32_t[::1] ids):
         """The jump grid over the loaded sites: about four sites a cell, each cell holding one of them."""
@@ -213,7 +237,7 @@ cdef class DynamicMesh:
     def set_site(self, int site, double x, double y):
         """Place a site (not yet in the mesh), e.g. a repeated point that stays outside it."""
         self._reserve(site)
-        self.settled[site] = 0
+        self.forget(site)
         self.wx[site] = x
         self.wy[site] = y
 
@@ -299,8 +323,8 @@ cdef class DynamicMesh:
         """Give the vertex of site old to site new (a repeated point taking over its place)."""
         cdef int e0, e
         self._reserve(new)
-        self.settled[old] = 0
-        self.settled[new] = 0
+        self.forget(old)
+        self.forget(new)
         self.wx[new] = self.m.x[old]
         self.wy[new] = self.m.y[old]
         e0 = self.m.vedge[old]
@@ -362,123 +386,201 @@ cdef class DynamicMesh:
         free_cell_buffers(&buf)
         return out
 
+    cdef void forget(self, int site) noexcept:
+        # the cell of site may have changed: no longer known bent or not, queued to be looked at again
+        if site < 0 or site >= self.cap_v:
+            return
+        if self.ring_state[site] == BENT:
+            self.n_bent -= 1
+        if self.ring_state[site] != QUEUED and not self.recheck_all:
+            self.queued[self.n_queued] = site
+            self.n_queued += 1
+            self.ring_state[site] = QUEUED
+        elif self.recheck_all:
+            self.ring_state[site] = UNKNOWN
+
     cdef void unsettle(self) noexcept:
-        # the cells the last update changed are no longer known not bent
+        # the cells the last update changed
         cdef int k
         for k in range(self.m.n_changed):
-            if self.m.changed[k] >= 0 and self.m.changed[k] != INF_VERTEX:
-                self.settled[self.m.changed[k]] = 0
+            if self.m.changed[k] != INF_VERTEX:
+                self.forget(self.m.changed[k])
+
+    cdef int look_again(self, Box* box) except -1:
+        """Bring ring_state and n_bent up to date: the queued cells, or every cell after a new mesh or
+        box (sure_cells settles most at once, by triangles). A cell is looked at once after each change
+        that touches it (cell_is_bent: memoised circumcentres, one convexity test in the usual case)."""
+        cdef CentreMemo memo
+        cdef int k, s, looked = 0
+        cdef bint all_of_them = self.recheck_all, out_of_memory = False
+        cdef signed char* sure = NULL
+        if not all_of_them and self.n_queued == 0:
+            return 0
+        memo_clear(&memo)
+        if all_of_them:
+            sure = <signed char*> calloc(max(self.cap_v, 1), 1)
+            if sure == NULL:
+                raise MemoryError("no memory to look at every cell")
+        with nogil:
+            if all_of_them:
+                self.n_bent = 0
+                for s in range(self.cap_v):
+                    self.ring_state[s] = UNKNOWN
+                if sure_cells(&self.m, box, sure) < 0:
+                    memset(sure, 0, self.cap_v)
+                for s in range(self.cap_v):
+                    if self.m.vedge[s] < 0:
+                        continue
+                    if sure[s]:
+                        self.ring_state[s] = NOT_BENT
+                        continue
+                    if not self.look_at(s, box, &memo):
+                        out_of_memory = True
+                        break
+                    looked += 1
+                    if looked % MEMO_RESET == 0:
+                        memo_clear(&memo)
+            else:
+                for k in range(self.n_queued):
+                    s = self.queued[k]
+                    if self.ring_state[s] != QUEUED:
+                        continue
+                    self.ring_state[s] = UNKNOWN
+                    if self.m.vedge[s] >= 0 and not self.look_at(s, box, &memo):
+                        out_of_memory = True
+                        break
+        free(sure)
+        if out_of_memory:
+            self.recheck_all = True          # what was not looked at is looked at next time
+            raise MemoryError("no memory for the cell of a site")
+        self.n_queued = 0
+        self.recheck_all = False
+        return 0
+
+    cdef bint look_at(self, int s, Box* box, CentreMemo* memo) noexcept nogil:
+        # ring_state of site s (in the mesh) from its cell; False when no buffers could be had for it
+        cdef int star = 0, e0 = self.m.vedge[s], e = e0
+        while True:
+            star += 1
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        if star > self.look_room:
+            if self.look_room > 0:
+                free_cell_buffers(&self.look_buf)
+            self.look_room = 0
+            if not alloc_cell_buffers(&self.look_buf, max(star, 16)):
+                free_cell_buffers(&self.look_buf)
+                return False
+            self.look_room = max(star, 16)
+        if cell_is_bent(&self.m, s, box, memo, &self.look_buf):
+            self.ring_state[s] = BENT
+            self.n_bent += 1
+        else:
+            self.ring_state[s] = NOT_BENT
+        return True
+
+    def bent_sites(self, double xmin, double ymin, double xmax, double ymax, int exponent, bint by_triangles):
+        """The sites whose cells rounding bent, looked at afresh: every cell by triangles (as after a new
+        mesh), or each on its own (as after updates). For tests: the two must agree."""
+        cdef Box box = make_box(xmin, ymin, xmax, ymax, exponent)
+        cdef int s
+        self.state_box = (xmin, ymin, xmax, ymax, exponent)
+        if by_triangles:
+            self.recheck_all = True
+        else:
+            self.recheck_all = False
+            self.n_queued = 0
+            self.n_bent = 0
+            for s in range(self.cap_v):
+                self.ring_state[s] = UNKNOWN
+                if self.m.vedge[s] >= 0:
+                    self.forget(s)
+        self.look_again(&box)
+        states = np.asarray(self.arrays["ring_state"][:self.cap_v])
+        assert int((states == BENT).sum()) == self.n_bent
+        return np.flatnonzero(states == BENT).astype(np.int32)
 
     def cells_near(self, int site, double xmin, double ymin, double xmax, double ymax, int exponent,
                    int radius):
         """The cell of a site, as cell() reads it, and whether the batch build's straightening could
         change it: when a cell of a site within `radius` Delaunay steps (the site's own included) is
-        bent (clipper.bent), also the cells of all those sites, for the caller to straighten.
+        bent (clipper.bent), also the cells of all those sites, for the caller to straighten. Which
+        cells are bent is kept up to date as updates change them (look_again), so without a bent cell
+        in the mesh this costs one cell and the cells the last updates changed.
 
         Returns (ring, None), or (ring, (ids, steps, offsets, xy)): the sites breadth first from this
         one (int32), their steps from it (int32), and their rings as rows of xy from offsets[k] to
         offsets[k + 1] (int64). A site whose cell misses the box has an empty ring."""
         cdef Box box = make_box(xmin, ymin, xmax, ymax, exponent)
         cdef CellBuffers buf
-        cdef CentreMemo memo
         cdef int32_t* ids = NULL
         cdef int32_t* steps = NULL
         cdef int32_t* grown
-        cdef int n_ids = 0, cap = 0, head = 0, star, max_star = 0, e0, e, j, k, i, any_bent = 0
+        cdef int n_ids = 0, cap = 0, head = 0, e0, e, j, k, i, any_bent = 0
         cdef int32_t epoch
         if self.m.vedge[site] < 0:
             return np.empty((0, 2)), None
-        if self.settled_box != (xmin, ymin, xmax, ymax, exponent):
-            self.arrays["settled"][:] = 0
-            self.settled_box = (xmin, ymin, xmax, ymax, exponent)
+        if self.state_box != (xmin, ymin, xmax, ymax, exponent):
+            self.recheck_all = True
+            self.state_box = (xmin, ymin, xmax, ymax, exponent)
+        self.look_again(&box)
+        ring = self.cell(site, xmin, ymin, xmax, ymax, exponent)
+        if self.n_bent == 0:
+            return ring, None
+        # breadth first from the site, to `radius` steps, looking for a bent cell
         self.mark_epoch += 1
         epoch = self.mark_epoch
-        # breadth first from the site, to `radius` steps; the largest star sizes the buffers
         cap = 64
         ids = <int32_t*> malloc(cap * sizeof(int32_t))
         steps = <int32_t*> malloc(cap * sizeof(int32_t))
         if ids == NULL or steps == NULL:
             free(ids); free(steps)
             raise MemoryError("no memory for the cells around a site")
-        ids[0] = site
-        steps[0] = 0
-        n_ids = 1
-        self.vmark[site] = epoch
-        while head < n_ids:
-            i = ids[head]
-            e0 = self.m.vedge[i]
-            e = e0
-            star = 0
-            while True:
-                star += 1
-                j = self.m.tv[nxt(e)]
-                if steps[head] < radius and j != self.m.inf and self.vmark[j] != epoch:
-                    if n_ids == cap:
-                        cap *= 2
-                        grown = <int32_t*> realloc(ids, cap * sizeof(int32_t))
-                        if grown != NULL:
-                            ids = grown
-                        grown = <int32_t*> realloc(steps, cap * sizeof(int32_t)) if grown != NULL else NULL
-                        if grown == NULL:
-                            free(ids); free(steps)
-                            raise MemoryError("no memory for the cells around a site")
-                        steps = grown
-                    self.vmark[j] = epoch
-                    ids[n_ids] = j
-                    steps[n_ids] = steps[head] + 1
-                    n_ids += 1
-                e = self.m.opp[prv(e)]
-                if e == e0:
-                    break
-            max_star = max(max_star, star)
-            head += 1
-        if not alloc_cell_buffers(&buf, max_star):
-            free_cell_buffers(&buf); free(ids); free(steps)
-            raise MemoryError(f"no memory for the cell of a site with {max_star} neighbours")
         try:
-            # the usual case: no bent ring; the site's own ring is read last, so it stays in buf (the
-            # others only when not known already: cells stay known until an update changes them)
-            memo_clear(&memo)
-            with nogil:
-                for i in range(n_ids - 1, -1, -1):
-                    if i > 0 and self.settled[ids[i]]:
-                        continue
-                    k = -1
-                    if i > 0:
-                        k = interior_ring(&self.m, ids[i], &box, &memo, buf.pts, buf.ring)
-                        if k > 0 and convex_ring(buf.ring, k, buf.pts) == k:
-                            self.settled[ids[i]] = 1     # every turn strictly left: not bent
-                            continue
-                        if k > 0:
-                            k = finish_ring(buf.ring, k, buf.pts)
-                    if k < 0:
-                        k = cell_ring(&self.m, ids[i], &box, &buf)
-                    if k > 0 and bent(buf.ring, k, buf.pts):
-                        any_bent = 1
-                    else:
-                        self.settled[ids[i]] = 1
-            ring = np.empty((max(k, 0), 2))
-            for j in range(k):
-                ring[j, 0] = buf.pts[2 * buf.ring[j]]
-                ring[j, 1] = buf.pts[2 * buf.ring[j] + 1]
+            ids[0] = site
+            steps[0] = 0
+            n_ids = 1
+            self.vmark[site] = epoch
+            while head < n_ids:
+                i = ids[head]
+                if self.ring_state[i] == BENT:
+                    any_bent = 1
+                e0 = self.m.vedge[i]
+                e = e0
+                while steps[head] < radius:
+                    j = self.m.tv[nxt(e)]
+                    if j != self.m.inf and self.vmark[j] != epoch:
+                        if n_ids == cap:
+                            cap *= 2
+                            grown = <int32_t*> realloc(ids, cap * sizeof(int32_t))
+                            if grown == NULL:
+                                raise MemoryError("no memory for the cells around a site")
+                            ids = grown
+                            grown = <int32_t*> realloc(steps, cap * sizeof(int32_t))
+                            if grown == NULL:
+                                raise MemoryError("no memory for the cells around a site")
+                            steps = grown
+                        self.vmark[j] = epoch
+                        ids[n_ids] = j
+                        steps[n_ids] = steps[head] + 1
+                        n_ids += 1
+                    e = self.m.opp[prv(e)]
+                    if e == e0:
+                        break
+                head += 1
             if not any_bent:
                 return ring, None
             offsets = np.zeros(n_ids + 1, np.int64)
             chunks = []
             for i in range(n_ids):
-                with nogil:
-                    k = cell_ring(&self.m, ids[i], &box, &buf)
-                xy = np.empty((max(k, 0), 2))
-                for j in range(k):
-                    xy[j, 0] = buf.pts[2 * buf.ring[j]]
-                    xy[j, 1] = buf.pts[2 * buf.ring[j] + 1]
+                xy = self.cell(ids[i], xmin, ymin, xmax, ymax, exponent)
                 chunks.append(xy)
-                offsets[i + 1] = offsets[i] + max(k, 0)
+                offsets[i + 1] = offsets[i] + len(xy)
             out_ids = np.array(<int32_t[:n_ids]> ids, np.int32)
             out_steps = np.array(<int32_t[:n_ids]> steps, np.int32)
             return ring, (out_ids, out_steps, offsets, np.concatenate(chunks))
         finally:
-            free_cell_buffers(&buf)
             free(ids)
             free(steps)
 
@@ -792,207 +894,6 @@ cdef int splice_hole(Mesh* m, int v, int k, const int32_t* poly, const int32_t* 
         return STATUS_FLAT
     repair_last(m, v, outs, k)
     return STATUS_DONE
-
-
-# ---------------------------------------------------------------------------------------------------------
-# one cell, read locally
-
-cdef struct CellBuffers:
-    # scratch of one cell with `star` triangles around its site (malloc'd: no cap on the star)
-    int32_t* ring          # point ids of the ring, 2 star + 4
-    double* pts            # interleaved x, y: star vertices, 2 star crossings, 4 corners
-    signed char* pt_side
-    int32_t* da            # how each boundary point was made (clipper.Points)
-    int32_t* db
-    int32_t* dc
-    signed char* vcx       # per triangle: the vertex's codes against the box
-    signed char* vcy
-    int32_t* c_start       # per edge: its part in the box
-    int32_t* c_end
-    signed char* c_entry
-    signed char* c_exit
-    signed char* c_has
-    double* nbx            # per edge: the neighbour's site
-    double* nby
-
-
-cdef bint alloc_cell_buffers(CellBuffers* b, int star) noexcept nogil:
-    b.ring = <int32_t*> malloc((2 * star + 8) * sizeof(int32_t))
-    b.pts = <double*> malloc(2 * (3 * star + 8) * sizeof(double))
-    b.pt_side = <signed char*> malloc(3 * star + 8)
-    b.da = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
-    b.db = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
-    b.dc = <int32_t*> malloc((3 * star + 8) * sizeof(int32_t))
-    b.vcx = <signed char*> malloc(star + 1)
-    b.vcy = <signed char*> malloc(star + 1)
-    b.c_start = <int32_t*> malloc((star + 1) * sizeof(int32_t))
-    b.c_end = <int32_t*> malloc((star + 1) * sizeof(int32_t))
-    b.c_entry = <signed char*> malloc(star + 1)
-    b.c_exit = <signed char*> malloc(star + 1)
-    b.c_has = <signed char*> malloc(star + 1)
-    b.nbx = <double*> malloc((star + 1) * sizeof(double))
-    b.nby = <double*> malloc((star + 1) * sizeof(double))
-    return (b.ring != NULL and b.pts != NULL and b.pt_side != NULL and b.vcx != NULL and b.vcy != NULL
-            and b.da != NULL and b.db != NULL and b.dc != NULL
-            and b.c_start != NULL and b.c_end != NULL and b.c_entry != NULL and b.c_exit != NULL
-            and b.c_has != NULL and b.nbx != NULL and b.nby != NULL)
-
-
-cdef void free_cell_buffers(CellBuffers* b) noexcept nogil:
-    free(b.ring); free(b.pts); free(b.pt_side); free(b.vcx); free(b.vcy); free(b.c_start); free(b.c_end)
-    free(b.c_entry); free(b.c_exit); free(b.c_has); free(b.nbx); free(b.nby); free(b.da); free(b.db)
-    free(b.dc)
-
-
-cdef enum:
-    MEMO_SLOTS = 256        # circumcentres remembered while the cells around a site are read (cells_near)
-
-
-cdef struct CentreMemo:
-    int32_t tri[MEMO_SLOTS]
-    double cx[MEMO_SLOTS]
-    double cy[MEMO_SLOTS]
-    int used
-
-
-cdef inline void memo_clear(CentreMemo* memo) noexcept nogil:
-    cdef int k
-    for k in range(MEMO_SLOTS):
-        memo.tri[k] = -1
-    memo.used = 0
-
-
-cdef inline void memo_centre(Mesh* m, int t, int e, CentreMemo* memo, double* x, double* y) noexcept nogil:
-    """The correctly rounded circumcentre of finite triangle t (the same double whichever corner it is
-    read from), computed once per cells_near while the memo has room."""
-    cdef int a = m.tv[3 * t], b = m.tv[3 * t + 1], c = m.tv[3 * t + 2], slot, probes
-    slot = <int> ((<uint64_t> t * 2654435761u) % MEMO_SLOTS)
-    for probes in range(MEMO_SLOTS // 2):
-        if memo.tri[slot] == t:
-            x[0] = memo.cx[slot]
-            y[0] = memo.cy[slot]
-            return
-        if memo.tri[slot] < 0:
-            break
-        slot = (slot + 1) % MEMO_SLOTS
-    circumcentre(m.x[a], m.y[a], m.x[b], m.y[b], m.x[c], m.y[c], e, x, y)
-    if memo.tri[slot] < 0 and memo.used < MEMO_SLOTS // 2:
-        memo.tri[slot] = t
-        memo.cx[slot] = x[0]
-        memo.cy[slot] = y[0]
-        memo.used += 1
-
-
-cdef int interior_ring(Mesh* m, int site, Box* box, CentreMemo* memo, double* pts, int32_t* ring) noexcept nogil:
-    """The cell of site when every vertex is finite and strictly inside the box: its circumcentres in
-    order, as cell_ring would read them before finish_ring (pts and ring as there). -1 when the cell
-    has a hull gap or a vertex not strictly inside the box: cell_ring clips it."""
-    cdef int e0 = m.vedge[site], e = e0, k = 0
-    cdef double x, y
-    while True:
-        if is_infinite(m, e // 3):
-            return -1
-        memo_centre(m, e // 3, box.e, memo, &x, &y)
-        if not (box.xmin < x < box.xmax and box.ymin < y < box.ymax):
-            return -1
-        pts[2 * k] = x
-        pts[2 * k + 1] = y
-        ring[k] = k
-        k += 1
-        e = m.opp[prv(e)]
-        if e == e0:
-            break
-    return k
-
-
-cdef int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
-    """The cell of site clipped to the box (clipper.pxd, as for batch cells): point ids of b.pts in
-    b.ring, counter-clockwise from the lowest point; returns the count."""
-    cdef int e0 = m.vedge[site], e, k = 0, q, p, nxq, j, a, c, n_pts, corner0, n_edges = 0, count
-    cdef double sx = m.x[site], sy = m.y[site]
-    cdef EdgePart part
-    cdef Points P
-    cdef bint has_o, has_d
-    # the triangles around the site, counter-clockwise: triangle q is (site, nb q, nb q+1), and its
-    # circumcentre is the cell's vertex q (the same double in every cell that has it)
-    e = e0
-    while True:
-        p = e // 3
-        if is_infinite(m, p):
-            b.vcx[k] = 3                                     # no vertex: a hull gap
-        else:
-            a = m.tv[nxt(e)]
-            c = m.tv[prv(e)]
-            circumcentre(sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], box.e, &b.pts[2 * k], &b.pts[2 * k + 1])
-            b.vcx[k] = axis_code(b.pts[2 * k], box.xmin, box.xmax, box.sxmin, box.sxmax,
-                                 sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], False)
-            b.vcy[k] = axis_code(b.pts[2 * k + 1], box.ymin, box.ymax, box.symin, box.symax,
-                                 sx, sy, m.x[a], m.y[a], m.x[c], m.y[c], True)
-            if code_in(b.vcx[k]) and code_in(b.vcy[k]):
-                b.pt_side[k] = code_side(b.vcx[k], b.vcy[k])
-            b.da[k] = site; b.db[k] = a; b.dc[k] = c
-        b.c_start[k] = m.tv[nxt(e)]                          # the neighbour of edge k, for now
-        k += 1
-        e = m.opp[prv(e)]
-        if e == e0:
-            break
-    n_pts = k
-    # the edges, counter-clockwise: the edge with neighbour nb q runs from vertex q - 1 to vertex q
-    for q in range(k):
-        j = b.c_start[q]
-        if j == m.inf:
-            continue
-        p = q - 1 if q > 0 else k - 1
-        has_o = b.vcx[p] != 3
-        has_d = b.vcx[q] != 3
-        if has_o and has_d and b.pts[2 * p] == b.pts[2 * q] and b.pts[2 * p + 1] == b.pts[2 * q + 1]:
-            continue                  # a zero-length edge (cocircular sites, or closer than rounding)
-        b.nbx[n_edges] = m.x[j]
-        b.nby[n_edges] = m.y[j]
-        clip_edge(box, sx, sy, m.x[j], m.y[j], has_o, b.vcx[p] if has_o else 0, b.vcy[p] if has_o else 0,
-                  has_d, b.vcx[q] if has_d else 0, b.vcy[q] if has_d else 0, &part)
-        b.c_has[n_edges] = part.has
-        b.c_entry[n_edges] = part.entry
-        b.c_exit[n_edges] = part.exit
-        if part.has:
-            if part.start_at == AT_POINT:
-                b.pts[2 * n_pts] = part.sx; b.pts[2 * n_pts + 1] = part.sy
-                b.pt_side[n_pts] = part.s_side
-                b.da[n_pts] = site; b.db[n_pts] = j; b.dc[n_pts] = -1
-                b.ring[n_edges] = n_pts            # parked here until the edges are all known
-                n_pts += 1
-            else:
-                b.ring[n_edges] = p if part.start_at == AT_ORIGIN else q
-            if part.end_at == AT_POINT:
-                b.pts[2 * n_pts] = part.ex; b.pts[2 * n_pts + 1] = part.ey
-                b.pt_side[n_pts] = part.e_side
-                b.da[n_pts] = site; b.db[n_pts] = j; b.dc[n_pts] = -1
-                b.c_end[n_edges] = n_pts
-                n_pts += 1
-            else:
-                b.c_end[n_edges] = p if part.end_at == AT_ORIGIN else q
-        n_edges += 1
-    for q in range(n_edges):
-        b.c_start[q] = b.ring[q]
-    corner0 = n_pts
-    for c in range(4):
-        b.pts[2 * (corner0 + c)] = box.kx[c]
-        b.pts[2 * (corner0 + c) + 1] = box.ky[c]
-        b.pt_side[corner0 + c] = c
-        b.da[corner0 + c] = -1
-    P.xy = b.pts
-    P.side = b.pt_side
-    P.da = b.da
-    P.db = b.db
-    P.dc = b.dc
-    P.sx = m.x
-    P.sy = m.y
-    P.corner0 = corner0
-    count = walk_cell(box, n_edges, b.c_start, b.c_end, b.c_entry, b.c_exit, b.c_has, &P, sx, sy, b.nbx,
-                      b.nby, b.ring)
-    if count <= 0:
-        return 0
-    return finish_ring(b.ring, count, b.pts)
 
 
 # ---------------------------------------------------------------------------------------------------------
