@@ -33,6 +33,21 @@ def test_value_names_name_each_value_by_its_first_point(pairs):
         assert names[p] == first
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(small, small), min_size=1, max_size=40), st.data())
+def test_value_names_of_some_values_name_only_those(pairs, data):
+    """With keys, a point is named as without them when its value is a key's, else by itself (the
+    straightening names only the values of its bent rings' points)."""
+    pts = np.array(pairs, float)
+    keys = data.draw(st.lists(st.integers(0, len(pts) - 1), max_size=10))
+    every = clip.value_names(pts)
+    some = clip.value_names(pts, np.array(keys, np.int32))
+    held = {(float(pts[k, 0]) + 0.0, float(pts[k, 1]) + 0.0) for k in keys}
+    for p in range(len(pts)):
+        value = (float(pts[p, 0]) + 0.0, float(pts[p, 1]) + 0.0)
+        assert some[p] == (every[p] if value in held else p)
+
+
 def test_value_names_at_scale():
     """100,000 points with repeats at random places: the names against a sort."""
     rng = np.random.default_rng(5)
@@ -47,6 +62,10 @@ def test_point_kinds_are_corners_sides_and_inside_by_value():
     box = (0.0, -1.0, 2.0, 3.0)
     pts = np.array([[0, -1], [2, 3], [0, 1], [1, 3], [1, 1], [2.0, 0.5], [-0.0, 3]], float)
     assert clip.point_kinds(pts, box).tolist() == [0, 0, 1, 1, 2, 1, 0]
+    # sides that are not integers, and far from 1 (the box read as doubles, not truncated)
+    box = (0.5, -1.25, 2.75, 1e15 + 0.125)
+    pts = np.array([[0.5, -1.25], [0.0, -1.0], [2.75, 7.0], [1.0, 1e15 + 0.125], [1.0, 1e15]], float)
+    assert clip.point_kinds(pts, box).tolist() == [0, 2, 1, 1, 2]
 
 
 def cyclic(ring: np.ndarray, pts: np.ndarray) -> list:

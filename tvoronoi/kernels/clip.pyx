@@ -527,6 +527,21 @@ def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
     return np.asarray(ids)
 
 
+cdef struct Sides:
+    double xmin, ymin, xmax, ymax
+
+
+cdef Sides sides(box_tuple):
+    # the box (x0, y0, x1, y1) as doubles
+    cdef Sides box
+    x0, y0, x1, y1 = box_tuple
+    box.xmin = float(x0)
+    box.ymin = float(y0)
+    box.xmax = float(x1)
+    box.ymax = float(y1)
+    return box
+
+
 def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed char[::1] was_bent=None):
     """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
     cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
@@ -535,42 +550,54 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
     In a ring that is not simple, each vertex at a right turn is merged with the nearer of its two
     ring neighbours, in every ring that has it (so neighbouring cells keep matching edges); merges keep
     the point that is a corner of the box (x0, y0, x1, y1), else one on its boundary, else the lowest
-    (y, then x). Points are named by their values, so the result depends on the values alone, not on
-    an engine's numbering. Repeats until every ring is simple: every cell is then a simple
-    counter-clockwise polygon, and such a subdivision covers the box exactly once. A cell can vanish
-    (all its vertices merged): a cell thinner than the rounding everywhere.
+    (y, then x). Points are named by their values (every point equal to a point of a bent ring is that
+    point), so the result depends on the values alone, not on an engine's numbering. Repeats until
+    every ring is simple: every cell is then a simple counter-clockwise polygon, and such a subdivision
+    covers the box exactly once. A cell can vanish (all its vertices merged): a cell thinner than the
+    rounding everywhere.
 
     was_bent: optional (cells,) int8, set to 1 for every ring found bent in some round.
     Returns the new (offsets, rings).
     """
     cdef Py_ssize_t n_pts = points.shape[0]
-    cdef const signed char[::1] kind
-    # every point starts named by its value: distinct points that rounded to one value (exact vertices
-    # closer than rounding, with no edge between them; a crossing on a vertex) are one point to the
-    # merges, whichever of them a ring's walk met
-    parent_arr = value_names(points)
+    cdef Sides box = sides(box_tuple)
+    parent_arr = np.arange(n_pts, dtype=np.int32)
     cdef int32_t[::1] parent = parent_arr
-    kind = point_kinds(points, box_tuple)
+    cdef int32_t[::1] names
     cdef const double* xy = &points[0, 0]
     cdef int32_t[::1] rv
     cdef int64_t[::1] ov
-    cdef int n_cells = len(offsets) - 1, i, k, cnt, v, u, w, t, ru, rt, changed, guard
+    cdef int n_cells = len(offsets) - 1, i, j, k, cnt, v, u, w, t, changed, guard, n_bent
+    cdef int32_t[::1] bent_at
     cdef int64_t lo, hi
     cdef double du, dw
     for guard in range(n_pts):
         rv = rings
         ov = offsets
         changed = 0
-        # merge each right-turn vertex with its nearer ring neighbour
+        bent_arr = np.empty(n_cells, np.int32)
+        bent_at = bent_arr
+        n_bent = 0
         for i in range(n_cells):
+            if ov[i + 1] > ov[i] and bent(&rv[ov[i]], <int> (ov[i + 1] - ov[i]), xy):
+                bent_at[n_bent] = i
+                n_bent += 1
+        if n_bent == 0:
+            break
+        if was_bent is not None:
+            for k in range(n_bent):
+                was_bent[bent_at[k]] = 1
+        # every point equal to a point of a bent ring is that point (exact vertices closer than rounding
+        # with no edge between them, a crossing on a vertex): whichever of them a ring's walk met
+        names = value_names(points, np.concatenate([rings[offsets[i]:offsets[i + 1]] for i in bent_arr[:n_bent].tolist()]))
+        for v in range(n_pts):
+            if names[v] != v:
+                changed += join(&parent[0], xy, &box, v, names[v])
+        # merge each right-turn vertex with its nearer ring neighbour
+        for j in range(n_bent):
+            i = bent_at[j]
             lo = ov[i]
             cnt = <int> (ov[i + 1] - lo)
-            if cnt == 0:
-                continue
-            if not bent(&rv[lo], cnt, xy):
-                continue
-            if was_bent is not None:
-                was_bent[i] = 1
             for k in range(cnt):
                 v = rv[lo + k]
                 u = rv[lo + (k + cnt - 1) % cnt]
@@ -580,15 +607,8 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
                 # hypot: no overflow of the squares on boxes up to 2^1000 times the sites
                 du = hypot(xy[2 * u] - xy[2 * v], xy[2 * u + 1] - xy[2 * v + 1])
                 dw = hypot(xy[2 * w] - xy[2 * v], xy[2 * w + 1] - xy[2 * v + 1])
-                t = u if (du < dw or (du == dw and before(xy, kind, u, w))) else w
-                ru = find(&parent[0], v)
-                rt = find(&parent[0], t)
-                if ru != rt:
-                    if before(xy, kind, ru, rt):
-                        parent[rt] = ru
-                    else:
-                        parent[ru] = rt
-                    changed += 1
+                t = u if (du < dw or (du == dw and before(xy, &box, u, w))) else w
+                changed += join(&parent[0], xy, &box, v, t)
         if changed == 0:
             break
         # every ring through a merged point, again
@@ -606,47 +626,94 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
     return offsets, rings
 
 
+cdef inline int kind_of(const double* xy, Sides* box, int p) noexcept nogil:
+    # 0 a corner of the box, 1 on a side, 2 inside: the order in which merges keep points
+    cdef bint on_x = xy[2 * p] == box.xmin or xy[2 * p] == box.xmax
+    cdef bint on_y = xy[2 * p + 1] == box.ymin or xy[2 * p + 1] == box.ymax
+    return 0 if (on_x and on_y) else (1 if (on_x or on_y) else 2)
+
+
+cdef inline int join(int32_t* parent, const double* xy, Sides* box, int p, int q) noexcept nogil:
+    # one set of p and q, under the point kept (before); 1 if they were apart
+    cdef int rp = find(parent, p), rq = find(parent, q)
+    if rp == rq:
+        return 0
+    if before(xy, box, rp, rq):
+        parent[rq] = rp
+    else:
+        parent[rp] = rq
+    return 1
+
+
 def point_kinds(const double[:, ::1] points, box_tuple):
     """Per point, by its value: 0 a corner of the box (x0, y0, x1, y1), 1 on a side, 2 inside (the
-    order in which straighten keeps points)."""
-    xmin, ymin, xmax, ymax = [float(v) for v in box_tuple]
-    x = np.asarray(points[:, 0])
-    y = np.asarray(points[:, 1])
-    on_x = (x == xmin) | (x == xmax)
-    on_y = (y == ymin) | (y == ymax)
-    return np.where(on_x & on_y, 0, np.where(on_x | on_y, 1, 2)).astype(np.int8)
+    order in which straighten keeps points; for tests)."""
+    cdef Sides box = sides(box_tuple)
+    out = np.empty(points.shape[0], np.int8)
+    cdef signed char[::1] o = out
+    cdef Py_ssize_t p
+    for p in range(points.shape[0]):
+        o[p] = kind_of(&points[0, 0], &box, <int> p)
+    return out
 
 
-def value_names(const double[:, ::1] points):
+def value_names(const double[:, ::1] points, keys=None):
     """name[p]: the first point with the same value as point p (signed zeros equal), by one pass over
-    a hash table: the names depend on the values alone, not on which of equal points a ring holds."""
-    cdef Py_ssize_t n = points.shape[0], size = 16, p, q, slot
-    while size < 2 * n:
+    a hash table: the names depend on the values alone, not on which of equal points a ring holds.
+    keys: optional point numbers; then only values held by one of them are named (the table holds
+    those alone), every other point is its own name."""
+    cdef Py_ssize_t n = points.shape[0], n_keys, size = 16, p, q, slot, k
+    cdef const int32_t[::1] kv
+    n_keys = n if keys is None else len(keys)
+    while size < 2 * n_keys:
         size *= 2
     names_arr = np.empty(n, np.int32)
-    table_arr = np.full(size, -1, np.int32)
+    table_arr = np.full(size, -1, np.int32)      # a point holding the value (a key), or -1
+    first_arr = np.full(size, -1, np.int32)      # the first point in order with it, once seen
     cdef int32_t[::1] name = names_arr
     cdef int32_t[::1] table = table_arr
-    cdef double x, y
-    cdef uint64_t bx, by, mask = <uint64_t> (size - 1)
+    cdef int32_t[::1] first = first_arr
+    cdef bint all_points = keys is None
+    if not all_points:
+        kv = np.ascontiguousarray(keys, np.int32)
     with nogil:
+        if not all_points:
+            for k in range(n_keys):
+                slot = value_slot(&points[0, 0], kv[k], &table[0], size)
+                if table[slot] < 0:
+                    table[slot] = kv[k]
         for p in range(n):
-            x = points[p, 0] + 0.0                  # -0.0 + 0.0 is +0.0: one key for both zeros
-            y = points[p, 1] + 0.0
-            memcpy(&bx, &x, 8)
-            memcpy(&by, &y, 8)
-            bx = (bx ^ (by * <uint64_t> 0x9E3779B97F4A7C15)) * <uint64_t> 0xC2B2AE3D27D4EB4F
-            slot = <Py_ssize_t> ((bx ^ (bx >> 29)) & mask)
             name[p] = <int32_t> p
-            while table[slot] >= 0:
-                q = table[slot]
-                if points[q, 0] == x and points[q, 1] == y:
-                    name[p] = <int32_t> q
-                    break
-                slot = (slot + 1) & (size - 1)
-            if name[p] == p:
-                table[slot] = <int32_t> p
+            if all_points:
+                slot = value_slot(&points[0, 0], <int> p, &table[0], size)
+                if table[slot] < 0:
+                    table[slot] = <int32_t> p
+            else:
+                slot = value_slot(&points[0, 0], <int> p, &table[0], size)
+                if table[slot] < 0:
+                    continue
+            if first[slot] < 0:
+                first[slot] = <int32_t> p
+            name[p] = first[slot]
     return names_arr
+
+
+cdef inline Py_ssize_t value_slot(const double* xy, int p, const int32_t* table, Py_ssize_t size) noexcept nogil:
+    # the slot of p's value: the one holding a point of that value, or the empty one where it would go
+    cdef double x = xy[2 * p] + 0.0, y = xy[2 * p + 1] + 0.0      # -0.0 + 0.0 is +0.0: one key for both
+    cdef uint64_t bx, by
+    cdef Py_ssize_t slot
+    cdef int q
+    memcpy(&bx, &x, 8)
+    memcpy(&by, &y, 8)
+    bx = (bx ^ (by * <uint64_t> 0x9E3779B97F4A7C15)) * <uint64_t> 0xC2B2AE3D27D4EB4F
+    slot = <Py_ssize_t> ((bx ^ (bx >> 29)) & <uint64_t> (size - 1))
+    while table[slot] >= 0:
+        q = table[slot]
+        if xy[2 * q] == x and xy[2 * q + 1] == y:
+            return slot
+        slot = (slot + 1) & (size - 1)
+    return slot
 
 
 cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_offsets, int32_t[::1] nv,
@@ -663,10 +730,11 @@ cdef void cdef_fill(const int64_t[::1] ov, int32_t[::1] rv, int64_t[::1] new_off
     new_offsets[n_cells] = out
 
 
-cdef inline bint before(const double* xy, const signed char[::1] kind, int p, int q) noexcept nogil:
+cdef inline bint before(const double* xy, Sides* box, int p, int q) noexcept nogil:
     # the point kept when p and q merge: a corner, else on the boundary, else the lowest (y, then x)
-    if kind[p] != kind[q]:
-        return kind[p] < kind[q]
+    cdef int kp = kind_of(xy, box, p), kq = kind_of(xy, box, q)
+    if kp != kq:
+        return kp < kq
     if xy[2 * p + 1] != xy[2 * q + 1]:
         return xy[2 * p + 1] < xy[2 * q + 1]
     if xy[2 * p] != xy[2 * q]:
