@@ -144,3 +144,27 @@ def test_straightening_reads_values_not_numbers():
         assert all(np.array_equal(a, b) for a, b in zip(own, shuffled))
     assert all(np.array_equal(a, b) for a, b in zip(own, shared))
     assert any(len(a) != b - c for a, b, c in zip(own, offsets[1:], offsets[:-1]))
+
+
+def test_straightening_looks_only_at_rings_that_may_be_bent():
+    """Told which rings may be bent (those that turn right), straighten gives the rings it gives
+    looking at all of them; told none, it changes nothing."""
+    offsets, xy, box = bent_patch()
+    rings = np.arange(len(xy), dtype=np.int32)
+    every = straightened(xy, offsets, rings, box)
+    turns_right = np.array(
+        [
+            any(
+                clip.ring_turn(*xy[a + (k - 1) % (b - a)], *xy[a + k], *xy[a + (k + 1) % (b - a)]) < 0
+                for k in range(b - a)
+            )
+            for a, b in zip(offsets[:-1], offsets[1:])
+        ],
+        np.int8,
+    )
+    assert 0 < turns_right.sum() < len(turns_right)
+    new_offsets, new_rings = clip.straighten(xy, offsets, rings, box, candidates=turns_right)
+    some = [xy[new_rings[a:b]] for a, b in zip(new_offsets[:-1], new_offsets[1:])]
+    assert all(np.array_equal(a, b) for a, b in zip(every, some))
+    new_offsets, new_rings = clip.straighten(xy, offsets, rings, box, candidates=np.zeros(len(turns_right), np.int8))
+    assert np.array_equal(new_offsets, offsets) and np.array_equal(new_rings, rings)

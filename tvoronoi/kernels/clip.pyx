@@ -222,6 +222,9 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     S.he_face = &he_face[0] if n_he > 0 else NULL
     S.face_edge = &face_edge[0] if n > 0 else NULL
     S.active = &active[0] if n > 0 else NULL
+    turned_arr = np.zeros(max(n, 1), np.int8)
+    cdef signed char[::1] turned = turned_arr
+    S.turned = &turned[0]
     S.flags = &flags[0] if n_he > 0 else NULL
     S.seg_start = seg_start
     S.seg_end = seg_end
@@ -260,7 +263,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     points = pts_buf[:n_pts]
     offs = np.asarray(offsets)
     if n_bent:
-        offs, rings = straighten(points, offs, rings, (xmin, ymin, xmax, ymax))
+        offs, rings = straighten(points, offs, rings, (xmin, ymin, xmax, ymax), candidates=turned_arr[:n])
     return points, offs, rings, status
 
 
@@ -311,6 +314,7 @@ cdef struct CellPass:
     const int32_t* he_face
     const int32_t* face_edge
     const signed char* active
+    signed char* turned             # per cell: 1 where its finished ring turns right somewhere
     const signed char* flags
     const int32_t* seg_start
     const int32_t* seg_end
@@ -357,6 +361,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
                 k = finish_ring(&ring[n_ring], cnt, pts)
                 if k > 0 and first_right_turn(&ring[n_ring], k, pts) >= 0:
                     n_bent[0] += 1
+                    S.turned[i] = 1
             n_ring += k
             continue
         # a cell that meets the box boundary: its edges' parts, then the walk
@@ -397,6 +402,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
         k = finish_ring(&ring[n_ring], k, pts)
         if k > 0 and first_right_turn(&ring[n_ring], k, pts) >= 0:
             n_bent[0] += 1
+            S.turned[i] = 1
         n_ring += k
     return n_ring
 
@@ -542,7 +548,8 @@ cdef Sides sides(box_tuple):
     return box
 
 
-def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed char[::1] was_bent=None):
+def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed char[::1] was_bent=None,
+               candidates=None):
     """Make every ring a simple polygon again where rounding made it cross itself (degenerate case: a
     cell thinner than the rounding near a vertex, so that the vertex rounded across the line of its
     neighbours and an edge of the ring crosses another).
@@ -557,6 +564,9 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
     rounding everywhere.
 
     was_bent: optional (cells,) int8, set to 1 for every ring found bent in some round.
+    candidates: optional (cells,) int8, 1 for the rings that may be bent (those with a right turn; the
+    others are not looked at in the first round). After a round only the rings it changed, and those
+    it found bent, are looked at again: a ring's verdict reads its own points alone.
     Returns the new (offsets, rings).
     """
     cdef Py_ssize_t n_pts = points.shape[0]
@@ -569,6 +579,9 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
     cdef int64_t[::1] ov
     cdef int n_cells = len(offsets) - 1, i, j, k, cnt, v, u, w, t, changed, guard, n_bent
     cdef int32_t[::1] bent_at
+    cdef signed char[::1] look = (np.ones(max(n_cells, 1), np.int8) if candidates is None
+                                  else np.array(candidates, np.int8))
+    cdef int32_t[::1] before_remap
     cdef int64_t lo, hi
     cdef double du, dw
     for guard in range(n_pts):
@@ -579,7 +592,7 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
         bent_at = bent_arr
         n_bent = 0
         for i in range(n_cells):
-            if ov[i + 1] > ov[i] and bent(&rv[ov[i]], <int> (ov[i + 1] - ov[i]), xy):
+            if look[i] and ov[i + 1] > ov[i] and bent(&rv[ov[i]], <int> (ov[i + 1] - ov[i]), xy):
                 bent_at[n_bent] = i
                 n_bent += 1
         if n_bent == 0:
@@ -611,10 +624,21 @@ def straighten(const double[:, ::1] points, offsets, rings, box_tuple, signed ch
                 changed += join(&parent[0], xy, &box, v, t)
         if changed == 0:
             break
-        # every ring through a merged point, again
+        # every ring through a merged point, again; the next round looks at the rings this one changed
+        # and at those it found bent
         for v in range(n_pts):
             parent[v] = find(&parent[0], v)
+        before_remap = rings
         rings = parent_arr[rings]
+        rv = rings
+        for i in range(n_cells):
+            look[i] = 0
+            for lo in range(ov[i], ov[i + 1]):
+                if rv[lo] != before_remap[lo]:
+                    look[i] = 1
+                    break
+        for j in range(n_bent):
+            look[bent_at[j]] = 1
         new_rings = np.empty_like(rings)
         new_offsets = np.zeros_like(offsets)
         rv = rings
