@@ -184,7 +184,11 @@ cdef class DynamicMesh:
         """Start from a batch triangulation: its vertex k is site ids[k], vertex inf is infinity."""
         cdef int n = xs.shape[0], k, e, v, n_he = tv.shape[0]
         top = int(np.max(ids)) + 1 if n else 0
-        self._grow(max(self.cap_v, top, 4), max(self.cap_t, n_he // 3 + 8, 2 * top + 8))
+        cap_v, cap_t = max(self.cap_v, top, 4), max(self.cap_t, n_he // 3 + 8, 2 * top + 8)
+        if cap_v > self.cap_v or cap_t > self.cap_t or self.m.n_tri > 0:
+            # (a new mesh with room enough keeps its fresh arrays: a second set of them, made and
+            # copied for nothing, cost a second at a million sites, mostly in fresh pages)
+            self._grow(cap_v, cap_t)
         for k in range(n):
             self.wx[ids[k]] = xs[k]
             self.wy[ids[k]] = ys[k]
