@@ -52,6 +52,26 @@ def test_random_triangles_are_correctly_rounded():
     check_triangles(rng.random((3000, 3, 2)))
 
 
+@pytest.mark.parametrize("offset, scale", [(0.0, 1.0), (0.5, 1e-7), (4.5e5, 1e3), (-3.0, 1e-3)])
+def test_delaunay_triangles_are_correctly_rounded(offset, scale):
+    """A build's triangles: the doubles settle about 5 centres in 6 by their bound (rounds_alike), the
+    others go on to long double; either way each coordinate is the nearest double (a sample against
+    Fractions, at offsets where a centre's offset from its site is small against an ulp and where not)."""
+    from tvoronoi import engines
+
+    rng = np.random.default_rng(13)
+    pts = offset + scale * rng.random((20000, 2))
+    e = engines.scale_exponent(pts)
+    s = engines.prepare(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
+    t = engines.triangulate(s, engine="incremental")
+    tri = t.voronoi()["triangles"]
+    pick = tri[rng.choice(len(tri), 1500, replace=False)]
+    got = dual.circumcentres(s.xs, s.ys, np.ascontiguousarray(pick), e)
+    for k, (a, b, c) in enumerate(pick):
+        ux, uy = exact_circumcentre(*((s.xs[v], s.ys[v]) for v in (a, b, c)))
+        assert got[k, 0] == rounded(ux, e) and got[k, 1] == rounded(uy, e), (a, b, c)
+
+
 def test_nearly_collinear_triangles():
     # sites on y = 1 + 2x rounded to doubles: the determinant is a few ulps, the vertex far away
     t = np.linspace(0, 1, 60)
