@@ -7,7 +7,7 @@ Used by dynamic.pyx: DynamicMesh.cell reads a cell; DynamicMesh.cells_near keeps
 from libc.math cimport fabs
 from libc.stdint cimport int32_t, uint64_t
 from libc.stdlib cimport malloc, calloc, free
-from tvoronoi.kernels.predicates cimport orient2d
+from tvoronoi.kernels.predicates cimport incircle, orient2d
 from tvoronoi.kernels.mesh cimport Mesh, nxt, prv, is_infinite
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, axis_code, code_in, code_side, clip_edge, walk_cell,
@@ -125,6 +125,12 @@ cdef inline int interior_ring(Mesh* m, int site, Box* box, CentreMemo* memo, dou
     return k
 
 
+cdef inline bint cocircular_edge(Mesh* m, int site, int before, int j, int after) noexcept nogil:
+    # the edge between site and neighbour j, from the centre of (site, before, j) to that of
+    # (site, j, after), has length zero: the four sites lie on one circle (exactly)
+    return incircle(m.x[site], m.y[site], m.x[before], m.y[before], m.x[j], m.y[j], m.x[after], m.y[after]) == 0
+
+
 cdef inline int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
     """The cell of site clipped to the box (clipper.pxd, as for batch cells): point ids of b.pts in
     b.ring, counter-clockwise from the lowest point; returns the count."""
@@ -165,8 +171,11 @@ cdef inline int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept 
         p = q - 1 if q > 0 else k - 1
         has_o = b.vcx[p] != 3
         has_d = b.vcx[q] != 3
-        if has_o and has_d and b.pts[2 * p] == b.pts[2 * q] and b.pts[2 * p + 1] == b.pts[2 * q + 1]:
-            continue                  # a zero-length edge (cocircular sites, or closer than rounding)
+        if (has_o and has_d and b.pts[2 * p] == b.pts[2 * q] and b.pts[2 * p + 1] == b.pts[2 * q + 1]
+                and cocircular_edge(m, site, b.db[p], j, b.dc[q])):
+            continue                  # a zero-length edge, which the batch dual drops too (dual.pyx)
+        # (an edge whose distinct ends round to one point stays, as in the batch cells: it may be where
+        # the cell enters or leaves the box)
         b.nbx[n_edges] = m.x[j]
         b.nby[n_edges] = m.y[j]
         clip_edge(box, sx, sy, m.x[j], m.y[j], has_o, b.vcx[p] if has_o else 0, b.vcy[p] if has_o else 0,
