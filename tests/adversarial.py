@@ -436,6 +436,38 @@ def box_through_sites(n: int = 300, *, seed: int = SEED) -> Case:
     return Case(_pts(g), bbox=(2.0, 2.5, 9.5, 9.0), note="box sides through grid sites and vertices")
 
 
+def box_on_lattice_edges(side: int = 24, *, step: float = 0.5, seed: int = SEED) -> Case:
+    """Sites at the centres of a lattice's squares, a few left out, and a box whose sides lie on the
+    lattice lines: the Voronoi edges run along the box's sides and meet at its corners, so cells outside
+    touch the box at a corner or along a side and hold nothing inside it."""
+    rng = np.random.default_rng(seed)
+    ij = np.array([(i, j) for i in range(side) for j in range(side)])
+    lo = rng.integers(1, side // 4, 2)
+    hi = rng.integers(3 * side // 4, side, 2)
+    keep = rng.random(len(ij)) < 0.9
+    # at each corner of the box, the two squares beside it across the box's sides go: the bisector of the
+    # two diagonal squares' centres passes through the corner
+    for cx, cy in ((lo[0], lo[1]), (hi[0], lo[1]), (lo[0], hi[1]), (hi[0], hi[1])):
+        for i, j in ((cx - 1, cy), (cx, cy - 1)) if (cx == lo[0]) == (cy == lo[1]) else ((cx - 1, cy - 1), (cx, cy)):
+            keep &= ~((ij[:, 0] == i) & (ij[:, 1] == j))
+    g = (ij[keep] + 0.5) * step
+    box = (lo[0] * step, lo[1] * step, hi[0] * step, hi[1] * step)
+    return Case(_pts(g[rng.permutation(len(g))]), bbox=box, note="box sides on cell edges, corners on bisectors")
+
+
+def ulp_pairs(n: int = 1200, *, decimals: int | None = 3, seed: int = SEED) -> Case:
+    """Points, each with a partner one ulp away in x, in y or in both: the bisector of a pair passes within
+    half an ulp of both sites (one cell may vanish, or miss its site by the rounding of its points)."""
+    rng = np.random.default_rng(seed)
+    base = rng.uniform(0.0, 1.0, (n // 2, 2)) + 0.25
+    if decimals is not None:
+        base = np.round(base, decimals)
+    steps = rng.integers(-1, 2, (len(base), 2))
+    steps[(steps == 0).all(axis=1), 1] = 1
+    partner = np.where(steps > 0, np.nextafter(base, np.inf), np.where(steps < 0, np.nextafter(base, -np.inf), base))
+    return Case(_pts(np.concatenate([base, partner])), note="pairs one ulp apart")
+
+
 # ---------------------------------------------------------------------------------------------
 # the registry: family name -> generator at its hunt size
 
@@ -526,6 +558,11 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "box_one_ulp_thin": box_one_ulp_thin,
     "box_huge_1e300": box_huge,
     "box_through_grid": box_through_sites,
+    "box_on_lattice_edges": box_on_lattice_edges,
+    "box_on_lattice_edges_tenths": partial(box_on_lattice_edges, 30, step=0.1),
+    # neighbours an ulp apart
+    "ulp_pairs_3dec": ulp_pairs,
+    "ulp_pairs_raw": partial(ulp_pairs, 1200, decimals=None),
 }
 
 

@@ -54,3 +54,19 @@ def test_a_self_intersecting_cell_is_caught():
     r[[1, 2]] = r[[2, 1]]  # a bow tie
     with pytest.raises(AssertionError, match="(not simple|clockwise|flat)"):
         ec.check_cells_valid(with_cells(d, rings))
+
+
+def test_a_site_outside_its_cell_by_more_than_rounding_is_caught():
+    """within_rounding allows a site an ulp of the ring's points outside its cell (a neighbour an ulp
+    away), and no more: a cell shifted off its site by 1e-9 is caught, at both spans."""
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    assert ec.within_rounding(square, (np.nextafter(1.0, 2.0), 0.5))
+    assert ec.within_rounding(square, (0.5, -1e-17))
+    assert not ec.within_rounding(square, (1.0 + 1e-9, 0.5))
+    for d in (huge_box_diagram(), tvoronoi.voronoi(np.random.default_rng(6).random((40, 2)))):
+        rings = [d.cell_polygon(i).copy() for i in range(d.n_sites)]
+        i = next(i for i, r in enumerate(rings) if len(r) and np.abs(r).max() < 10)
+        # the cell moved up until its lowest point is 1e-9 above its site
+        rings[i] = rings[i] + np.array([0.0, d.sites[i][1] - rings[i][:, 1].min() + 1e-9])
+        with pytest.raises(AssertionError, match="outside its cell"):
+            ec.check_cells_valid(with_cells(d, rings))

@@ -159,11 +159,11 @@ def test_checked_fortune_fixture(checked, fixture):
 # hypothesis: small near-degenerate sets
 
 
-def run_engines(worker: Worker, points) -> list[dict]:
+def run_engines(worker: Worker, points, bbox=None) -> list[dict]:
     pts = np.asarray(points, np.float64).reshape(-1, 2)
+    req: dict = {"points": pts.tolist()} if bbox is None else {"points": pts.tolist(), "bbox": list(bbox)}
     return [
-        worker.run({"points": pts.tolist(), "engine": e, "save": worker.cells_path(f"hyp-{e}")}, timeout=SMALL_TIMEOUT)
-        for e in ENGINES
+        worker.run({**req, "engine": e, "save": worker.cells_path(f"hyp-{e}")}, timeout=SMALL_TIMEOUT) for e in ENGINES
     ]
 
 
@@ -221,3 +221,28 @@ def test_hypothesis_engines_agree(worker, kind, data):
     fortune, incremental = run_engines(worker, points)
     assert "saved" in fortune and "saved" in incremental, (fortune["build"], incremental["build"])
     exact_checks.check_same_cells(load_cells(fortune["saved"]), load_cells(incremental["saved"]), ENGINES)
+
+
+@st.composite
+def box_on_bisectors(draw):
+    """A few sites at small integer points and a box with integer corners: bisectors pass through the
+    box's corners and along its sides (a cell may touch the box at a corner or a side and hold nothing
+    inside it)."""
+    pts = draw(st.lists(st.tuples(st.integers(0, 6), st.integers(0, 6)), min_size=2, max_size=8, unique=True))
+    x0, y0 = draw(st.integers(0, 5)), draw(st.integers(0, 5))
+    x1, y1 = draw(st.integers(x0 + 1, 6)), draw(st.integers(y0 + 1, 6))
+    return [(float(x), float(y)) for x, y in pts], (float(x0), float(y0), float(x1), float(y1))
+
+
+@HYPOTHESIS
+@given(data=st.data())
+def test_hypothesis_boxes_on_bisectors(worker, data):
+    """Every check passes, and the engines agree, with box corners and sides on the sites' bisectors (a
+    cell touching the box only at its lower-left corner, or along the sides through it, once took the
+    whole box)."""
+    points, bbox = data.draw(box_on_bisectors(), label="points, box")
+    answers = run_engines(worker, points, bbox)
+    for engine, ans in zip(ENGINES, answers):
+        bad = {c: ans[c] for c in CHECK_NAMES if ans[c] != "ok"}
+        assert not bad, f"{engine}: {bad}"
+    exact_checks.check_same_cells(*(load_cells(a["saved"]) for a in answers), ENGINES)

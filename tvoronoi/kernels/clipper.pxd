@@ -250,6 +250,17 @@ cdef inline bint owns_corner(Box* b, int k, double ix, double iy, const double* 
     return True
 
 
+cdef inline bint owns_box(Box* b, double ix, double iy, const double* nbx, const double* nby, int m) noexcept nogil:
+    """The box lies in the cell of i (closed), given all of i's Voronoi neighbours: its four corners do (the
+    cell is convex). One corner is not enough: a cell may hold a corner, or the sides through it, and
+    nothing inside the box (it touches the box there)."""
+    cdef int k
+    for k in range(4):
+        if not owns_corner(b, k, ix, iy, nbx, nby, m):
+            return False
+    return True
+
+
 cdef struct Points:
     # the points a cell's ring is made of, and how each boundary point was made
     double* xy                 # interleaved x, y, user unit
@@ -349,8 +360,8 @@ cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t*
             if entry[q] and q0 < 0:
                 q0 = q
     if not any_part:
-        # the box lies wholly inside the cell or wholly outside it
-        if owns_corner(b, 0, ix, iy, nbx, nby, m):
+        # the box's inside lies wholly inside the cell or wholly outside it (an edge may touch the box)
+        if owns_box(b, ix, iy, nbx, nby, m):
             for k in range(4):
                 ring[k] = P.corner0 + k
             return 4
