@@ -27,7 +27,7 @@ from libc.string cimport memcpy
 from libc.stdint cimport uint64_t
 
 from tvoronoi.kernels.predicates cimport (
-    EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_square, two_product, two_two_diff, expansion_sign,
+    EPSILON, CCW_ERRBOUND_A, two_sum, two_diff, two_diff_tail, two_square, two_product, two_two_diff, expansion_sign,
     fast_expansion_sum_zeroelim,
     scale_expansion_zeroelim, expansion_product, negate_expansion, difference_expansion,
 )
@@ -398,6 +398,87 @@ cdef inline bint circumcentre_long(double ax, double ay, double bx, double by, d
             and (not need_y or settled_long(ay, qy, wy, e, uy)))
 
 
+cdef inline bint in_pair_range(double v) noexcept nogil:
+    # 0, or a size whose products of three stay normal doubles (so every product's roundoff is exact) and
+    # whose splits cannot overflow
+    cdef double m = fabs(v)
+    return m == 0.0 or (1e-60 <= m <= 1e60)
+
+
+cdef inline int circumcentre_pairs(double ax, double ay, double bx, double by, double cx, double cy,
+                                    double bax, double bay, double cax, double cay,
+                                    double l, double r, double det, double det_sum, double bb, double cc,
+                                    double tx1, double tx2, double ty1, double ty2, double nx, double ny,
+                                    double inv, double qx, double qy, int e, bint need_x, bint need_y,
+                                    double* ux, double* uy) noexcept nogil:
+    """circumcentre's doubles carried on as pairs (a double and its roundoff), for the coordinates they
+    left open (need_x, need_y), when the differences bax .. cay are exact and in_pair_range: N and D are
+    then known within a few eps^2 of their size, and a centre nearly always settles. Returns 1: settled;
+    0: some coordinate is still open (what settled is written); -1: not tried (a difference not exact,
+    or out of range).
+
+    With u = eps (2^-53) and every roundoff below exact (Dekker's products, two-sums; no underflow in
+    range):
+      D = det + t, t = (l - r - det) + (roundoff(l) - roundoff(r)): within 3.01 u^2 P, P = det_sum;
+      |t| <= 2.01 u P
+      |b - a|^2 = bb + lo_b, bb = fl(fl(bax^2) + fl(bay^2)), lo_b its three roundoffs summed: within
+      3.01 u^2 bb, |lo_b| <= 2.01 u bb (the same for cc)
+      cay |b - a|^2 = tx1 + lo1, lo1 = roundoff(cay bb) + fl(cay lo_b): within 8.1 u^2 |tx1|,
+      |lo1| <= 3.03 u |tx1| (each term of N likewise)
+      N_x = nx + nl, nl = (tx1 - tx2 - nx) + (lo1 - lo2): within 15.2 u^2 M, M = |tx1| + |tx2|,
+      |nl| <= 4.1 u M
+    and pair_settled finishes each coordinate."""
+    cdef double t, lo_b, lo_c, lo1, lo2, lo3, lo4, x, sq1, sq2, nl
+    cdef bint done_x = not need_x, done_y = not need_y
+    if (two_diff_tail(bx, ax, bax) != 0.0 or two_diff_tail(by, ay, bay) != 0.0
+            or two_diff_tail(cx, ax, cax) != 0.0 or two_diff_tail(cy, ay, cay) != 0.0):
+        return -1
+    if not (in_pair_range(bax) and in_pair_range(bay) and in_pair_range(cax) and in_pair_range(cay)):
+        return -1
+    t = two_diff_tail(l, r, det) + (two_product(bax, cay)[1] - two_product(bay, cax)[1])
+    x, sq1 = two_square(bax)
+    x, sq2 = two_square(bay)
+    lo_b = two_sum(bax * bax, bay * bay)[1] + (sq1 + sq2)
+    x, sq1 = two_square(cax)
+    x, sq2 = two_square(cay)
+    lo_c = two_sum(cax * cax, cay * cay)[1] + (sq1 + sq2)
+    if need_x:
+        lo1 = two_product(cay, bb)[1] + cay * lo_b
+        lo2 = two_product(bay, cc)[1] + bay * lo_c
+        nl = two_diff_tail(tx1, tx2, nx) + (lo1 - lo2)
+        done_x = pair_settled(ax, nx, nl, fabs(tx1) + fabs(tx2), det, t, det_sum, inv, qx, e, ux)
+    if need_y:
+        lo3 = two_product(bax, cc)[1] + bax * lo_c
+        lo4 = two_product(cax, bb)[1] + cax * lo_b
+        nl = two_diff_tail(ty1, ty2, ny) + (lo3 - lo4)
+        done_y = pair_settled(ay, ny, nl, fabs(ty1) + fabs(ty2), det, t, det_sum, inv, qy, e, uy)
+    return 1 if done_x and done_y else 0
+
+
+cdef inline bint pair_settled(double a, double ns, double nl, double m, double s, double t, double p, double inv,
+                              double q1, int e, double* out) noexcept nogil:
+    """a + N / (2 D), N = ns + nl within 15.2 u^2 m, D = s + t within 3.01 u^2 p (|t| <= 2.01 u p, and
+    |s| > 24 u p: circumcentre's guard), q1 = fl(ns inv), inv = fl(0.5 / s): its rounding if it settles
+    (then 2^e times it; rounds_alike).
+
+    2 s q1 = r1 + r1e exactly, and ns - r1 = h exactly (r1 is within three roundings of ns), so
+    N - 2 D q1 = rp + E, rp = ((h - r1e) + nl) - 2 t q1 as computed (four roundings of terms below
+    4.1 u (|ns| + m + p |q1|)), |E| <= u^2 (17 |ns| + 42 m + 26 p |q1|); then with q2 = fl(rp inv),
+    |N / (2 D) - q1 - q2| <= u |q2| (5 p |inv| + 2.1) + 1.11 u^2 (17 |ns| + 42 m + 26 p |q1|) |inv|
+    (1 / (2 D) = inv (1 + rho), |rho| <= 2.2 u p / |s| < 0.1), which w2 bounds with room; a + q1 = s0 + s1
+    exactly, and s1 + q2 rounds to sm."""
+    cdef double r1, r1e, h, rp, q2, w2, s0, s1, sm, u = EPSILON
+    r1, r1e = two_product(2.0 * s, q1)
+    h = ns - r1
+    rp = ((h - r1e) + nl) - 2.0 * t * q1
+    q2 = rp * inv
+    w2 = 64.0 * u * u * (fabs(ns) + m + p * fabs(q1)) * fabs(inv) + 8.0 * u * (1.0 + p * fabs(inv)) * fabs(q2)
+    s0, s1 = two_sum(a, q1)
+    sm = s1 + q2
+    # rounds_alike's slack: the bound, the rounding of sm, and w's own (w (1 - u) >= w2 + 2 u |sm|)
+    return rounds_alike(s0, sm, 1.0001 * w2 + 3.0 * u * fabs(sm) + 1e-300, e, out)
+
+
 cdef inline void circumcentre(double ax, double ay, double bx, double by, double cx, double cy, int e,
                               double* ux, double* uy) noexcept nogil:
     """The circumcentre of a, b, c (not collinear), each coordinate correctly rounded, times 2^e."""
@@ -407,6 +488,7 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
     cdef double err_det = CCW_ERRBOUND_A * det_sum
     cdef double bb, cc, tx1, tx2, ty1, ty2, nx, ny, adet, inv, ig, qx, qy, wx, wy
     cdef bint done_x, done_y
+    cdef int pairs
     adet = fabs(det)
     # fast path: relative coordinates in doubles, with a bound on their error; skipped when the
     # determinant is too close to its error or values could underflow
@@ -436,8 +518,14 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
         done_y = rounds_alike(ay, qy, wy, e, uy)
         if done_x and done_y:
             return
-        # the coordinate the doubles left open (rarely both) again in long double
-        if circumcentre_long(ax, ay, bx, by, cx, cy, e, not done_x, not done_y, ux, uy):
+        # the coordinates the doubles left open (rarely both): as pairs of doubles where the differences
+        # are exact (nearly always; what the pairs leave open is within a few eps^2 of a tie, beyond long
+        # double too), else in long double
+        pairs = circumcentre_pairs(ax, ay, bx, by, cx, cy, bax, bay, cax, cay, l, r, det, det_sum, bb, cc, tx1,
+                                   tx2, ty1, ty2, nx, ny, inv, qx, qy, e, not done_x, not done_y, ux, uy)
+        if pairs == 1:
+            return
+        if pairs == -1 and circumcentre_long(ax, ay, bx, by, cx, cy, e, not done_x, not done_y, ux, uy):
             return
     if circumcentre_relative(ax, ay, bx, by, cx, cy, e, ux, uy):
         return
