@@ -118,6 +118,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         for t in range(n_tri - 1, -1, -1):
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             if a == inf or b == inf or c == inf:
+                vid[n_hull] = t         # (vid is free until the walks: the hull's triangles, listed)
                 n_hull += 1
                 if threads > 1:
                     for e in range(3 * t, 3 * t + 3):
@@ -131,14 +132,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 if threads > 1:
                     h_first[a] += 1; h_first[b] += 1; h_first[c] += 1
                     v_first[smallest(a, b, c)] += 1
-        t = 0
-        while n_hull > 0:
-            if tv[3 * t] == inf or tv[3 * t + 1] == inf or tv[3 * t + 2] == inf:
-                n_hull -= 1
-                for e in range(3 * t, 3 * t + 3):
-                    if tv[e] != inf and tv[nxt(e)] != inf:
-                        first_e[tv[nxt(e)]] = opp[e]
-            t += 1
+        for k in range(n_hull):
+            t = vid[k]
+            for e in range(3 * t, 3 * t + 3):
+                if tv[e] != inf and tv[nxt(e)] != inf:
+                    first_e[tv[nxt(e)]] = opp[e]
         if threads > 1:
             # counts -> offsets: a site's half-edges and vertices follow those of the sites before it
             for a in range(n):
