@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 
+from tvoronoi.errors import EngineError
+
 from libc.stdint cimport int8_t, int32_t, int64_t, uint64_t
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle
@@ -383,7 +385,11 @@ cdef class DynamicMesh:
             raise MemoryError(f"no memory for the cell of a site with {star} neighbours")
         with nogil:
             k = cell_ring(&self.m, site, &box, &buf)
-        out = np.empty((max(k, 0), 2))
+        if k < 0:
+            free_cell_buffers(&buf)
+            raise EngineError(f"the clipper found a cell whose edges do not chain (site {site}): please report "
+                              "the updates that led here")
+        out = np.empty((k, 2))
         for i in range(k):
             out[i, 0] = buf.pts[2 * buf.ring[i]]
             out[i, 1] = buf.pts[2 * buf.ring[i] + 1]

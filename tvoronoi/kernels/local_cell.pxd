@@ -133,7 +133,8 @@ cdef inline bint cocircular_edge(Mesh* m, int site, int before, int j, int after
 
 cdef inline int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept nogil:
     """The cell of site clipped to the box (clipper.pxd, as for batch cells): point ids of b.pts in
-    b.ring, counter-clockwise from the lowest point; returns the count."""
+    b.ring, counter-clockwise from the lowest point; returns the count, or -1 if its edges do not chain
+    (an inconsistent mesh: the batch build raises there too)."""
     cdef int e0 = m.vedge[site], e, k = 0, q, p, nxq, j, a, c, n_pts, corner0, n_edges = 0, count
     cdef double sx = m.x[site], sy = m.y[site]
     cdef EdgePart part
@@ -220,7 +221,7 @@ cdef inline int cell_ring(Mesh* m, int site, Box* box, CellBuffers* b) noexcept 
     count = walk_cell(box, n_edges, b.c_start, b.c_end, b.c_entry, b.c_exit, b.c_has, &P, sx, sy, b.nbx,
                       b.nby, b.ring)
     if count <= 0:
-        return 0
+        return count            # -1: the edges did not chain (never on a valid mesh)
     return finish_ring(b.ring, count, b.pts)
 
 
