@@ -455,6 +455,30 @@ def box_on_lattice_edges(side: int = 24, *, step: float = 0.5, seed: int = SEED)
     return Case(_pts(g[rng.permutation(len(g))]), bbox=box, note="box sides on cell edges, corners on bisectors")
 
 
+def box_corner_on_vertex(side: int = 20, *, pythagorean: bool = False, seed: int = SEED) -> Case:
+    """A small box inside one cell with a corner exactly on a Voronoi vertex: the cell's edges only touch
+    the box there (at a lattice's 4-cell vertex, or at the centre of 3-4-5 circles of sites), and every
+    cell around the vertex touches the box at that corner alone."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(i, j) for i in range(side) for j in range(side)], float)
+    if pythagorean:
+        # sites at (3, 4), (-4, 3), (0, -5), ... from centres on a lattice of step 20: each centre a vertex
+        rim = np.array([(3, 4), (-4, 3), (-5, 0), (0, -5), (4, -3), (-3, -4)], float)
+        centres = g[::7] * 20.0
+        pts = (
+            centres[:, None, :] + rim[rng.permuted(np.tile(np.arange(6), (len(centres), 1)), axis=1)[:, :3]]
+        ).reshape(-1, 2)
+        v = centres[rng.integers(len(centres))]
+        reach = 0.5
+    else:
+        pts = g
+        v = g[rng.integers(len(g))] + 0.5
+        reach = 0.5 * float(rng.choice([1.0, 0.5, 2.0**-20]))
+    qx, qy = rng.choice([-1.0, 1.0], 2) * reach
+    box = (min(v[0], v[0] + qx), min(v[1], v[1] + qy), max(v[0], v[0] + qx), max(v[1], v[1] + qy))
+    return Case(_pts(np.unique(pts, axis=0)), bbox=box, note="a small box in one cell, a corner on a vertex")
+
+
 def ulp_pairs(n: int = 1200, *, decimals: int | None = 3, seed: int = SEED) -> Case:
     """Points, each with a partner one ulp away in x, in y or in both: the bisector of a pair passes within
     half an ulp of both sites (one cell may vanish, or miss its site by the rounding of its points)."""
@@ -560,6 +584,8 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "box_through_grid": box_through_sites,
     "box_on_lattice_edges": box_on_lattice_edges,
     "box_on_lattice_edges_tenths": partial(box_on_lattice_edges, 30, step=0.1),
+    "box_corner_on_vertex": box_corner_on_vertex,
+    "box_corner_on_vertex_pythagorean": partial(box_corner_on_vertex, 20, pythagorean=True),
     # neighbours an ulp apart
     "ulp_pairs_3dec": ulp_pairs,
     "ulp_pairs_raw": partial(ulp_pairs, 1200, decimals=None),

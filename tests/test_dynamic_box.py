@@ -9,6 +9,7 @@ dynamic cell once dropped every edge whose ends rounded alike, and lost cells at
 import numpy as np
 import pytest
 
+import adversarial
 from test_dynamic_straighten import differing_cells
 from tvoronoi.dynamic import DynamicVoronoi
 
@@ -58,3 +59,13 @@ def test_sessions_in_a_box_through_lattice_rows_end_with_the_batch_cells(engine)
     """About one session in four of these failed before (cells missing at the box's sides)."""
     for seed in range(16):
         assert differing_cells(lattice_session(seed, engine)) == [], f"seed {seed}"
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("family", ["box_corner_on_vertex", "box_corner_on_vertex_pythagorean"])
+def test_a_small_box_with_a_corner_on_a_vertex_has_the_batch_cells(family, engine):
+    """A box inside one cell, a corner on a Voronoi vertex: every cell there touches the box at that
+    corner alone, and the one holding the box must still take it (the batch's hunt checks its tiling)."""
+    for seed in range(12):
+        case = adversarial.FAMILIES[family](seed=seed)
+        assert differing_cells(DynamicVoronoi(case.points, engine=engine, bbox=case.bbox)) == [], f"seed {seed}"

@@ -356,11 +356,14 @@ cdef inline int walk_cell(Box* b, int m, const int32_t* start_pt, const int32_t*
     cdef bint any_part = False
     for q in range(m):
         if has[q]:
-            any_part = True
+            # (a part of one point, start and end the same: the edge only touches the box there)
+            any_part = any_part or start_pt[q] != end_pt[q]
             if entry[q] and q0 < 0:
                 q0 = q
     if not any_part:
-        # the box's inside lies wholly inside the cell or wholly outside it (an edge may touch the box)
+        # the box's inside lies wholly inside the cell or wholly outside it (an edge may touch the box: at
+        # a vertex on its boundary, say on a corner, where a ring of touching points alone would be one
+        # point, or a walk round the box from it to itself)
         if owns_box(b, ix, iy, nbx, nby, m):
             for k in range(4):
                 ring[k] = P.corner0 + k
