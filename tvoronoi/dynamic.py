@@ -42,7 +42,13 @@ def settled_cell(mesh: dynamic.DynamicMesh, i: int, bbox, e: int) -> np.ndarray:
     bent cell within SETTLE_RADIUS steps, again the cell as clipped; otherwise those cells are
     straightened together, the patch grown until every ring it bends lies two steps inside its edge (or
     it holds the whole mesh). A chain of three rounds or more arriving from beyond SETTLE_RADIUS would
-    not be seen; the hunts (66,000 sessions on rounded lattices) met none."""
+    not be seen; the hunts (66,000 sessions on rounded lattices) met none.
+
+    Known to fail (open): nearly cocircular sites share one rounded vertex across more than
+    SETTLE_RADIUS steps. Seven sites within 1e-11 of one circle at 1e5
+    (tests/fixtures/open/dynamic_near_cocircular_point_merged_three_steps_away.npz): a bent cell's
+    merge renames a point that a cell three steps away holds too, and that cell reads an ulp off the
+    batch's. The patch should follow shared point values, not steps."""
     radius = SETTLE_RADIUS
     x0, y0, x1, y1 = bbox
     ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
