@@ -44,23 +44,44 @@ def settled_cell(mesh: dynamic.DynamicMesh, i: int, bbox, e: int) -> np.ndarray:
     it holds the whole mesh). A chain of three rounds or more arriving from beyond SETTLE_RADIUS would
     not be seen; the hunts (66,000 sessions on rounded lattices) met none.
 
-    Known to fail (open): nearly cocircular sites share one rounded vertex across more than
-    SETTLE_RADIUS steps. Seven sites within 1e-11 of one circle at 1e5
-    (tests/fixtures/open/dynamic_near_cocircular_point_merged_three_steps_away.npz): a bent cell's
-    merge renames a point that a cell three steps away holds too, and that cell reads an ulp off the
-    batch's. The patch should follow shared point values, not steps."""
+    Steps are not the whole story: nearly cocircular sites share one rounded vertex across their whole
+    circle, and a merge renames a point in every cell that has it. So a cell that shares a vertex with a
+    bent cell however far away is read with a patch that reaches it (shares_a_bent_vertex), and a
+    patch is kept only when it holds every cell that has a point of a ring it found bent
+    (holds_sharers); otherwise it grows."""
     radius = SETTLE_RADIUS
     x0, y0, x1, y1 = bbox
     ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
+    if patch is None and mesh.shares_a_bent_vertex(i, e):
+        # a bent cell further away has a vertex of this one: a patch that reaches it
+        while patch is None:
+            radius *= 2
+            ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
     while patch is not None:
-        _ids, steps, offsets, xy = patch
+        ids, steps, offsets, xy = patch
         was_bent = np.zeros(len(steps), np.int8)
         new_offsets, rings = clip.straighten(xy, offsets, np.arange(len(xy), dtype=np.int32), bbox, was_bent)
-        if int(steps.max()) < radius or not (was_bent.view(bool) & (steps >= radius - 1)).any():
+        whole = int(steps.max()) < radius
+        if whole or (
+            not (was_bent.view(bool) & (steps >= radius - 1)).any() and holds_sharers(mesh, patch, was_bent, e)
+        ):
             return xy[rings[new_offsets[0] : new_offsets[1]]]
         radius *= 2
         ring, patch = mesh.cells_near(i, x0, y0, x1, y1, e, radius)
     return ring
+
+
+def holds_sharers(mesh: dynamic.DynamicMesh, patch, was_bent: np.ndarray, e: int) -> bool:
+    """Every cell that has a point of a ring the straightening found bent as a vertex is in the patch: a
+    merge renames that point in every cell that has it, however many steps away (nearly cocircular
+    sites share one rounded vertex across their whole circle)."""
+    ids, _steps, offsets, xy = patch
+    have = set(ids.tolist())
+    for k in np.flatnonzero(was_bent):
+        for x, y in xy[offsets[k] : offsets[k + 1]].tolist():
+            if not mesh.sites_at_point(int(ids[k]), x, y, e) <= have:
+                return False
+    return True
 
 
 class DynamicVoronoi:

@@ -21,6 +21,7 @@ from tvoronoi.kernels.local_cell cimport (
     sure_cells,
 )
 from tvoronoi.kernels.fortune cimport sweep_triangles
+from tvoronoi.kernels.construct cimport circumcentre
 
 cdef enum:
     UNKNOWN = 0             # ring_state of a site: not looked at (or not in the mesh)
@@ -510,6 +511,62 @@ cdef class DynamicMesh:
         states = np.asarray(self.arrays["ring_state"][:self.cap_v])
         assert int((states == BENT).sum()) == self.n_bent
         return np.flatnonzero(states == BENT).astype(np.int32)
+
+    def sites_at_point(self, int site, double x, double y, int exponent):
+        """The sites of the cells that have (x, y) as a vertex: of the triangles whose circumcentre,
+        correctly rounded (times 2^exponent), is that point, found from the triangles around `site` and
+        then their neighbours that round to it too. (Delaunay triangles whose centres round to one point
+        share one empty circle, nearly: they triangulate the polygon of its sites, each next to another.)
+        Nearly cocircular sites can share such a point across many Delaunay steps."""
+        cdef int e0 = self.m.vedge[site], e, t, k, u
+        cdef double cx, cy
+        found, todo, seen = set(), [], set()
+        if e0 < 0:
+            return found
+        e = e0
+        while True:
+            todo.append(e // 3)
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        while todo:
+            t = todo.pop()
+            if t in seen or is_infinite(&self.m, t):
+                continue
+            seen.add(t)
+            circumcentre(self.m.x[self.m.tv[3 * t]], self.m.y[self.m.tv[3 * t]],
+                         self.m.x[self.m.tv[3 * t + 1]], self.m.y[self.m.tv[3 * t + 1]],
+                         self.m.x[self.m.tv[3 * t + 2]], self.m.y[self.m.tv[3 * t + 2]], exponent, &cx, &cy)
+            if cx != x or cy != y:
+                continue
+            for k in range(3):
+                found.add(self.m.tv[3 * t + k])
+                u = self.m.opp[3 * t + k]
+                if u >= 0:
+                    todo.append(u // 3)
+        return found
+
+    def shares_a_bent_vertex(self, int site, int exponent):
+        """Whether a cell known bent (ring_state, as cells_near last brought it up to date) has a vertex
+        of this site's cell: its merges would rename that point here, however many steps away."""
+        cdef int e0 = self.m.vedge[site], e, t, a, b, c
+        cdef double cx, cy
+        if e0 < 0 or self.n_bent == 0:
+            return False
+        e = e0
+        while True:
+            t = e // 3
+            if not is_infinite(&self.m, t):
+                a = self.m.tv[3 * t]; b = self.m.tv[3 * t + 1]; c = self.m.tv[3 * t + 2]
+                circumcentre(self.m.x[a], self.m.y[a], self.m.x[b], self.m.y[b], self.m.x[c], self.m.y[c],
+                             exponent, &cx, &cy)
+                for s in self.sites_at_point(site, cx, cy, exponent):
+                    if self.ring_state[s] == BENT:
+                        return True
+            e = self.m.opp[prv(e)]
+            if e == e0:
+                break
+        return False
 
     def cells_near(self, int site, double xmin, double ymin, double xmax, double ymax, int exponent,
                    int radius):
