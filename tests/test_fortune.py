@@ -193,21 +193,25 @@ def test_hinted_location_is_the_trees_on_small_integer_sets(n, span, turn, seed)
 @pytest.mark.parametrize("dist", ["uniform", "gaussian", "clustered"])
 def test_hints_locate_nearly_every_site(dist):
     """The hints work: on 50,000 sites of each distribution, at least 97% are located by a short walk,
-    and the result is the tree's."""
+    the rest by longer walks within their budget, so that the tree is never built; and the result is
+    the tree's."""
     from tvoronoi.generators import generate
 
     hinted, tree = _sweep_both_ways(generate(dist, 50_000, seed=5))
     _assert_same_sweep(hinted, tree)
     walks, descents = hinted["located"]
-    assert walks + descents == 50_000 - 1  # (the first site starts the beach line)
+    assert walks + descents + hinted["long_walks"] == 50_000 - 1  # (the first site starts the beach line)
     assert walks >= 0.97 * 50_000
+    assert descents == 0 and not hinted["tree_built"]
+    assert tree["long_walks"] == 0 and tree["tree_built"]
 
 
 def test_hints_outlast_outliers_and_give_way_to_the_tree():
     """The strips span the middle 99.8% of the sites' x: a dense cluster with a few far outliers is
     still located by walks. Two clusters far apart leave each one strip or two, where walks seldom
-    settle: the hints are given up after a trial, and the tree locates the rest. The same sweep as the
-    tree's either way."""
+    settle: once the longer walks have spent their budget the tree is built from the beach line, the
+    hints are given up after a trial, and the tree locates the rest. The same sweep as the tree's
+    either way."""
     rng = np.random.default_rng(8)
     outliers = np.r_[0.5 + 1e-3 * rng.random((20_000, 2)), rng.random((20, 2)) * 1000]
     hinted, tree = _sweep_both_ways(outliers)
@@ -217,4 +221,6 @@ def test_hints_outlast_outliers_and_give_way_to_the_tree():
     hinted, tree = _sweep_both_ways(far)
     _assert_same_sweep(hinted, tree)
     walks, descents = hinted["located"]
-    assert descents > 0.9 * len(far)
+    assert hinted["tree_built"]
+    assert walks + descents + hinted["long_walks"] == len(far) - 1
+    assert descents > 0.8 * len(far)

@@ -1,7 +1,16 @@
-# Fortune's beach line (fortune.pyx): the arcs left to right, as an AVL tree (in the Sweep's arrays) and a
-# doubly linked list; positions are given, never searched by key, except where a new site is located
-# (exactly: parabola_order and coordinate comparisons), by a short walk along the list from a hint, else
-# down the tree. Inline helpers, compiled into the fortune module.
+# Fortune's beach line (fortune.pyx): the arcs left to right, as a doubly linked list and, once a site needs
+# it, an AVL tree (in the Sweep's arrays); positions are given, never searched by key, except where a new
+# site is located (exactly: parabola_order and coordinate comparisons), by a walk along the list from a
+# hint, else down the tree. Inline helpers, compiled into the fortune module.
+#
+# A site is located in the arc whose half-open span [left breakpoint, right breakpoint) holds its x: at a
+# breakpoint (a site on it, ties in degenerate input), the arc right of it, whichever way it is found. The
+# spans are in order and cover the line, so that arc is one and the same for every walk and for the tree.
+#
+# The tree: with hints, walks settle nearly every site, and keeping an AVL tree balanced cost a tenth of
+# the sweep. It is built (balanced, from the list, linear in the arcs) the first time a site needs it: when
+# the walks' steps beyond the short ones pass a budget linear in the sites (sites far from every hint, as
+# in clusters far apart), and from then on kept as before. Without hints it is kept from the start.
 
 from libc.stdint cimport int8_t
 
@@ -98,13 +107,15 @@ cdef inline int new_arc(Sweep* s, int site) noexcept nogil:
 
 
 cdef inline void insert_after(Sweep* s, int x, int z) noexcept nogil:
-    """Put arc z right after arc x, in the list and in the tree."""
+    """Put arc z right after arc x, in the list and in the tree (when it is kept)."""
     cdef int y
     s.arc_prev[z] = x
     s.arc_next[z] = s.arc_next[x]
     if s.arc_next[x] != NONE:
         s.arc_prev[s.arc_next[x]] = z
     s.arc_next[x] = z
+    if not s.tree_on:
+        return
     if s.right[x] == NONE:
         s.right[x] = z
         s.parent[z] = x
@@ -118,15 +129,23 @@ cdef inline void insert_after(Sweep* s, int x, int z) noexcept nogil:
 
 
 cdef inline void remove_arc(Sweep* s, int z) noexcept nogil:
-    """Take arc z out of the list and the tree."""
-    cdef int y, zp, zl, zr, yp, yr, child, p
-    cdef int8_t zh
+    """Take arc z out of the list and the tree (when it is kept)."""
     if s.arc_prev[z] != NONE:
         s.arc_next[s.arc_prev[z]] = s.arc_next[z]
     else:
         s.first_arc = s.arc_next[z]
     if s.arc_next[z] != NONE:
         s.arc_prev[s.arc_next[z]] = s.arc_prev[z]
+    if s.tree_on:
+        unlink_from_tree(s, z)
+    s.arc_site[z] = NONE
+    s.free_arcs[s.n_free] = z
+    s.n_free += 1
+
+
+cdef inline void unlink_from_tree(Sweep* s, int z) noexcept nogil:
+    cdef int y, zp, zl, zr, yp, yr, child, p
+    cdef int8_t zh
     if s.left[z] != NONE and s.right[z] != NONE:
         # swap z with its successor y in the tree (y has no left child)
         y = s.right[z]
@@ -158,9 +177,41 @@ cdef inline void remove_arc(Sweep* s, int z) noexcept nogil:
     if child != NONE:
         s.parent[child] = p
     rebalance_up(s, p)
-    s.arc_site[z] = NONE
-    s.free_arcs[s.n_free] = z
-    s.n_free += 1
+
+
+cdef inline int balanced_subtree(Sweep* s, int count, int* cursor) noexcept nogil:
+    """The next count arcs of the list from cursor[0] on, as a subtree whose sides differ by one arc at
+    most (so by one in height: an AVL tree); returns its root and moves the cursor past them."""
+    cdef int v, l, r, hl, hr, n_left = count // 2
+    if count == 0:
+        return NONE
+    l = balanced_subtree(s, n_left, cursor)
+    v = cursor[0]
+    cursor[0] = s.arc_next[v]
+    r = balanced_subtree(s, count - 1 - n_left, cursor)
+    s.left[v] = l
+    s.right[v] = r
+    if l != NONE:
+        s.parent[l] = v
+    if r != NONE:
+        s.parent[r] = v
+    hl = h_of(s, l)
+    hr = h_of(s, r)
+    s.height[v] = <int8_t>(1 + (hl if hl > hr else hr))
+    return v
+
+
+cdef inline void build_tree(Sweep* s) noexcept nogil:
+    """The tree of the arcs in the list, balanced; kept from now on."""
+    cdef int a = s.first_arc, count = 0, cursor
+    while a != NONE:
+        count += 1
+        a = s.arc_next[a]
+    cursor = s.first_arc
+    s.root = balanced_subtree(s, count, &cursor)
+    if s.root != NONE:
+        s.parent[s.root] = NONE
+    s.tree_on = True
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -186,8 +237,10 @@ cdef inline int breakpoint_side(Sweep* s, int a, int b, double px, double py) no
 
 
 cdef enum:
-    WALK_MAX = 8        # arcs a walk from a hint may pass before the tree is searched instead
+    WALK_MAX = 8        # arcs a walk from a hint may pass before it counts as a long one
     HINTS_TRIAL = 2048  # sites searched in the tree before the hints may be given up (most sites were)
+    LONG_WALK_STEPS_PER_SITE = 2    # the budget of long walks' steps (and strips scanned for a hint):
+    LONG_WALK_STEPS_BASE = 4096     # this many a site, and this many more, before the tree is built
 
 
 cdef inline int hint_slot(Sweep* s, double px) noexcept nogil:
@@ -210,64 +263,94 @@ cdef inline void set_hint(Sweep* s, double x, int arc) noexcept nogil:
     s.hint_site[k] = s.arc_site[arc]
 
 
-cdef inline int walk_to_arc(Sweep* s, int h, double px, double py) noexcept nogil:
-    """The arc above p by a walk along the beach line from the live arc h: the arc whose breakpoints
-    have p strictly between them; NONE when p lies on a breakpoint, or further than WALK_MAX arcs.
+cdef inline bint hint_live(Sweep* s, int k) noexcept nogil:
+    # strip k's arc is live (its slot may since have been freed, or reused for another site elsewhere)
+    return s.hint[k] != NONE and s.arc_site[s.hint[k]] == s.hint_site[k]
 
-    Strictly between its breakpoints, the arc is the only one that locate_arc can return (the
-    breakpoints are in order along the line), so either way gives the same arc. At a breakpoint the
-    tree's search decides, as it always has.
-    """
-    cdef int a, c, k, side
-    # (a step left shows that p is left of the new arc's right breakpoint, a step right that it is right
-    # of its left one: neither is tested again)
+
+cdef inline int walk_to_arc(Sweep* s, int h, double px, double py, long max_steps, long* taken) noexcept nogil:
+    """The arc above p by a walk along the beach line from the live arc h: the arc whose span
+    [left breakpoint, right breakpoint) holds p; NONE past max_steps arcs. Adds the arcs passed to
+    taken[0]."""
+    cdef int a, c, side
+    cdef long k = 0
+    # (a step left shows that p is left of the new arc's right breakpoint, a step right that it is not
+    # left of its left one: neither is tested again)
     cdef bint left_known = False, right_known = False
-    for k in range(WALK_MAX):
+    while k < max_steps:
         a = s.arc_prev[h]
         if a != NONE and not left_known:
             side = breakpoint_side(s, s.arc_site[a], s.arc_site[h], px, py)
             if side < 0:
                 h = a
                 right_known = True
+                k += 1
                 continue
-            if side == 0:
-                return NONE
         c = s.arc_next[h]
         if c != NONE and not right_known:
             side = breakpoint_side(s, s.arc_site[h], s.arc_site[c], px, py)
-            if side > 0:
+            if side >= 0:
                 h = c
                 left_known = True
+                k += 1
                 continue
-            if side == 0:
-                return NONE
+        taken[0] += k
         return h
+    taken[0] += k
     return NONE
 
 
+cdef inline int nearest_live_hint(Sweep* s, int k, long* taken) noexcept nogil:
+    """The live hint of the strip nearest to strip k (either side), else the first arc; adds the strips
+    looked at to taken[0]."""
+    cdef int d
+    for d in range(1, s.n_hint):
+        if k + d < s.n_hint and hint_live(s, k + d):
+            taken[0] += d
+            return s.hint[k + d]
+        if k - d >= 0 and hint_live(s, k - d):
+            taken[0] += d
+            return s.hint[k - d]
+    taken[0] += s.n_hint
+    return s.first_arc
+
+
 cdef inline int locate_hinted(Sweep* s, double px, double py) noexcept nogil:
-    """locate_arc, by a walk from the hint of p's strip (else of a strip beside it) when it holds a live
-    arc and the walk settles; else down the tree. Counts each way in n_walks and n_descents, and gives
-    the hints up (n_hint = 0) once the tree has located more sites than the walks, past HINTS_TRIAL."""
+    """locate_arc, by a short walk from the hint of p's strip (else of a strip beside it) when it holds a
+    live arc and the walk settles; else, while the tree is not built, by a longer walk (from the nearest
+    live hint) within the budget left; else down the tree. Counts each way in n_walks, n_long_walks and
+    n_descents, and gives the hints up (n_hint = 0) once the tree has located more sites than the walks,
+    past HINTS_TRIAL."""
     cdef int k, h, v
+    cdef long taken = 0
     if s.n_hint == 0:
         s.n_descents += 1
         return locate_arc(s, px, py)
     k = hint_slot(s, px)
-    h = s.hint[k]
-    if h == NONE or s.arc_site[h] != s.hint_site[k]:
-        # a stale hint: the next strip's, else the one before's
-        if k + 1 < s.n_hint and s.hint[k + 1] != NONE and s.arc_site[s.hint[k + 1]] == s.hint_site[k + 1]:
-            h = s.hint[k + 1]
-        elif k > 0 and s.hint[k - 1] != NONE and s.arc_site[s.hint[k - 1]] == s.hint_site[k - 1]:
-            h = s.hint[k - 1]
-        else:
-            h = NONE
+    if hint_live(s, k):
+        h = s.hint[k]
+    elif k + 1 < s.n_hint and hint_live(s, k + 1):
+        h = s.hint[k + 1]
+    elif k > 0 and hint_live(s, k - 1):
+        h = s.hint[k - 1]
+    else:
+        h = NONE
     if h != NONE:
-        v = walk_to_arc(s, h, px, py)
+        v = walk_to_arc(s, h, px, py, WALK_MAX, &taken)
         if v != NONE:
             s.n_walks += 1
             return v
+    if not s.tree_on:
+        if h == NONE:
+            h = nearest_live_hint(s, k, &taken)
+        else:
+            taken = 0       # (the short walk's steps are not counted against the budget)
+        v = walk_to_arc(s, h, px, py, s.long_budget - taken, &taken)
+        s.long_budget -= taken
+        if v != NONE:
+            s.n_long_walks += 1
+            return v
+        build_tree(s)
     s.n_descents += 1
     if s.n_descents > HINTS_TRIAL and s.n_descents > s.n_walks:
         s.n_hint = 0        # the strips do not fit these sites (clusters far apart): the tree alone from now
@@ -275,7 +358,7 @@ cdef inline int locate_hinted(Sweep* s, double px, double py) noexcept nogil:
 
 
 cdef inline int locate_arc(Sweep* s, double px, double py) noexcept nogil:
-    """The arc above p (at a breakpoint: the arc right of it)."""
+    """The arc above p: the one whose span [left breakpoint, right breakpoint) holds p."""
     cdef int v = s.root, a, c, step
     while True:
         a = s.arc_prev[v]
@@ -283,7 +366,7 @@ cdef inline int locate_arc(Sweep* s, double px, double py) noexcept nogil:
         step = 0
         if a != NONE and breakpoint_side(s, s.arc_site[a], s.arc_site[v], px, py) < 0:
             step = -1
-        elif c != NONE and breakpoint_side(s, s.arc_site[v], s.arc_site[c], px, py) > 0:
+        elif c != NONE and breakpoint_side(s, s.arc_site[v], s.arc_site[c], px, py) >= 0:
             step = 1
         if step == -1 and s.left[v] != NONE:
             v = s.left[v]

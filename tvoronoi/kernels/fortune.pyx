@@ -24,7 +24,9 @@ from tvoronoi.kernels.sweep_state cimport (
     Sweep, NONE, EVENT_SITE, EVENT_CIRCLE, EVENT_REPEAT, FINE_UNKNOWN, FINE_OK, FINE_NONE, FINE_MASK, RISE_KNOWN,
     OK, BROKEN, NO_MEMORY, NO_REPAIR,
 )
-from tvoronoi.kernels.beach_line cimport new_arc, insert_after, remove_arc, locate_hinted, set_hint
+from tvoronoi.kernels.beach_line cimport (
+    new_arc, insert_after, remove_arc, locate_hinted, set_hint, LONG_WALK_STEPS_PER_SITE, LONG_WALK_STEPS_BASE,
+)
 from tvoronoi.kernels.event_queue cimport (
     event_sites, heap_push, heap_fix, heap_remove, cancel_event, take_event, site_first,
 )
@@ -273,7 +275,7 @@ cdef void site_event(Sweep* s, int i) noexcept nogil:
     s.sweep_y = py
     s.last_site = i
     s.last_kind = EVENT_SITE
-    if s.root == NONE:
+    if s.first_arc == NONE:
         b = new_arc(s, i)
         s.root = b
         s.first_arc = b
@@ -481,7 +483,7 @@ cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap
     s.x = x; s.y = y; s.n = n
     s.root = NONE; s.n_arcs = 0; s.first_arc = NONE; s.n_free = 0
     s.n_hint = 0; s.hint = NULL; s.hint_site = NULL; s.hint_x0 = 0.0; s.hint_scale = 0.0
-    s.n_walks = 0; s.n_descents = 0
+    s.n_walks = 0; s.n_descents = 0; s.tree_on = True; s.long_budget = 0; s.n_long_walks = 0
     s.n_classes = 0; s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0
     s.n_recs = 0; s.n_tri = 0
     s.row_mode = False; s.row_last = NONE
@@ -595,6 +597,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         s.hint_site = &hint[n_hint]
         s.hint_x0 = x_lo
         s.hint_scale = n_hint / (x_hi - x_lo) if x_hi > x_lo else 0.0
+        s.tree_on = False
+        s.long_budget = LONG_WALK_STEPS_PER_SITE * <long> n + LONG_WALK_STEPS_BASE
     cdef int next_site = 0, flips = 0
     cdef long steps = 0
     # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
@@ -611,7 +615,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         s.ev_fine = NULL
     out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
            "last": (s.last_kind, s.last_site, s.last_tri),
-           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle), "located": (s.n_walks, s.n_descents)}
+           "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle), "located": (s.n_walks, s.n_descents),
+           "long_walks": s.n_long_walks, "tree_built": s.tree_on}
     if s.status != OK:
         return out
     cdef bint finished = next_site == n and s.n_heap == 0

@@ -52,6 +52,11 @@ cdef struct Sweep:
     double hint_scale
     long n_walks
     long n_descents
+    # the tree is kept only once a site needs it: with hints, the arcs are a list alone (tree_on False)
+    # while walks settle within long_budget steps in all (beach_line.locate_hinted)
+    bint tree_on
+    long long_budget
+    long n_long_walks
     # circle events: position (top of the circle, rounded, and an interval that surely holds it),
     # centre, arc; a binary heap of their ids
     double* ev_y
