@@ -433,46 +433,63 @@ cdef bint is_infinite(Sweep* s, int t) noexcept nogil:
 cdef int repair(Sweep* s, int32_t* stack, int8_t* queued, int max_flips) noexcept nogil:
     """Lawson flips until every edge is locally Delaunay (exact incircle).
 
+    Every edge is tested once, in order; one that is not locally Delaunay is flipped at once, and the
+    edges around each flip are tested again (a stack) before the scan goes on. An edge the scan has
+    passed can only stop being locally Delaunay by a flip next to it, which puts it on the stack, so
+    every edge is locally Delaunay at the end. (On the sweep's own output nothing is flipped, and
+    stack and queued, which must be zero, are never written.)
+
     Returns the flip count, or -1 when more than max_flips were needed (an
     input that was not a triangulation; each flip is exact, so on a valid
     triangulation the flips end).
     """
-    cdef int n_he = 3 * s.n_tri, top = 0, e, o, e1, e2, o1, o2, a, b, c, d, A, B, flips = 0, k
-    cdef int quad[4]
-    for e in range(n_he):
-        if s.opp[e] > e:
-            stack[top] = e
-            top += 1
-            queued[e] = 1
-    while top > 0:
-        top -= 1
-        e = stack[top]
-        queued[e] = 0
-        o = s.opp[e]
-        if is_infinite(s, e // 3) or is_infinite(s, o // 3):
+    cdef int n_he = 3 * s.n_tri, top = 0, e, e0, flips = 0
+    for e0 in range(n_he):
+        if s.opp[e0] < e0 or not flip_if_illegal(s, e0, stack, queued, &top, &flips, max_flips):
             continue
-        e1 = nxt(e); e2 = prv(e); o1 = nxt(o); o2 = prv(o)
-        a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
-        if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
-            continue
-        if flips >= max_flips:
+        if flips > max_flips:
             return -1
-        # flip a-b to c-d: (a, b, c) + (b, a, d) become (d, b, c) + (c, a, d)
-        A = s.opp[e2]
-        B = s.opp[o2]
-        s.tv[e] = d
-        s.tv[o] = c
-        s.opp[e] = B; s.opp[B] = e
-        s.opp[o] = A; s.opp[A] = o
-        s.opp[e2] = o2; s.opp[o2] = e2
-        flips += 1
-        quad[0] = e; quad[1] = e1; quad[2] = o; quad[3] = o1
-        for k in range(4):
-            if not queued[quad[k]] and not queued[s.opp[quad[k]]]:
-                stack[top] = quad[k]
-                top += 1
-                queued[quad[k]] = 1
+        while top > 0:
+            top -= 1
+            e = stack[top]
+            queued[e] = 0
+            flip_if_illegal(s, e, stack, queued, &top, &flips, max_flips)
+            if flips > max_flips:
+                return -1
     return flips
+
+
+cdef inline bint flip_if_illegal(Sweep* s, int e, int32_t* stack, int8_t* queued, int* top, int* flips,
+                                 int max_flips) noexcept nogil:
+    """Flip the edge of half-edge e if it is not locally Delaunay (both triangles finite, and the far
+    site strictly inside the circle of e's triangle), pushing the four edges around it that are not on
+    the stack already; True if it did. Past max_flips, counts the flip without making it."""
+    cdef int o = s.opp[e], e1, e2, o1, o2, a, b, c, d, A, B, k
+    cdef int quad[4]
+    if is_infinite(s, e // 3) or is_infinite(s, o // 3):
+        return False
+    e1 = nxt(e); e2 = prv(e); o1 = nxt(o); o2 = prv(o)
+    a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
+    if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
+        return False
+    flips[0] += 1
+    if flips[0] > max_flips:
+        return True
+    # flip a-b to c-d: (a, b, c) + (b, a, d) become (d, b, c) + (c, a, d)
+    A = s.opp[e2]
+    B = s.opp[o2]
+    s.tv[e] = d
+    s.tv[o] = c
+    s.opp[e] = B; s.opp[B] = e
+    s.opp[o] = A; s.opp[A] = o
+    s.opp[e2] = o2; s.opp[o2] = e2
+    quad[0] = e; quad[1] = e1; quad[2] = o; quad[3] = o1
+    for k in range(4):
+        if not queued[quad[k]] and not queued[s.opp[quad[k]]]:
+            stack[top[0]] = quad[k]
+            top[0] += 1
+            queued[quad[k]] = 1
+    return True
 
 
 cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap_arcs, int cap_ev, int cap_rec,
