@@ -14,7 +14,7 @@ from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 
-from tvoronoi.kernels.predicates cimport orient2d, incircle
+from tvoronoi.kernels.predicates cimport orient2d, incircle, incircle_filter
 from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.circle_events cimport (
     circle_top, circle_top_fast, relative_sign, circle_top_fine, fine_order, fine_site,
@@ -464,13 +464,16 @@ cdef inline bint flip_if_illegal(Sweep* s, int e, int32_t* stack, int8_t* queued
     """Flip the edge of half-edge e if it is not locally Delaunay (both triangles finite, and the far
     site strictly inside the circle of e's triangle), pushing the four edges around it that are not on
     the stack already; True if it did. Past max_flips, counts the flip without making it."""
-    cdef int o = s.opp[e], e1, e2, o1, o2, a, b, c, d, A, B, k
+    cdef int o = s.opp[e], e1, e2, o1, o2, a, b, c, d, A, B, k, sign
     cdef int quad[4]
     if is_infinite(s, e // 3) or is_infinite(s, o // 3):
         return False
     e1 = nxt(e); e2 = prv(e); o1 = nxt(o); o2 = prv(o)
     a = s.tv[e]; b = s.tv[e1]; c = s.tv[e2]; d = s.tv[o2]
-    if incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d]) <= 0:
+    sign = incircle_filter(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d])
+    if sign == 2:
+        sign = incircle(s.x[a], s.y[a], s.x[b], s.y[b], s.x[c], s.y[c], s.x[d], s.y[d])
+    if sign <= 0:
         return False
     flips[0] += 1
     if flips[0] > max_flips:

@@ -534,8 +534,10 @@ cdef inline int incircle_exact(double ax, double ay, double bx, double by, doubl
     return incircle_exact_short(adx, ady, bdx, bdy, cdx, cdy)
 
 
-cdef inline int incircle(double ax, double ay, double bx, double by, double cx, double cy,
-                         double dx, double dy) noexcept nogil:
+cdef inline int incircle_filter(double ax, double ay, double bx, double by, double cx, double cy,
+                                double dx, double dy) noexcept nogil:
+    """incircle's first tier alone: its sign when the rounded determinant settles it, else 2. Small
+    enough to be compiled into a hot loop that calls incircle only when this gives 2."""
     cdef double adx = ax - dx
     cdef double ady = ay - dy
     cdef double bdx = bx - dx
@@ -558,7 +560,15 @@ cdef inline int incircle(double ax, double ay, double bx, double by, double cx, 
                              + (fabs(cdxady) + fabs(adxcdy)) * b_lift
                              + (fabs(adxbdy) + fabs(bdxady)) * c_lift)
     cdef double err_bound = ICC_ERRBOUND_A * permanent
-    # filter: trust the rounded determinant when it exceeds its worst-case rounding error
+    # trust the rounded determinant when it exceeds its worst-case rounding error
     if fabs(det) > err_bound:
         return (det > 0.0) - (det < 0.0)
-    return incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, adx, ady, bdx, bdy, cdx, cdy)
+    return 2
+
+
+cdef inline int incircle(double ax, double ay, double bx, double by, double cx, double cy,
+                         double dx, double dy) noexcept nogil:
+    cdef int sign = incircle_filter(ax, ay, bx, by, cx, cy, dx, dy)
+    if sign != 2:
+        return sign
+    return incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, ax - dx, ay - dy, bx - dx, by - dy, cx - dx, cy - dy)
