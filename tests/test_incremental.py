@@ -146,3 +146,34 @@ def test_vertex_on_the_box_edge_leaves_no_spike(engine):
     d = tvoronoi.voronoi(pts, engine=engine)
     validate(d)
     assert_matches_oracle(d)
+
+
+@pytest.mark.parametrize("name", ["uniform", "grid", "circle", "duplicates", "collinear_repeats"])
+def test_an_insertion_order_gives_the_triangulation_of_the_sites_in_that_order(name):
+    """triangulate(xs, ys, order=o) is triangulate(xs[o], ys[o]) with the sites named as given: the same
+    triangles and repeats, site for site (the halves' build numbers sites along a curve and inserts them
+    in its BRIO order)."""
+    from tvoronoi.kernels import incremental
+
+    pts = DATASETS[name]
+    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+    o = np.random.default_rng(3).permutation(len(xs)).astype(np.int32)
+    s1, tv1, opp1, dup1 = incremental.triangulate(xs, ys, order=o)
+    s2, tv2, opp2, dup2 = incremental.triangulate(xs[o], ys[o])
+    assert s1 == s2
+    n = len(xs)
+    name_of = np.append(o, n)  # site k of the second run is site o[k]; n stays the vertex at infinity
+    assert np.array_equal(tv1, name_of[tv2]) and np.array_equal(opp1, opp2)
+    assert np.array_equal(dup1[o], np.where(dup2 >= 0, name_of[np.maximum(dup2, 0)], -1))
+
+
+@pytest.mark.parametrize(
+    "order, message",
+    [([0, 1, 1], "1 at place 2"), ([0, 1, 3], "3 at place 2"), ([0, -1, 2], "-1 at place 1"), ([0, 1], "of 2 sites")],
+)
+def test_a_wrong_insertion_order_is_refused_by_name(order, message):
+    from tvoronoi.kernels import incremental
+
+    xs = np.array([0.0, 1.0, 0.0])
+    with pytest.raises(ValueError, match=message):
+        incremental.triangulate(xs, xs[::-1].copy(), order=np.array(order, np.int32))

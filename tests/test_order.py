@@ -158,3 +158,26 @@ def test_two_lines_are_followed_along(rng):
     last = perm[n // 2 + n // 8 :]
     rank = np.argsort(np.argsort(xs[last]))
     assert np.abs(np.diff(rank)).mean() < 4
+
+
+@pytest.mark.parametrize("name", sorted(DATASETS))
+@pytest.mark.parametrize("seed", [0, 7])
+def test_the_order_along_the_curve_is_the_same_order(name, seed):
+    """along_curve: the curve is a permutation, and the insertion order given in places along it names
+    the same sites in the same order as the plain permutation."""
+    pts = DATASETS[name]
+    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+    perm = brio_order(xs, ys, seed)
+    order, curve = brio_order(xs, ys, seed, True)
+    assert order.dtype == curve.dtype == np.int32
+    assert np.array_equal(np.sort(curve), np.arange(len(xs)))
+    assert np.array_equal(curve[order], perm)
+
+
+def test_the_curve_keeps_neighbours_near(rng):
+    """Consecutive sites along the curve are near: over 20,000 uniform sites, about one site spacing
+    apart on average (a random order: a third of the square)."""
+    xs, ys = rng.random(20_000), rng.random(20_000)
+    _, curve = brio_order(xs, ys, 0, True)
+    step = np.hypot(np.diff(xs[curve]), np.diff(ys[curve])).mean()
+    assert step < 3 / np.sqrt(20_000), step

@@ -319,3 +319,36 @@ def test_sites_into_refuses_an_index_out_of_range():
         renumber.sites_into(xs, xs, ok[:3], ok, ok, *out)  # perm names row 3 of 3
     with pytest.raises(ValueError):
         renumber.sites_into(xs, xs, ok, ok, ok, np.empty(3), out[1], out[2])
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 200), seed=st.integers(0, 2**16))
+def test_sites_into_without_perm_takes_rows_in_the_new_order(n, seed):
+    """perm None: out_rows[k] = rows[new_to_old[k]] (a half's sites gathered along their curve)."""
+    rng = np.random.default_rng(seed)
+    xs, ys = rng.random(n), rng.random(n)
+    rows = rng.permutation(10 * n)[:n].astype(np.int32)
+    new_to_old = rng.permutation(n).astype(np.int32)
+    ox, oy, orows = np.empty(n), np.empty(n), np.empty(n, np.int32)
+    renumber.sites_into(xs, ys, rows, None, new_to_old, ox, oy, orows)
+    assert np.array_equal(ox, xs[new_to_old]) and np.array_equal(oy, ys[new_to_old])
+    assert np.array_equal(orows, rows[new_to_old])
+
+
+@pytest.mark.parametrize("name", ["uniform", "grid", "circle", "duplicates", "clustered"])
+def test_triangle_order_without_renumbering_is_the_identity_renumbering(name):
+    """triangle_order_into with old_to_new None (sites numbered along a curve already) sorts the
+    triangles exactly as with the identity renumbering, and writes the sites as they are."""
+    t = triangulation(DATASETS[name], "incremental")
+    assert not t.flat
+    n = len(t.sites)
+    a, b = np.empty_like(t.tv), np.empty_like(t.opp)
+    c, d = np.empty_like(t.tv), np.empty_like(t.opp)
+    renumber.triangle_order_into(t.tv, t.opp, np.arange(n, dtype=np.int32), a, b, 0, 0, n)
+    renumber.triangle_order_into(t.tv, t.opp, None, c, d, 0, 0, n, n_sites=n)
+    assert np.array_equal(a, c) and np.array_equal(b, d)
+    assert sorted(map(tuple, np.sort(c.reshape(-1, 3), axis=1))) == sorted(
+        map(tuple, np.sort(t.tv.reshape(-1, 3), axis=1))
+    )
+    with pytest.raises(ValueError):
+        renumber.triangle_order_into(t.tv, t.opp, None, c, d, 0, 0, n)

@@ -18,7 +18,7 @@ from functools import partial
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.kernels import STOPPING, renumber, seam
+from tvoronoi.kernels import STOPPING, incremental, order, renumber, seam
 
 # fewer sites: one triangulation (two halves and a seam cost more than they save on two threads)
 SPLIT_MIN_SITES = 1 << 16
@@ -117,30 +117,38 @@ def half(
     2^-exponent), as sites first.. of ``out``, their triangles at its start (first == 0, the left half)
     or at its end; mark the triangles it keeps (c and other_box, the other half's bounding box: scaled).
     Returns the slots its triangles take (lo, hi), or None when its sites are collinear."""
-    s = engines.prepare(*renumber.take_sites(xs, ys, rows, exponent), engine=engine, seed=seed, exponent=0)
-    t = engines.triangulate(s, engine=engine)
-    if t.tv is None or t.opp is None:
-        return None
-    n, k, n_tri = len(xs), len(rows), len(t.tv) // 3
+    hx, hy = renumber.take_sites(xs, ys, rows, exponent)
+    n, k = len(xs), len(rows)
+    mine = slice(first, first + k)
+    if engine == "fortune":
+        s = engines.prepare(hx, hy, engine=engine, seed=seed, exponent=0)
+        t = engines.triangulate(s, engine=engine)
+        if t.tv is None or t.opp is None:
+            return None
+        tv_h, opp_h, dup_h = t.tv, t.opp, t.dup
+        out.xs[mine], out.ys[mine], out.perm[mine] = s.xs, s.ys, rows[s.perm]
+        del s, t
+    else:
+        # the sites numbered along the curve that orders their insertion (BRIO), inserted in that order:
+        # the numbering the dual and the clipper walk best, with no renumbering after the triangulation
+        insertion, curve = order.brio_order(hx, hy, seed, True)
+        renumber.sites_into(hx, hy, rows, None, curve, out.xs[mine], out.ys[mine], out.perm[mine])
+        del hx, hy, curve
+        status, tv_h, opp_h, dup_h = incremental.triangulate(out.xs[mine], out.ys[mine], order=insertion)
+        if status != incremental.STATUS_OK:
+            return None
+    n_tri = len(tv_h) // 3
     lo = 0 if first == 0 else len(out.keep) - n_tri
     tv, opp = out.tv[3 * lo : 3 * (lo + n_tri)], out.opp[3 * lo : 3 * (lo + n_tri)]
-    mine = slice(first, first + k)
     if engine == "fortune":
         # the sweep's order and its triangles as they are: stored next to their sites already (a Z-curve
         # renumbering cost Fortune's builds more than it saved, see engines.spatial)
-        renumber.shifted_into(t.tv, t.opp, k, tv, opp, first, lo, n)
-        out.xs[mine], out.ys[mine], out.perm[mine] = s.xs, s.ys, rows[s.perm]
-        out.dup[mine] = np.where(t.dup >= 0, t.dup + first, -1)
+        renumber.shifted_into(tv_h, opp_h, k, tv, opp, first, lo, n)
     else:
-        new_to_old, old_to_new = renumber.site_order(s.xs, s.ys)
-        renumber.triangle_order_into(t.tv, t.opp, old_to_new, tv, opp, first, lo, n, threads)
-        renumber.sites_into(s.xs, s.ys, rows, s.perm, new_to_old, out.xs[mine], out.ys[mine], out.perm[mine])
-        if (t.dup >= 0).any():  # repeated sites: each names a copy that holds the place, in the new numbers
-            dup = t.dup[new_to_old]
-            out.dup[mine] = np.where(dup >= 0, old_to_new[np.maximum(dup, 0)] + first, -1)
-        else:
-            out.dup[mine] = -1
-    del t
+        # the triangles sorted by their first site, so that each site's lie together
+        renumber.triangle_order_into(tv_h, opp_h, None, tv, opp, first, lo, n, threads, n_sites=k)
+    out.dup[mine] = np.where(dup_h >= 0, dup_h + first, -1)
+    del tv_h, opp_h, dup_h
     keep = out.keep[lo : lo + n_tri]
     seam.kept_triangles(out.xs, out.ys, tv, opp, lo, n, c.split, c.axis, first == 0, *other_box, keep, out.seam)
     return lo, lo + n_tri

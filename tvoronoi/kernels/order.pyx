@@ -233,7 +233,7 @@ def hilbert_indices(const uint32_t[::1] x, const uint32_t[::1] y, int bits):
     return out_arr
 
 
-def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
+def brio_order(const double[::1] xs, const double[::1] ys, seed=0, bint along_curve=False):
     """A biased randomized insertion order (Amenta, Choi and Rote), as a permutation.
 
     Each site joins a random round: the last with probability 1/2, the one
@@ -252,11 +252,20 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
     seed : int
         Seed of the rounds (taken modulo 2**64); the same seed gives the same
         order.
+    along_curve : bool
+        Also return the curve's order of all the sites, and give the insertion
+        order in places along it: for sites numbered along the curve (where
+        neighbours in the plane are neighbours in memory, as the Voronoi phases
+        want them) and inserted in this order (incremental.triangulate's
+        ``order``), with no renumbering after the triangulation.
 
     Returns
     -------
     perm : (n,) int32
         Insert input site perm[k] k-th.
+    (with along_curve) (order, curve) : (n,) int32 each
+        curve[j] is the j-th input site along the curve; insert site curve[order[k]]
+        k-th (the same sites in the same order as perm: perm == curve[order]).
 
     Raises
     ------
@@ -276,9 +285,11 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
         raise ValueError(f"{n} sites: an int32 permutation holds fewer than 2**31")
     perm_arr = np.empty(n, np.int32)
     cdef int32_t[::1] perm = perm_arr
+    curve_arr = np.empty(n if along_curve else 0, np.int32)
+    cdef int32_t[::1] curve = curve_arr
     cdef int8_t[::1] round_of = np.empty(n, np.int8)
     if n == 0:
-        return perm_arr
+        return (perm_arr, curve_arr) if along_curve else perm_arr
     cdef Keyed* a = <Keyed*>malloc(n * sizeof(Keyed))
     cdef Keyed* b = <Keyed*>malloc(n * sizeof(Keyed))
     if a == NULL or b == NULL:
@@ -316,7 +327,11 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
             poll_signals()
             for k in range(n):
                 r = round_of[a[k].i]
-                perm[count[r]] = a[k].i
+                if along_curve:
+                    perm[count[r]] = <int32_t> k
+                    curve[k] = a[k].i
+                else:
+                    perm[count[r]] = a[k].i
                 count[r] += 1
             # the first round (64 to 127 sites expected, or all of them when there are fewer than 128) in
             # random order, the textbook randomized incremental order: too few sites for their order to
@@ -329,4 +344,4 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0):
     finally:
         free(a)
         free(b)
-    return perm_arr
+    return (perm_arr, curve_arr) if along_curve else perm_arr

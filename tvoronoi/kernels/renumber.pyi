@@ -13,13 +13,14 @@ def triangle_order(
 def triangle_order_into(
     tv: np.ndarray,
     opp: np.ndarray,
-    old_to_new: np.ndarray,
+    old_to_new: np.ndarray | None,
     tv2: np.ndarray,
     opp2: np.ndarray,
     site_base: int,
     tri_base: int,
     inf_out: int,
     threads: int = 1,
+    n_sites: int = -1,
 ) -> None: ...
 def shifted_into(
     tv: np.ndarray,
@@ -39,7 +40,7 @@ def sites_into(
     xs: np.ndarray,
     ys: np.ndarray,
     rows: np.ndarray,
-    perm: np.ndarray,
+    perm: np.ndarray | None,
     new_to_old: np.ndarray,
     out_x: np.ndarray,
     out_y: np.ndarray,

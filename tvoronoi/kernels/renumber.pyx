@@ -49,13 +49,17 @@ cdef inline int cell_index(double v, double lo, double scale, int top) noexcept 
 
 
 cdef inline int32_t first_site(const int32_t* corners, const int32_t* old_to_new, int inf) noexcept nogil:
-    # the smallest new number among a triangle's finite corners (every triangle has one)
+    # the smallest new number among a triangle's finite corners (every triangle has one; old_to_new
+    # NULL: the numbers stay)
     cdef int32_t low = inf, a
     cdef int k
     for k in range(3):
         a = corners[k]
-        if a != inf and old_to_new[a] < low:
-            low = old_to_new[a]
+        if a != inf:
+            if old_to_new != NULL:
+                a = old_to_new[a]
+            if a < low:
+                low = a
     return low
 
 
@@ -172,15 +176,20 @@ def triangle_order(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[
 
 def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int32_t[::1] old_to_new,
                         int32_t[::1] tv2, int32_t[::1] opp2, int site_base, int tri_base, int inf_out,
-                        int threads=1):
+                        int threads=1, int n_sites=-1):
     """triangle_order, written into tv2, opp2 (each as long as tv) as part of a larger triangulation
     (tvoronoi.halves): sites numbered from site_base on and the vertex at infinity inf_out, triangles from
     tri_base on (the twins count from there: tv2 and opp2 are the slice of the larger arrays that starts
-    at half-edge 3 tri_base)."""
-    cdef Py_ssize_t n = old_to_new.shape[0], n_he = tv.shape[0], n_tri = n_he // 3, k, t
+    at half-edge 3 tri_base). old_to_new None: the sites are numbered in a spatial order already (n_sites
+    of them) and keep their numbers; only the triangles are sorted."""
+    cdef Py_ssize_t n = old_to_new.shape[0] if old_to_new is not None else n_sites
+    cdef Py_ssize_t n_he = tv.shape[0], n_tri = n_he // 3, k, t
     cdef int inf = <int> n, a, T, o
+    if n < 0:
+        raise ValueError("triangle_order_into: no old_to_new and no n_sites")
     if tv2.shape[0] != n_he or opp2.shape[0] != n_he or opp.shape[0] != n_he:
         raise ValueError("triangle_order_into: tv, opp, tv2 and opp2 differ in length")
+    cdef const int32_t* renumbered = &old_to_new[0] if old_to_new is not None and n > 0 else NULL
     cdef int32_t[::1] keys = np.empty(max(n_tri, 1), np.int32)      # each triangle's smallest new site
     cdef int32_t[::1] start = np.zeros(n + 1, np.int32)
     cdef int32_t[::1] tri_new = np.empty(max(n_tri, 1), np.int32)
@@ -190,7 +199,7 @@ def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int
     with nogil:
         # a counting sort by the smallest new site (every triangle has a finite one)
         for t in prange(n_tri, num_threads=T_threads, schedule="static"):
-            keys[t] = first_site(&tv[3 * t], &old_to_new[0], inf)
+            keys[t] = first_site(&tv[3 * t], renumbered, inf)
         for t in range(n_tri):
             start[keys[t] + 1] += 1
         for k in range(n):
@@ -204,7 +213,11 @@ def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int
             T = tri_new[t]
             for k in range(3):
                 a = tv[3 * t + k]
-                tv2[3 * T + k] = site_base + old_to_new[a] if a != inf else inf_out
+                if a == inf:
+                    a = inf_out
+                else:
+                    a = site_base + (renumbered[a] if renumbered != NULL else a)
+                tv2[3 * T + k] = a
                 o = opp[3 * t + k]
                 opp2[3 * T + k] = 3 * (tri_base + tri_new[o // 3]) + o % 3
 
@@ -349,12 +362,14 @@ def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
 def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] rows, const int32_t[::1] perm,
                const int32_t[::1] new_to_old, double[::1] out_x, double[::1] out_y, int32_t[::1] out_rows):
     """A half's sites in their new order, written into its part of the joined arrays (tvoronoi.halves):
-    out_x[k] = xs[j], out_y[k] = ys[j] and out_rows[k] = rows[perm[j]], j = new_to_old[k]. Raises
-    IndexError if an index is out of range."""
+    out_x[k] = xs[j], out_y[k] = ys[j] and out_rows[k] = rows[perm[j]], j = new_to_old[k] (perm None:
+    rows[j]). Raises IndexError if an index is out of range."""
     cdef Py_ssize_t n = xs.shape[0], m = new_to_old.shape[0], n_rows = rows.shape[0], k
     cdef int32_t j, r
     cdef bint bad = False
-    if ys.shape[0] != n or perm.shape[0] != n or out_x.shape[0] != m or out_y.shape[0] != m or out_rows.shape[0] != m:
+    cdef const int32_t* through = &perm[0] if perm is not None and n > 0 else NULL
+    if (ys.shape[0] != n or (perm is not None and perm.shape[0] != n) or out_x.shape[0] != m
+            or out_y.shape[0] != m or out_rows.shape[0] != m):
         raise ValueError("sites_into: the arrays differ in length")
     with nogil:
         for k in range(m):
@@ -362,7 +377,7 @@ def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] ro
             if j < 0 or j >= n:
                 bad = True
                 break
-            r = perm[j]
+            r = through[j] if through != NULL else j
             if r < 0 or r >= n_rows:
                 bad = True
                 break
