@@ -7,13 +7,15 @@ cells are timed one after the other, in interleaved repeats (the median is repor
   tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep), then for the
             incremental engine its sites and triangles renumbered along a Z-curve. From
             halves.SPLIT_MIN_SITES sites on, both engines go by halves (tvoronoi.halves): each half
-            ordered, triangulated and renumbered on its own thread, then joined; the order is then
-            part of tri, and the order column reads "-"
+            ordered, triangulated and laid out on its own thread (the incremental engine's sites numbered
+            along their BRIO curve), then joined; the order is then part of tri, and the order column
+            reads "-"
   dual      the Voronoi half-edge structure and its correctly rounded vertices
   cells     clipping every cell to the box and gathering the cells into input order
 
 and, on the same points, whole calls of other tools: Shewchuk's Triangle (`triangle.voronoi`: vertices
-and edges, no cells), Qhull (`scipy.spatial.Delaunay`, the triangulation alone), CGAL's
+and edges, no cells; the issue's yardstick, so it is timed in the same interleaved repeats, warm, and
+each tvoronoi build's median is also given as a multiple of its median), Qhull (`scipy.spatial.Delaunay`, the triangulation alone), CGAL's
 `Delaunay_triangulation_2` through its Python bindings (the `cgal` package, if installed: the points
 made as CGAL objects, then inserted; both timed) and, up to --geos-max sites, GEOS
 (`shapely.voronoi_polygons`, cells). The peak memory of a whole `tvoronoi.voronoi()` build is measured
@@ -88,17 +90,21 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
     return {"order": order, "tri": t2 - t1, "dual": t3 - t2, "cells": t4 - t3, "system": k1 - k0}
 
 
-def others(pts: np.ndarray, geos_max: int) -> dict:
-    """Whole calls of the other tools on the same points (seconds), where they are installed."""
-    out = {}
+def time_triangle(pts: np.ndarray) -> float | None:
+    """One warm call of Triangle's `triangle.voronoi` on the points (seconds), None if not installed."""
     try:
         import triangle
-
-        t0 = time.perf_counter()
-        triangle.voronoi(pts)
-        out["Triangle voronoi"] = time.perf_counter() - t0
     except ImportError:
-        pass
+        return None
+    t0 = time.perf_counter()
+    triangle.voronoi(pts)
+    return time.perf_counter() - t0
+
+
+def others(pts: np.ndarray, geos_max: int) -> dict:
+    """Whole calls of the other tools on the same points (seconds), where they are installed (Triangle is
+    timed with the repeats, time_triangle)."""
+    out = {}
     from scipy.spatial import Delaunay
 
     t0 = time.perf_counter()
@@ -185,13 +191,20 @@ def main(argv=None) -> None:
             pts = points(dist, n)
             n_pts = len(pts)
             runs = {}
+            triangle_runs: list[float] = []
             for engine in ("incremental", "fortune"):  # warm-up, not timed: the process's memory, the caches
                 time_phases(pts, engine, 1)
+            time_triangle(pts)
             for _ in range(args.repeats):  # interleaved: every configuration once per round
                 for engine in ("incremental", "fortune"):
                     for threads in thread_counts:
                         gc.collect()
                         runs.setdefault((engine, threads), []).append(time_phases(pts, engine, threads))
+                gc.collect()
+                seconds = time_triangle(pts)
+                if seconds is not None:
+                    triangle_runs.append(seconds)
+            triangle_median = statistics.median(triangle_runs) if triangle_runs else None
             for (engine, threads), reps in runs.items():
                 med = {p: None if reps[0][p] is None else statistics.median(r[p] for r in reps) for p in PHASES}
                 med["total"] = statistics.median(sum(r[p] or 0.0 for p in PHASES) for r in reps)
@@ -203,6 +216,7 @@ def main(argv=None) -> None:
                         "tool": f"tvoronoi {engine}",
                         "threads": threads,
                         **{p: med[p] for p in (*PHASES, "total", "system")},
+                        "x_triangle": None if triangle_median is None else med["total"] / triangle_median,
                     }
                 )
                 rows[-1]["peak_mib"], rows[-1]["first_build"] = fresh_build(dist, n, engine, threads)
@@ -211,6 +225,11 @@ def main(argv=None) -> None:
                     + " ".join(f"{p}={(med[p] or 0.0) * 1e3:.0f}ms" for p in (*PHASES, "total", "system")),
                     flush=True,
                 )
+            if triangle_median is not None:
+                rows.append(
+                    {"n": n_pts, "dist": dist, "tool": "Triangle voronoi", "threads": 1, "total": triangle_median}
+                )
+                print(f"{dist:>13} n={n_pts:>9,} Triangle voronoi: {triangle_median * 1e3:.0f}ms", flush=True)
             for tool, seconds in others(pts, args.geos_max).items():
                 rows.append({"n": n_pts, "dist": dist, "tool": tool, "threads": 1, "total": seconds})
                 print(f"{dist:>13} n={n_pts:>9,} {tool}: {seconds * 1e3:.0f}ms", flush=True)
@@ -232,7 +251,8 @@ def report(rows: list[dict], info: dict) -> str:
         "triangulation, CGAL's `Delaunay_triangulation_2` (making its points, then inserting them), "
         "GEOS's `voronoi_polygons` (cells). Peak: MiB a whole build adds to a fresh process; first build: "
         "that build's time (the process's first, where its memory is fresh; the phases are warm builds, "
-        "as are the other tools' calls). System: the "
+        "as are the other tools' calls). x Triangle: the build's total over the median of Triangle's calls, "
+        "timed warm in the same interleaved repeats (the others are timed once, after them). System: the "
         "kernel's time within a build (all threads, ms), mostly first touches of fresh memory: on a "
         "virtual machine whose host takes back freed memory it varies from run to run, and explains "
         "most of the swings of the phases.",
@@ -244,8 +264,9 @@ def report(rows: list[dict], info: dict) -> str:
             lines += [
                 f"## {dist}, n = {n:,}",
                 "",
-                "| build | threads | order | tri | dual | cells | total | system ms | peak MiB | first build |",
-                "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+                "| build | threads | order | tri | dual | cells | total | x Triangle | system ms | peak MiB "
+                "| first build |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             for r in sub:
                 if "order" in r:
@@ -253,6 +274,8 @@ def report(rows: list[dict], info: dict) -> str:
                         f"| {r['tool']} | {r['threads']} | "
                         + " | ".join(fmt_ns(r[p], n) for p in PHASES)
                         + f" | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | "
+                        + (f"{r['x_triangle']:.2f}x" if r.get("x_triangle") is not None else "")
+                        + " | "
                         + (f"{r['system'] * 1e3:.0f}" if "system" in r else "")
                         + f" | {r['peak_mib']:.0f} | "
                         + (f"{r['first_build'] * 1e3:.0f} ms" if "first_build" in r else "")
@@ -261,7 +284,7 @@ def report(rows: list[dict], info: dict) -> str:
             for r in sub:
                 if "order" not in r:
                     lines.append(
-                        f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | | | |"
+                        f"| {r['tool']} | 1 | | | | | {fmt_ns(r['total'], n)} ({r['total'] * 1e3:.0f} ms) | | | | |"
                     )
             lines.append("")
     return "\n".join(lines)
