@@ -3,7 +3,7 @@
 import numpy as np
 
 from libc.math cimport INFINITY, floor, log2
-from libc.stdint cimport int8_t, int32_t, uint32_t, uint64_t
+from libc.stdint cimport int8_t, int32_t, uint8_t, uint32_t, uint64_t
 from libc.stdlib cimport malloc, free
 from libc.string cimport memcpy
 
@@ -67,15 +67,40 @@ NEXT[2][:] = [2, 2, 0, 3]
 DIGIT[3][:] = [2, 3, 1, 0]
 NEXT[3][:] = [3, 1, 3, 2]
 
+# two levels a step: for state q and the two bits of x and of y at those levels (xb << 2 | yb), the two
+# digits (low four bits) and the state after them (bits 4, 5), in one byte, so that a step is one load
+cdef uint8_t TWO_LEVELS[4][16]
+
+
+cdef void fill_two_levels() noexcept:
+    cdef int q, xb, yb, hi, lo, q1
+    for q in range(4):
+        for xb in range(4):
+            for yb in range(4):
+                hi = ((xb >> 1) << 1) | (yb >> 1)
+                q1 = NEXT[q][hi]
+                lo = ((xb & 1) << 1) | (yb & 1)
+                TWO_LEVELS[q][(xb << 2) | yb] = <uint8_t> (((DIGIT[q][hi] << 2) | DIGIT[q1][lo])
+                                                          | (NEXT[q1][lo] << 4))
+
+
+fill_two_levels()
+
 
 cdef inline uint32_t hilbert_index(uint32_t x, uint32_t y, int bits) noexcept nogil:
     """The place of cell (x, y) of a 2^bits square along the Hilbert curve from (0, 0) to (max, 0)."""
-    cdef uint32_t d = 0, quadrant
-    cdef int level, q = 0
-    for level in range(bits - 1, -1, -1):
+    cdef uint32_t d = 0, quadrant, step
+    cdef int level = bits, q = 0
+    if level & 1:
+        level -= 1
         quadrant = (((x >> level) & 1) << 1) | ((y >> level) & 1)
-        d = (d << 2) | DIGIT[q][quadrant]
-        q = NEXT[q][quadrant]
+        d = DIGIT[0][quadrant]
+        q = NEXT[0][quadrant]
+    while level > 0:
+        level -= 2
+        step = TWO_LEVELS[q][(((x >> level) & 3) << 2) | ((y >> level) & 3)]
+        d = (d << 4) | (step & 15)
+        q = step >> 4
     return d
 
 
