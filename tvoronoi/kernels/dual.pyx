@@ -447,45 +447,54 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
     group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
     each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts."""
-    cdef int g, k, u, w, a
+    cdef int g, k, u, w, r, a, last_face = -1, h_kept
+    # the merges (each zero-length edge from its half-edge of smaller index: its twin joins the same two
+    # vertices), and each kept half-edge's new number (how many before it are kept)
+    k = 0
     for g in range(h):
+        newh[g] = k
         if zero[g]:
+            if he_twin[g] < g:
+                continue
             u = find(parent, he_origin[g])
             w = find(parent, he_origin[next_in_cell(g, h, he_face, face_edge)])
             if u < w:
                 parent[w] = u
             elif w < u:
                 parent[u] = w
+        else:
+            k += 1
+    h_kept = k
+    # the vertices renumbered in order: a root takes the next number, any other vertex its root's (a
+    # merge keeps the smaller root, so that root is numbered already)
     k = 0
     for g in range(m):
-        if find(parent, g) == g:
+        r = find(parent, g)
+        if r == g:
             vmap[g] = k
             centre[2 * k] = centre[2 * g]
             centre[2 * k + 1] = centre[2 * g + 1]
             k += 1
-    for g in range(m):
-        if parent[g] != g:
-            vmap[g] = vmap[parent[g]]     # parent[g] is its root after find, and smaller than g
+        else:
+            vmap[g] = vmap[r]
     m = k
-    k = 0
-    for g in range(h):
-        newh[g] = k
-        if not zero[g]:
-            k += 1
-    for g in range(h):
-        if zero[g]:
-            continue
-        he_origin[newh[g]] = vmap[he_origin[g]] if he_origin[g] >= 0 else -1
-        he_twin[newh[g]] = newh[he_twin[g]]
-        he_face[newh[g]] = he_face[g]
-    h = k
-    # the cells again: each is one run of equal faces
+    # the kept half-edges moved down in place (to no later place than their own), and each cell's first
+    # where its face begins: the cells stay contiguous and in order (every cell keeps some edges: those
+    # from and to infinity, or three at least)
     for g in range(n):
         face_edge[g] = -1
     for g in range(h):
-        if g == 0 or he_face[g] != he_face[g - 1]:
-            face_edge[he_face[g]] = g
-    return m, h
+        if zero[g]:
+            continue
+        k = newh[g]
+        he_origin[k] = vmap[he_origin[g]] if he_origin[g] >= 0 else -1
+        he_twin[k] = newh[he_twin[g]]
+        a = he_face[g]
+        he_face[k] = a
+        if a != last_face:
+            face_edge[a] = k
+            last_face = a
+    return m, h_kept
 
 
 def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0):
