@@ -190,6 +190,28 @@ def test_hinted_location_is_the_trees_on_small_integer_sets(n, span, turn, seed)
         _assert_same_sweep(hinted, tree)
 
 
+@pytest.mark.parametrize("hints", [True, False])
+@pytest.mark.parametrize("row, k", [(8, 3), (64, 0), (64, 31), (64, 62), (257, 128)])
+def test_a_site_on_a_breakpoint_goes_to_the_arc_right_of_it(hints, row, k):
+    """A row of sites at y = 0 (vertical breakpoints at their midpoints), then one site right above the
+    midpoint of sites k and k + 1: it splits the arc of site k + 1, the arc whose span [left breakpoint,
+    right breakpoint) holds it, whether a walk from a hint or the tree finds it (the tree's answer at a
+    breakpoint used to depend on its shape)."""
+    xs = np.r_[np.arange(float(row)), k + 0.5]
+    ys = np.r_[np.zeros(row), 2.0]
+    beach = fortune.sweep(xs, ys, stop_after=row + 1, hints=hints)["beach"].tolist()
+    assert beach == [*range(k + 2), row, *range(k + 1, row)]
+
+
+@pytest.mark.parametrize("hints", [True, False])
+def test_a_site_at_the_top_of_a_circle_goes_to_the_arc_right_of_the_breakpoint(hints):
+    """Sites (-3, -4) and (4, -3) on the circle of radius 5 about the origin, then (0, 5), its top: at
+    that sweep line the breakpoint between the first site's arc and the second's is the origin, right
+    below the new site, which splits the arc right of it (the second site's)."""
+    xs, ys = np.array([-3.0, 4.0, 0.0]), np.array([-4.0, -3.0, 5.0])
+    assert fortune.sweep(xs, ys, stop_after=3, hints=hints)["beach"].tolist() == [0, 1, 2, 1, 0]
+
+
 @pytest.mark.parametrize("dist", ["uniform", "gaussian", "clustered"])
 def test_hints_locate_nearly_every_site(dist):
     """The hints work: on 50,000 sites of each distribution, at least 97% are located by a short walk,
