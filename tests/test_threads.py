@@ -1,7 +1,7 @@
 """Builds on several threads give the same Diagram, bit for bit, as on one.
 
-The split phases are the dual's walks, which compute the Voronoi vertices and test their cells for
-zero-length edges (dual.voronoi_from_delaunay), and the clipping of the cells (clip.clip_cells). The API tests use enough sites for the clipper to split; the
+The split phases are the dual's vertices (circumcentres, by blocks of triangles) and walks, which mark
+the zero-length edges (dual.voronoi_from_delaunay), and the clipping of the cells (clip.clip_cells). The API tests use enough sites for the clipper to split; the
 kernel tests force the split on every adversarial family, small as they are.
 """
 
@@ -125,7 +125,7 @@ def test_kernels_split_on_every_family(name):
 def test_walks_in_any_runs_find_the_same_zero_length_edges():
     """Hypothesis hunts over small integer and rounded point sets (cocircular quadruples everywhere,
     repeats, collinear runs): the dual on 2 or 3 threads with walks in runs of any length, where a
-    walk leaves open the edges whose ends an earlier run numbers, equals the one-thread dual, and its
+    twin made by another run waits for the pass after the walks, equals the one-thread dual, and its
     zero-length edges are exactly the Delaunay edges between cocircular triangles."""
     from hypothesis import given, settings
     from hypothesis import strategies as st

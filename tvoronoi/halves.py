@@ -140,13 +140,11 @@ def half(
     n_tri = len(tv_h) // 3
     lo = 0 if first == 0 else len(out.keep) - n_tri
     tv, opp = out.tv[3 * lo : 3 * (lo + n_tri)], out.opp[3 * lo : 3 * (lo + n_tri)]
-    if engine == "fortune":
-        # the sweep's order and its triangles as they are: stored next to their sites already (a Z-curve
-        # renumbering cost Fortune's builds more than it saved, see engines.spatial)
-        renumber.shifted_into(tv_h, opp_h, k, tv, opp, first, lo, n)
-    else:
-        # the triangles sorted by their first site, so that each site's lie together
-        renumber.triangle_order_into(tv_h, opp_h, None, tv, opp, first, lo, n, threads, n_sites=k)
+    # the sites keep their order (the sweep's, or along the BRIO curve), and the triangles are sorted by
+    # their first site, so that each site's lie together: the dual numbers the vertices in the
+    # triangles' order, and the walks and the clipper then find a cell's vertices near its neighbours'
+    # (a Z-curve renumbering of Fortune's sites cost its builds more than it saved, see engines.spatial)
+    renumber.triangle_order_into(tv_h, opp_h, None, tv, opp, first, lo, n, threads, n_sites=k)
     out.dup[mine] = np.where(dup_h >= 0, dup_h + first, -1)
     del tv_h, opp_h, dup_h
     keep = out.keep[lo : lo + n_tri]

@@ -22,16 +22,6 @@ def triangle_order_into(
     threads: int = 1,
     n_sites: int = -1,
 ) -> None: ...
-def shifted_into(
-    tv: np.ndarray,
-    opp: np.ndarray,
-    inf: int,
-    tv2: np.ndarray,
-    opp2: np.ndarray,
-    site_base: int,
-    tri_base: int,
-    inf_out: int,
-) -> None: ...
 def take_sites(xs: np.ndarray, ys: np.ndarray, idx: np.ndarray, exponent: int = 0) -> tuple[np.ndarray, np.ndarray]: ...
 def split_rows(
     xs: np.ndarray, ys: np.ndarray, axis: int, split: float

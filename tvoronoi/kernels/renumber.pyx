@@ -222,20 +222,6 @@ def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int
                 opp2[3 * T + k] = 3 * (tri_base + tri_new[o // 3]) + o % 3
 
 
-def shifted_into(const int32_t[::1] tv, const int32_t[::1] opp, int inf, int32_t[::1] tv2, int32_t[::1] opp2,
-                 int site_base, int tri_base, int inf_out):
-    """The triangulation tv, opp (vertex inf at infinity) written into tv2, opp2 as part of a larger one,
-    in its own order (for a triangulation laid out near its sites already, as Fortune's sweep makes it):
-    sites moved up by site_base, the vertex at infinity made inf_out, twins moved up by 3 tri_base."""
-    cdef Py_ssize_t n_he = tv.shape[0], k
-    if tv2.shape[0] != n_he or opp2.shape[0] != n_he or opp.shape[0] != n_he:
-        raise ValueError("shifted_into: tv, opp, tv2 and opp2 differ in length")
-    with nogil:
-        for k in range(n_he):
-            tv2[k] = inf_out if tv[k] == inf else tv[k] + site_base
-            opp2[k] = opp[k] + 3 * tri_base
-
-
 def spatial_order(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
                   int threads=1):
     """Sites and triangles renumbered so that neighbours in the plane are neighbours in memory:
