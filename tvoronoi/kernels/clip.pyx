@@ -64,6 +64,10 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int n = xs.shape[0], m = vertices.shape[0], n_he = he_origin.shape[0]
     cdef signed char[::1] vcx = np.empty(max(m, 1), np.int8)
     cdef signed char[::1] vcy = np.empty(max(m, 1), np.int8)
+    # 1 for a vertex in the closed box (both codes in), 0 outside; from index -1 on, where "at infinity"
+    # reads 0
+    cdef signed char[::1] v_in_buf = np.empty(m + 1, np.int8)
+    cdef signed char* v_in = &v_in_buf[0] + 1
     # arrays written at a few places only (Scratch): ties, the parts of edges not WHOLE
     cdef Scratch scratch = Scratch()
     cdef signed char* tie = <signed char*> scratch.take(max(m, 1), True)
@@ -79,7 +83,6 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int n_pts = m, corner0, h, tw, o, d, a, b, c, v, i, k, cnt, status = 0, n_ties = 0, n_bent = 0
     cdef int n_cross = 0, lo, hi
     cdef int64_t n_ring = 0
-    cdef double x, y
     cdef EdgePart part
     cdef Points P
     cdef bint has_o, has_d
@@ -87,17 +90,12 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int T = threads if n >= parallel_min and threads > 1 else 1
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
-        for v in prange(m, num_threads=T, schedule="static"):
-            x = vertices[v, 0]
-            y = vertices[v, 1]
-            if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
-                tie[v] = 1
-                n_ties += 1
-                vcx[v] = 0
-                vcy[v] = 0
-            else:
-                vcx[v] = -2 if x < box.xmin else (2 if x > box.xmax else 0)
-                vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
+        # (each thread a run of them, in a function of its own: its pointers stay in registers across
+        # the byte stores, which could alias them for the compiler)
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            n_ties += vertex_codes(<int> (<int64_t> k * m // T), <int> (<int64_t> (k + 1) * m // T),
+                                   &vertices[0, 0] if m > 0 else NULL, &box, &vcx[0], &vcy[0], tie, v_in)
+        v_in_buf[0] = 0
         for h in range(n_he if n_ties > 0 else 0):
             v = he_origin[h]
             if v < 0 or tie[v] != 1:
@@ -111,17 +109,13 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], False)
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
-        # the edges with both ends vertices in the box are whole; count the others (each makes at most
-        # two new points)
-        # (each half-edge on its own: its end is where the next one of its cell starts, and the twin
-        # reaches the same verdict)
-        for h in prange(n_he, num_threads=T, schedule="static"):
-            o = he_origin[h]
-            d = he_origin[next_in_cell(h, n_he, &he_face[0], &face_edge[0])]
-            if o >= 0 and d >= 0 and code_in(vcx[o]) and code_in(vcy[o]) and code_in(vcx[d]) and code_in(vcy[d]):
-                flags[h] = HAS | WHOLE
-            elif he_twin[h] > h:
-                n_cross += 1
+            v_in[v] = code_in(vcx[v]) and code_in(vcy[v])
+        # the edges with both ends vertices in the box are whole; the others counted
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            n_cross += whole_edges(<int> (<int64_t> k * n_he // T), <int> (<int64_t> (k + 1) * n_he // T), n_he,
+                                   &he_origin[0] if n_he > 0 else NULL, &he_twin[0] if n_he > 0 else NULL,
+                                   &he_face[0] if n_he > 0 else NULL, &face_edge[0] if n > 0 else NULL,
+                                   v_in, &flags[0] if n_he > 0 else NULL)
     cdef bint in_room = False
     if room is not None:
         room_pts = room
@@ -265,6 +259,45 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     if n_bent:
         offs, rings = straighten(points, offs, rings, (xmin, ymin, xmax, ymax), candidates=turned_arr[:n])
     return points, offs, rings, status
+
+
+cdef int vertex_codes(int lo, int hi, const double* vertices, const Box* box, signed char* vcx, signed char* vcy,
+                      signed char* tie, signed char* v_in) noexcept nogil:
+    # vertices lo..hi-1 against the box, by their rounded coordinates: codes, and 1 in v_in for those
+    # in it; a coordinate equal to a side is a tie (marked 1, codes 0 until the exact test); returns the
+    # count of ties
+    cdef int v, n_ties = 0
+    cdef double x, y
+    for v in range(lo, hi):
+        x = vertices[2 * v]
+        y = vertices[2 * v + 1]
+        if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
+            tie[v] = 1
+            n_ties += 1
+            vcx[v] = 0
+            vcy[v] = 0
+            v_in[v] = 1
+        else:
+            vcx[v] = -2 if x < box.xmin else (2 if x > box.xmax else 0)
+            vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
+            v_in[v] = vcx[v] == 0 and vcy[v] == 0
+    return n_ties
+
+
+cdef int whole_edges(int lo, int hi, int n_he, const int32_t* he_origin, const int32_t* he_twin,
+                     const int32_t* he_face, const int32_t* face_edge, const signed char* v_in,
+                     signed char* flags) noexcept nogil:
+    # half-edges lo..hi-1 with both ends in the box flagged whole (each on its own: its end is where the
+    # next one of its cell starts, and the twin reaches the same verdict; v_in reads 0 at infinity, -1);
+    # returns the count of the other edges, from the half-edge of smaller index (each makes at most two
+    # new points)
+    cdef int h, k, n_cross = 0
+    for h in range(lo, hi):
+        k = v_in[he_origin[h]] & v_in[he_origin[next_in_cell(h, n_he, he_face, face_edge)]]
+        flags[h] = k * (HAS | WHOLE)
+        if k == 0 and he_twin[h] > h:
+            n_cross += 1
+    return n_cross
 
 
 cdef class Scratch:
