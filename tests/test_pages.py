@@ -189,3 +189,19 @@ def test_threads_allocating_at_once_keep_their_data():
         for w in workers:
             w.join()
     assert not errors
+
+
+@pytest.mark.skipif(not pages.MAPS, reason="no mappings here")
+@pytest.mark.parametrize("mib", [4, 5, 24, 33])
+def test_a_fresh_large_mapping_starts_on_a_huge_page(mib):
+    """From 4 MiB on, a fresh mapping starts on a 2 MiB boundary (the array 64 bytes after it, its
+    header), so that every whole huge page of it can be one; nothing beyond its pages stays mapped
+    (the slack taken to align it is handed back), and it is writable to its last byte."""
+    with build_arrays():
+        held = resident_mib()
+        a = np.empty((mib << 20) // 8)
+        assert data_address(a) % (2 << 20) == 64
+        a[:] = 1.0
+        assert a[-1] == 1.0 and a.sum() == a.size
+        assert resident_mib() - held < mib + 2.5
+        del a

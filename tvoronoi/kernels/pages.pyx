@@ -5,7 +5,9 @@ freed for later (it raises its threshold for mapping a block of its own each tim
 32 MiB), so a build's temporaries stay resident as holes that the next, larger arrays cannot use: at
 1,000,000 sites that is 40-60 MiB of peak memory for nothing. numpy lets a context choose the allocator of
 the arrays made in it (a data memory handler, NEP 49). ``mapped()`` installs one that maps each array of
-1 MiB or more on its own (with numpy's own advice for huge pages from 4 MiB), unmaps it when it is freed,
+1 MiB or more on its own (from 4 MiB on, advised for huge pages as numpy does, and starting on a huge
+page's boundary, so that all its whole huge pages can be huge: the kernel places a mapping anywhere,
+which left up to 2 MiB at either end to 4 KiB faults), unmaps it when it is freed,
 and resizes it in place (mremap); smaller arrays come from malloc as before. An array remembers the handler
 that made it, so arrays that outlive the build are freed correctly whenever they are.
 
@@ -22,6 +24,7 @@ from cpython.pycapsule cimport PyCapsule_New
 
 cdef extern from *:
     """
+    #include <stdint.h>
     #include <stdlib.h>
     #include <string.h>
     #include <numpy/ndarraytypes.h>
@@ -37,6 +40,7 @@ cdef extern from *:
     #define TV_HEAD 64
     #define TV_MAP_MIN ((size_t) 1 << 20)
     #define TV_HUGE_MIN ((size_t) 4 << 20)
+    #define TV_HUGE_PAGE ((size_t) 2 << 20)
 
     #if TV_MAPS
     /* Mappings freed during a build are kept (up to TV_KEEP_BYTES) and given to the next large
@@ -117,6 +121,32 @@ cdef extern from *:
     static void tv_leave(void) {}
     #endif
 
+    #if TV_MAPS
+    /* a fresh mapping of len bytes; from TV_HUGE_MIN on, advised for huge pages and starting on a
+       huge page's boundary (the kernel would place it anywhere, leaving up to 2 MiB of its first and
+       last huge pages to 4 KiB faults) */
+    static char* tv_map(size_t len) {
+        char* p;
+    #ifdef MADV_HUGEPAGE
+        if (len >= TV_HUGE_MIN) {
+            /* a huge page more than needed, then what lies before the first boundary and after the
+               array's pages handed back */
+            size_t page = (size_t) sysconf(_SC_PAGESIZE), plen = (len + page - 1) / page * page;
+            char* a;
+            p = (char*) mmap(NULL, plen + TV_HUGE_PAGE, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+            if (p == MAP_FAILED) return NULL;
+            a = (char*) (((uintptr_t) p + TV_HUGE_PAGE - 1) & ~(uintptr_t) (TV_HUGE_PAGE - 1));
+            if (a > p) munmap(p, (size_t) (a - p));
+            munmap(a + plen, (size_t) (p + TV_HUGE_PAGE - a));
+            madvise(a, len, MADV_HUGEPAGE);
+            return a;
+        }
+    #endif
+        p = (char*) mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        return p == MAP_FAILED ? NULL : p;
+    }
+    #endif
+
     static void* tv_block(size_t n, int zeroed) {
         char* p;
         size_t len = n + TV_HEAD, had = 0;
@@ -143,11 +173,8 @@ cdef extern from *:
                 ((size_t*) p)[1] = n;
                 return p + TV_HEAD;
             }
-            p = (char*) mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-            if (p == MAP_FAILED) return NULL;
-    #ifdef MADV_HUGEPAGE
-            if (len >= TV_HUGE_MIN) madvise(p, len, MADV_HUGEPAGE);
-    #endif
+            p = tv_map(len);
+            if (p == NULL) return NULL;
             ((size_t*) p)[0] = len;
             ((size_t*) p)[1] = n;
             return p + TV_HEAD;
