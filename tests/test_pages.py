@@ -205,3 +205,32 @@ def test_a_fresh_large_mapping_starts_on_a_huge_page(mib):
         assert a[-1] == 1.0 and a.sum() == a.size
         assert resident_mib() - held < mib + 2.5
         del a
+
+
+def kernel_at_least(major: int, minor: int) -> bool:
+    """The running kernel (Linux) is at least major.minor."""
+    release = os.uname().release.split("-")[0].split(".")
+    try:
+        return (int(release[0]), int(release[1])) >= (major, minor)
+    except (IndexError, ValueError):
+        return False
+
+
+# (MADV_POPULATE_WRITE came with Linux 5.14; before it, populate leaves the pages to their first stores)
+@pytest.mark.skipif(not pages.MAPS or not kernel_at_least(5, 14), reason="no mappings or no populate here")
+def test_populated_pages_become_resident_and_keep_their_data():
+    """populate (the kernels' call before writing an array whole) makes a fresh array's pages resident
+    in one call, and changes nothing already written: a part written before it keeps its values, a
+    part never written stays zero."""
+    with build_arrays():
+        held = resident_mib()
+        a = np.zeros((24 << 20) // 4, np.int32)  # fresh pages: not resident until touched
+        assert resident_mib() - held < 4
+        a[: a.size // 3] = np.arange(a.size // 3, dtype=np.int32)
+        pages.populate_pages(a)
+        assert resident_mib() - held > 22
+        assert np.array_equal(a[: a.size // 3], np.arange(a.size // 3, dtype=np.int32))
+        assert not a[a.size // 3 :].any()
+        with pytest.raises(ValueError, match="C-contiguous"):
+            pages.populate_pages(a[::2])
+        del a

@@ -14,6 +14,7 @@ from tvoronoi.kernels.clipper cimport (
     finish_ring, first_right_turn, turn, convex_ring, bent,
 )
 from tvoronoi.kernels.prefetch cimport prefetch
+from tvoronoi.kernels.populate cimport populate_part, fill_int32
 
 
 cdef enum:
@@ -510,6 +511,8 @@ def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int3
     cdef int64_t k, lo, hi
     cdef const int32_t* ring_p = &ring[0] if ring.shape[0] > 0 else NULL     # (a prefetch never faults)
     with nogil:
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            populate_part(out_p, total * sizeof(int32_t), <int> k, T)     # (written whole: by runs of pages)
         # rows in input order are cells in random engine order: each cell's offsets are loaded GATHER_AHEAD
         # rows ahead and its ring half as far ahead, so that a copy seldom waits for memory
         for r in prange(rows, num_threads=T, schedule="static"):
@@ -539,10 +542,17 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
     cdef int T = threads if n >= PARALLEL_MIN_CELLS and threads > 1 else 1
     cdef int r
     site_of_arr = np.empty(n, np.int32)
-    cell_of_row_arr = np.full(n, -1, np.int32)
-    face_edge_arr = np.full(n, -1, np.int32)
+    cell_of_row_arr = np.empty(n, np.int32)
+    face_edge_arr = np.empty(n, np.int32)
     cdef int32_t[::1] site_of = site_of_arr, cell_of_row = cell_of_row_arr, row_face_edge = face_edge_arr
+    if n == 0:
+        return site_of_arr, cell_of_row_arr, face_edge_arr
     with nogil:
+        # (written whole: faulted in by runs of pages)
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            populate_part(&site_of[0], n * sizeof(int32_t), <int> k, T)
+            fill_int32(&cell_of_row[k * n // T], (k + 1) * n // T - k * n // T, -1)
+            fill_int32(&row_face_edge[k * n // T], (k + 1) * n // T - k * n // T, -1)
         for k in prange(n, num_threads=T, schedule="static"):
             r = dup[k] if dup[k] >= 0 else <int> k
             site_of[perm[k]] = owner[r]

@@ -10,6 +10,7 @@ from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
 from tvoronoi.kernels.prefetch cimport prefetch
+from tvoronoi.kernels.populate cimport populate_part, fill_int32
 
 cdef enum:
     AHEAD = 4       # the walk around site a + AHEAD starts loading while site a is walked
@@ -84,7 +85,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int n = xs.shape[0], inf = n
     cdef int n_he_d = tv.shape[0], n_tri = n_he_d // 3
     cdef int n_blocks = (n_tri + TRI_BLOCK - 1) // TRI_BLOCK
-    cdef int32_t[::1] first_e = np.full(n, -1, np.int32)     # where each site's walk starts
+    cdef int32_t[::1] first_e = np.empty(max(n, 1), np.int32)   # where each site's walk starts
     cdef int32_t[::1] h_first = np.zeros(n + 1, np.int32)    # the cell's first half-edge (a count first)
     cdef int32_t[::1] v_block = np.zeros(n_blocks + 1, np.int32)  # the first vertex of each block of triangles
     cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # triangle -> its vertex, -1 if infinite
@@ -92,7 +93,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] face_edge = np.full(n, -1, np.int32)
+    cdef int32_t[::1] face_edge = np.empty(max(n, 1), np.int32)
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
     cdef double[:, ::1] centre
     cdef int32_t[:, ::1] tri
@@ -102,6 +103,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         threads = 1
 
     with nogil:
+        fill_int32(&first_e[0], n, -1)      # (written whole: faulted in by runs of pages)
+        fill_int32(&face_edge[0], n, -1)
         # which triangles are finite (counted by blocks of triangles, for their vertices' numbers), and
         # where each site's walk starts: any half-edge out of it, or for a hull site the one whose dual
         # comes from infinity (the twin of a hull edge p->q of an infinite triangle starts at q). On
@@ -157,6 +160,15 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int h0, marked
 
     with nogil:
+        # the arrays written whole, faulted in by runs of pages (a part on each thread)
+        for k in prange(threads, num_threads=threads, schedule="static", chunksize=1):
+            populate_part(&vid[0], n_tri * sizeof(int32_t), k, threads)
+            populate_part(tri_rows, 3 * n_finite * sizeof(int32_t), k, threads)
+            populate_part(centres, 2 * n_finite * sizeof(double), k, threads)
+            populate_part(&vor[0], n_he_d * sizeof(int32_t), k, threads)
+            populate_part(&he_origin[0], n_he_d * sizeof(int32_t), k, threads)
+            populate_part(&he_twin[0], n_he_d * sizeof(int32_t), k, threads)
+            populate_part(&he_face[0], n_he_d * sizeof(int32_t), k, threads)
         # the vertices: each finite triangle's number (those of the triangles before it), its sites
         # and its circumcentre (construct.circumcentre), by blocks of triangles, on the threads
         lo = 0
@@ -226,7 +238,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         "he_origin": np.asarray(he_origin)[:h],
         "he_twin": np.asarray(he_twin)[:h],
         "he_face": np.asarray(he_face)[:h],
-        "face_edge": np.asarray(face_edge),
+        "face_edge": np.asarray(face_edge)[:n],
         "triangles": np.asarray(tri),
     }
     if clip_room:

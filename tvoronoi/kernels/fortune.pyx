@@ -13,6 +13,7 @@ from libc.math cimport sqrt, INFINITY
 from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
+from tvoronoi.kernels.populate cimport populate
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle, incircle_filter
 from tvoronoi.kernels.mesh cimport nxt, prv
@@ -242,12 +243,13 @@ cdef void check_circle(Sweep* s, int arc, int old) noexcept nogil:
 cdef int new_record(Sweep* s, int a, int b, double x, double y) noexcept nogil:
     cdef int r = s.n_recs
     s.n_recs += 1
-    s.rec_a[r] = a
-    s.rec_b[r] = b
     s.rec_e0[r] = NONE
     s.rec_e1[r] = NONE
-    s.rec_x[r] = x
-    s.rec_y[r] = y
+    if s.rec_a != NULL:         # a step trace's state: what the records show
+        s.rec_a[r] = a
+        s.rec_b[r] = b
+        s.rec_x[r] = x
+        s.rec_y[r] = y
     return r
 
 
@@ -545,6 +547,9 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     """
     cdef int n = xs.shape[0]
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
+    # (the records' sites and starts only for a trace's state: a whole sweep would write 24 bytes an
+    # edge that nothing reads)
+    cdef int cap_shown = cap_rec if stop_after >= 0 else 1
     arrays = {
         "arc_site": np.empty(cap_arcs, np.int32), "arc_prev": np.empty(cap_arcs, np.int32),
         "arc_next": np.empty(cap_arcs, np.int32), "left": np.empty(cap_arcs, np.int32),
@@ -559,9 +564,9 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         "ev_class": np.empty(cap_ev, np.int64),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
-        "rec_a": np.empty(cap_rec, np.int32), "rec_b": np.empty(cap_rec, np.int32),
+        "rec_a": np.empty(cap_shown, np.int32), "rec_b": np.empty(cap_shown, np.int32),
         "rec_e0": np.empty(cap_rec, np.int32), "rec_e1": np.empty(cap_rec, np.int32),
-        "rec_x": np.empty(cap_rec, np.float64), "rec_y": np.empty(cap_rec, np.float64),
+        "rec_x": np.empty(cap_shown, np.float64), "rec_y": np.empty(cap_shown, np.float64),
         "tv": np.empty(3 * cap_tri, np.int32), "opp": np.empty(3 * cap_tri, np.int32),
         "dup": np.full(n, -1, np.int32),
     }
@@ -596,8 +601,12 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]
     s.free_events = &free_events[0]
     s.free_arcs = &free_arcs[0]
-    s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]; s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
-    s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]
+    s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
+    s.rec_a = s.rec_b = NULL
+    s.rec_x = s.rec_y = NULL
+    if stop_after >= 0:
+        s.rec_a = &rec_a[0]; s.rec_b = &rec_b[0]
+        s.rec_x = &rec_x[0]; s.rec_y = &rec_y[0]
     s.tv = &tv[0]; s.opp = &opp[0]
     s.dup = &dup[0] if n else NULL
     # the hints: about sqrt(n) strips of equal width (a strip then holds an arc or two of the beach line
@@ -624,6 +633,13 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     # the sweep: one event at a time (every step processes a site or removes an arc, so it ends)
     try:
         with nogil:
+            # the arrays a whole sweep writes (nearly) whole, faulted in by runs of pages: the triangles
+            # (at most 2 n) and the records (one an edge)
+            if stop_after < 0 and n > 0:
+                populate(s.tv, 3 * min(cap_tri, 2 * n) * sizeof(int32_t))
+                populate(s.opp, 3 * min(cap_tri, 2 * n) * sizeof(int32_t))
+                populate(s.rec_e0, cap_rec * sizeof(int32_t))
+                populate(s.rec_e1, cap_rec * sizeof(int32_t))
             while stop_after < 0 or steps < stop_after:
                 if not step(&s, &next_site):
                     break
@@ -688,7 +704,7 @@ cdef dict _state(Sweep* s, dict arrays):
         ev = s.heap[k]
         events.append((index[s.ev_arc[ev]], s.ev_x[ev], s.ev_cy[ev], s.ev_y[ev]))
     events.sort(key=lambda row: (row[3], row[1]))
-    r = s.n_recs
+    r = s.n_recs if s.rec_a != NULL else 0
     return {
         "beach": np.asarray(beach, np.int32),
         "beach_edges": np.asarray(edges[:len(edges) - 1], np.int32) if edges else np.empty(0, np.int32),
@@ -734,8 +750,8 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     memory comes from malloc.
     """
     cdef int cap_arcs = 2 * n + 2, cap_ev = 2 * n + 2, cap_rec = 3 * n + 4, cap_tri = 3 * n + 4
-    cdef int n_i32 = 11 * cap_arcs + 7 * cap_ev + 4 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
-    cdef int n_f64 = 9 * cap_ev + 2 * cap_rec
+    cdef int n_i32 = 11 * cap_arcs + 7 * cap_ev + 2 * cap_rec + 6 * cap_tri + n + (n + 1) + 3 * cap_tri
+    cdef int n_f64 = 9 * cap_ev
     cdef int32_t* ib = <int32_t*>malloc(n_i32 * sizeof(int32_t))
     cdef double* fb = <double*>malloc(n_f64 * sizeof(double))
     cdef int8_t* bb = <int8_t*>malloc((cap_arcs + 3 * cap_tri + cap_ev) * sizeof(int8_t))
@@ -764,8 +780,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.ev_pos = p; p += cap_ev
     s.heap = p; p += cap_ev
     s.free_events = p; p += cap_ev
-    s.rec_a = p; p += cap_rec
-    s.rec_b = p; p += cap_rec
+    s.rec_a = s.rec_b = NULL      # (no trace: the records' sites and starts are not kept)
     s.rec_e0 = p; p += cap_rec
     s.rec_e1 = p; p += cap_rec
     s.tv = p; p += 3 * cap_tri
@@ -783,8 +798,7 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
     s.ev_cy = q; q += cap_ev
     s.ev_span = q; q += 2 * cap_ev
     s.ev_rise = q; q += 3 * cap_ev
-    s.rec_x = q; q += cap_rec
-    s.rec_y = q
+    s.rec_x = s.rec_y = NULL
     for k in range(n):
         s.dup[k] = NONE
     while step(&s, &next_site):

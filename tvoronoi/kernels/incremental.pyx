@@ -13,6 +13,7 @@ from tvoronoi.kernels.mesh cimport Mesh
 from tvoronoi.kernels.location cimport locate, list_site
 from tvoronoi.kernels.fill cimport insert_site
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
+from tvoronoi.kernels.populate cimport populate, fill_int32
 
 cdef enum:
     # status codes returned to the API layer
@@ -147,7 +148,10 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
         For a repeated point, the site it repeats; -1 otherwise.
     """
     cdef int n = xs.shape[0]
-    cdef int32_t[::1] dup = np.full(n, -1, np.int32)
+    cdef int32_t[::1] dup = np.empty(n, np.int32)
+    if n > 0:
+        with nogil:
+            fill_int32(&dup[0], n, -1)
     # (a copy: build reorders its first sites)
     cdef int32_t[::1] ins = np.arange(n, dtype=np.int32) if order is None else permutation_copy(order, n)
     if n < 3:
@@ -155,7 +159,7 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     cdef int max_tri = 2 * n - 2
     cdef int32_t[::1] tv = np.empty(3 * max_tri, np.int32)
     cdef int32_t[::1] opp = np.empty(3 * max_tri, np.int32)
-    cdef int32_t[::1] stamp = np.full(max_tri, -1, np.int32)
+    cdef int32_t[::1] stamp = np.empty(max_tri, np.int32)
     cdef int32_t[::1] vmap = np.empty(n + 1, np.int32)
     cdef int32_t[::1] cavity = np.empty(max_tri, np.int32)
     cdef int32_t[::1] bnd_a = np.empty(max_tri + 2, np.int32)
@@ -206,6 +210,11 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     m.last = 0
     cdef int status
     with nogil:
+        # the mesh grows to 2 n - 2 triangles less the hull's: its arrays are written (nearly) whole,
+        # faulted in by runs of pages
+        populate(&tv[0], 3 * max_tri * sizeof(int32_t))
+        populate(&opp[0], 3 * max_tri * sizeof(int32_t))
+        fill_int32(&stamp[0], max_tri, -1)
         status = build(&m, &ins[0], stop_after)
     if status != STATUS_OK:
         return status, np.empty(0, np.int32), np.empty(0, np.int32), np.asarray(dup)

@@ -8,6 +8,7 @@ from libc.stdlib cimport malloc, free
 from libc.string cimport memcpy
 
 from tvoronoi.kernels.interrupt cimport poll_signals
+from tvoronoi.kernels.populate cimport populate
 
 cdef enum:
     # rounds stop halving below this expected size: the first sites form one round (CGAL's threshold in 2D)
@@ -328,6 +329,13 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0, bint along_cu
     cdef int32_t tmp
     try:
         with nogil:
+            # the arrays written whole, faulted in by runs of pages
+            populate(&perm[0], n * sizeof(int32_t))
+            if along_curve:
+                populate(&curve[0], n * sizeof(int32_t))
+            populate(&round_of[0], n * sizeof(int8_t))
+            populate(a, n * sizeof(Keyed))
+            populate(b, n * sizeof(Keyed))
             # the rounds: n/2 sites expected in the last, n/4 in the one before, ..., the rest in the first
             while (n >> (n_rounds + 1)) >= FIRST_ROUND and n_rounds + 1 < MAX_ROUNDS:
                 n_rounds += 1

@@ -21,6 +21,9 @@ malloc); a build calls it between phases.
 from contextlib import contextmanager
 
 from cpython.pycapsule cimport PyCapsule_New
+from libc.stdint cimport uintptr_t
+
+from tvoronoi.kernels.populate cimport populate
 
 cdef extern from *:
     """
@@ -285,3 +288,15 @@ def trim_heap():
     with nogil:
         released = tv_trim()
     return bool(released)
+
+
+def populate_pages(a):
+    """Fault in the whole pages of C-contiguous array ``a`` in one call (populate.pxd, as the kernels do
+    for the arrays they write whole); its contents stay as they are. Exposed for tests."""
+    if not a.flags.c_contiguous:
+        raise ValueError("populate_pages: the array must be C-contiguous")
+    cdef uintptr_t address = a.__array_interface__["data"][0]
+    cdef size_t length = a.nbytes
+    with nogil:
+        populate(<void*> address, length)
+

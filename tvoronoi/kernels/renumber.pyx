@@ -19,6 +19,7 @@ from libc.stdint cimport int32_t, uint32_t
 from libc.stdlib cimport calloc, free, malloc
 from libc.math cimport INFINITY, ldexp
 from libc.string cimport memcpy
+from tvoronoi.kernels.populate cimport populate, populate_part
 
 cdef enum:
     MAX_GRID_BITS = 11      # at most 2^11 x 2^11 grid cells (a 16 MiB count array); more sites share cells
@@ -197,6 +198,12 @@ def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int
     if n_tri == 0:
         return
     with nogil:
+        # the arrays written whole, faulted in by runs of pages (the output a part on each thread)
+        populate(&keys[0], n_tri * sizeof(int32_t))
+        populate(&tri_new[0], n_tri * sizeof(int32_t))
+        for k in prange(T_threads, num_threads=T_threads, schedule="static", chunksize=1):
+            populate_part(&tv2[0], n_he * sizeof(int32_t), <int> k, T_threads)
+            populate_part(&opp2[0], n_he * sizeof(int32_t), <int> k, T_threads)
         # a counting sort by the smallest new site (every triangle has a finite one)
         for t in prange(n_tri, num_threads=T_threads, schedule="static"):
             keys[t] = first_site(&tv[3 * t], renumbered, inf)
@@ -267,6 +274,9 @@ def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx, i
     out_y_arr = np.empty(m, np.float64)
     cdef double[::1] out_x = out_x_arr, out_y = out_y_arr
     with nogil:
+        if m > 0:
+            populate(&out_x[0], m * sizeof(double))
+            populate(&out_y[0], m * sizeof(double))
         for k in range(m):
             i = idx[k]
             if i < 0 or i >= n:
@@ -358,6 +368,10 @@ def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] ro
             or out_y.shape[0] != m or out_rows.shape[0] != m):
         raise ValueError("sites_into: the arrays differ in length")
     with nogil:
+        if m > 0:
+            populate(&out_x[0], m * sizeof(double))
+            populate(&out_y[0], m * sizeof(double))
+            populate(&out_rows[0], m * sizeof(int32_t))
         for k in range(m):
             j = new_to_old[k]
             if j < 0 or j >= n:

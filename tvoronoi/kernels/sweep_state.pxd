@@ -76,7 +76,8 @@ cdef struct Sweep:
     int n_events
     int32_t* free_events
     int n_free_ev
-    # edge records: the sites on each side, the Delaunay half-edges found so far, where it began
+    # edge records: the Delaunay half-edges found so far; for the step trace only (NULL otherwise: a
+    # finished sweep never reads them), the sites on each side and where the edge began
     int32_t* rec_a
     int32_t* rec_b
     int32_t* rec_e0
