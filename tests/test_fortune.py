@@ -11,6 +11,7 @@ from conftest import DATASETS, GENERAL_POSITION
 from invariants import validate
 from oracle import assert_matches_oracle
 from tests import adversarial
+from tests.flips import flip_edges
 from tvoronoi.engines import sweep_order
 from tvoronoi.kernels import fortune, incremental
 
@@ -74,28 +75,7 @@ def test_legalize_restores_delaunay(rng):
     xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
     _, tv, opp, _ = incremental.triangulate(xs, ys)
     want = {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()}
-    n, spoiled = len(pts), 0
-    for e in rng.permutation(len(tv)):
-        o = opp[e]
-        t, u = e // 3, o // 3
-        if n in tv[3 * t : 3 * t + 3] or n in tv[3 * u : 3 * u + 3]:
-            continue
-        nxt = lambda h: h - 2 if h % 3 == 2 else h + 1  # noqa: E731
-        prv = lambda h: h + 2 if h % 3 == 0 else h - 1  # noqa: E731
-        a, b, c, d = tv[e], tv[nxt(e)], tv[prv(e)], tv[prv(o)]
-        # flip only where the quadrilateral a, d, b, c is convex
-        cross = lambda p, q, r: (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])  # noqa: E731
-        if cross(pts[c], pts[a], pts[d]) <= 0 or cross(pts[d], pts[b], pts[c]) <= 0:
-            continue
-        e2, o2 = prv(e), prv(o)
-        A, B = opp[e2], opp[o2]
-        tv[e], tv[o] = d, c
-        opp[e], opp[B] = B, e
-        opp[o], opp[A] = A, o
-        opp[e2], opp[o2] = o2, e2
-        spoiled += 1
-        if spoiled == 40:
-            break
+    assert flip_edges(xs, ys, tv, opp, rng, 40) == 40
     assert {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()} != want
     assert fortune.legalize(xs, ys, tv, opp) >= 1
     assert {tuple(sorted(t)) for t in tv.reshape(-1, 3).tolist()} == want

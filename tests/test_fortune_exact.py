@@ -587,7 +587,7 @@ def test_a_large_lattice_proves_each_tie_about_once(kind):
 
 def test_an_inconsistent_sweep_is_a_tvoronoi_error(monkeypatch):
     real = fortune.sweep
-    monkeypatch.setattr(fortune, "sweep", lambda xs, ys: {**real(xs, ys), "status": fortune.STATUS_BROKEN})
+    monkeypatch.setattr(fortune, "sweep", lambda xs, ys, **kw: {**real(xs, ys, **kw), "status": fortune.STATUS_BROKEN})
     with pytest.raises(tvoronoi.TvoronoiError, match="inconsistent state"):
         tvoronoi.voronoi(np.random.default_rng(SEED).random((20, 2)), engine="fortune")
 
@@ -595,7 +595,7 @@ def test_an_inconsistent_sweep_is_a_tvoronoi_error(monkeypatch):
 def test_an_inconsistent_sweep_stops_a_dynamic_diagram_too(monkeypatch):
     """DynamicVoronoi's start with the Fortune engine goes through the same check as a batch build."""
     real = fortune.sweep
-    monkeypatch.setattr(fortune, "sweep", lambda xs, ys: {**real(xs, ys), "status": fortune.STATUS_BROKEN})
+    monkeypatch.setattr(fortune, "sweep", lambda xs, ys, **kw: {**real(xs, ys, **kw), "status": fortune.STATUS_BROKEN})
     with pytest.raises(tvoronoi.TvoronoiError, match="inconsistent state"):
         tvoronoi.DynamicVoronoi(np.random.default_rng(SEED).random((20, 2)), engine="fortune")
 

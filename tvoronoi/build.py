@@ -55,7 +55,8 @@ def triangulate_and_lay_out(s: engines.Sites, *, engine: str, insertion: str, th
     thread it is made on a second one while the triangulation runs (both kernels release the GIL), in
     this context (the build's arrays are made as on the first). The same result either way."""
     if threads < 2 or engine != "incremental" or len(s) < OVERLAP_MIN_SITES:
-        return engines.spatial(engines.triangulate(s, engine=engine, insertion=insertion), threads)
+        # (its dual follows: Fortune's closing guard is the dual's check, engines.Triangulation.voronoi)
+        return engines.spatial(engines.triangulate(s, engine=engine, insertion=insertion, guard=False), threads)
     with ThreadPoolExecutor(max_workers=1) as pool:
         layout = pool.submit(contextvars.copy_context().run, engines.spatial_sites, s)
         t = engines.triangulate(s, engine=engine, insertion=insertion)

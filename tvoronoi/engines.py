@@ -174,7 +174,8 @@ class Triangulation:
 
     tv, opp are the triangles' vertices (n stands for the vertex at infinity) and twin half-edges, or
     None when the distinct sites are collinear (fewer than three, or all on one line); dup[k] is the
-    earlier site that site k repeats, or -1.
+    earlier site that site k repeats, or -1. checked is False for Fortune's sweep without its closing
+    guard (``triangulate(..., guard=False)``): ``voronoi`` then checks every edge in the dual.
     """
 
     engine: str
@@ -182,6 +183,7 @@ class Triangulation:
     tv: np.ndarray | None
     opp: np.ndarray | None
     dup: np.ndarray
+    checked: bool = True
 
     @property
     def flat(self) -> bool:
@@ -190,11 +192,20 @@ class Triangulation:
 
     def voronoi(self, threads: int = 1, clip_room: bool = False) -> dict:
         """The Voronoi DCEL (vertices in the user's unit, correctly rounded) with ``dup``, in engine order;
-        the same for any thread count (clip_room: see dual.voronoi_from_delaunay)."""
+        the same for any thread count (clip_room: see dual.voronoi_from_delaunay).
+
+        An unchecked triangulation is checked as the dual walks it; were some edge not locally
+        Delaunay (never seen: the sweep's decisions are exact), it is repaired by exact flips in
+        place (fortune.legalize, the sweep's own guard) and the dual made again."""
         s = self.sites
         if self.flat:
             return collinear_dcel(s.xs, s.ys)
-        out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room)
+        out = dual.voronoi_from_delaunay(
+            s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room, check=not self.checked
+        )
+        if "illegal" in out:
+            fortune.legalize(s.xs, s.ys, self.tv, self.opp)
+            out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room)
         out["dup"] = self.dup
         return out
 
@@ -245,8 +256,12 @@ def renumbered(t: Triangulation, threads: int = 1, layout: SiteLayout | None = N
     return Triangulation(t.engine, layout.sites, tv, opp, dup)
 
 
-def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triangulation:
+def triangulate(sites: Sites, *, engine: str, insertion: str = "brio", guard: bool = True) -> Triangulation:
     """Run an engine on prepared sites.
+
+    guard=False: Fortune's sweep leaves out its closing repair (a guard that never flips), and the
+    triangulation is returned unchecked: its ``voronoi`` checks every edge instead, at a fraction of the
+    cost. Only for a triangulation whose next step is that dual (build.triangulation).
 
     Raises
     ------
@@ -255,7 +270,7 @@ def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triang
         incremental engine is the fallback the message names).
     """
     if engine == "fortune":
-        result = fortune.sweep(sites.xs, sites.ys)
+        result = fortune.sweep(sites.xs, sites.ys, guard=guard)
         if result["status"] != fortune.STATUS_OK:
             raise TvoronoiError(
                 f"{fortune.STATUS_MESSAGES[result['status']]} on {len(sites)} points; "
@@ -263,7 +278,7 @@ def triangulate(sites: Sites, *, engine: str, insertion: str = "brio") -> Triang
             )
         if "tv" not in result:
             return Triangulation(engine, sites, None, None, first_copies(sites.xs, sites.ys))
-        return Triangulation(engine, sites, result["tv"], result["opp"], result["dup"])
+        return Triangulation(engine, sites, result["tv"], result["opp"], result["dup"], checked=guard)
     status, tv, opp, dup = incremental.triangulate(sites.xs, sites.ys, conflict_lists=(insertion == "random"))
     if status != incremental.STATUS_OK:
         return Triangulation(engine, sites, None, None, first_copies(sites.xs, sites.ys))

@@ -4,6 +4,7 @@ import numpy as np
 
 from cython.parallel cimport prange
 from libc.stdint cimport int32_t, uint64_t
+from libc.math cimport fabs, ldexp
 
 from tvoronoi.kernels.construct cimport circumcentre
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -30,6 +31,60 @@ cdef enum:
 # An edge lies on the bisector of he_face[h] and he_face[he_twin[h]].
 
 
+cdef extern from *:
+    """
+    /* edge_order's band of magnitudes (see there) and its constants: 2^-53, and Shewchuk's error bound
+       of a 2x2 determinant of differences, (3 + 16 eps) eps */
+    #define TV_ORDER_BAND_LOW 0x1p-400
+    #define TV_ORDER_BAND_HIGH 0x1p400
+    #define TV_ORDER_EPS 0x1p-53
+    #define TV_ORDER_CCW ((3.0 + 16.0 * 0x1p-53) * 0x1p-53)
+    #define TV_ORDER_SLACK (1.0 + 0x1p-40)
+    """
+    const double ORDER_BAND_LOW "TV_ORDER_BAND_LOW"
+    const double ORDER_BAND_HIGH "TV_ORDER_BAND_HIGH"
+    const double ORDER_EPS "TV_ORDER_EPS"
+    const double ORDER_CCW "TV_ORDER_CCW"
+    const double ORDER_SLACK "TV_ORDER_SLACK"
+
+
+cdef inline int edge_order(double rx, double ry, double lx, double ly, double ax, double ay) noexcept nogil:
+    """Whether the Voronoi edge from vertex r to vertex l (correctly rounded circumcentres) runs with site
+    a on its left, from the rounded values alone: +1 surely (its Delaunay edge is locally Delaunay and the
+    Voronoi edge has a positive length), -1 surely not (the Delaunay edge is illegal), 0 undecided (the
+    exact in-circle test decides: a zero-length edge, or one too short for the rounding).
+
+    Site a (exact, the user's unit) and the edge's exact ends c_r, c_l lie on either side of the bisector
+    of a and its neighbour b, so T = cross(c_l - c_r, a - c_r) has the sign of the edge's length along
+    the bisector, counted positive the way a's cell runs (counter-clockwise): positive for a locally
+    Delaunay edge, zero for cocircular sites, negative for an illegal one. T is taken on the rounded ends
+    r = c_r + d_r, l = c_l + d_l, each coordinate within eta = 2^-53 m of the exact one (m: the largest
+    magnitude, in the band where no rounding is subnormal and no product overflows). Expanding the cross
+    product, with |cross(x, y)| <= |x|_1 |y|_1, |d_l - d_r|_1 <= 4 eta and |d_r|_1 <= 2 eta:
+        |T(r, l) - T| <= 2 eta |l - r|_1 + 4 eta |a - r|_1 + 24 eta^2,
+    and evaluating T(r, l) in doubles adds at most (3 + 16 eps) eps (|u1 v2| + |u2 v1|) (Shewchuk's
+    bound for orient2d, the same expression). The sum, raised for its own rounding, bounds the error."""
+    cdef double u1 = lx - rx, u2 = ly - ry, v1 = ax - rx, v2 = ay - ry
+    cdef double left = u1 * v2, right = u2 * v1, t = left - right
+    cdef double m = fabs(rx), eta, bound
+    m = fabs(ry) if fabs(ry) > m else m
+    m = fabs(lx) if fabs(lx) > m else m
+    m = fabs(ly) if fabs(ly) > m else m
+    m = fabs(ax) if fabs(ax) > m else m
+    m = fabs(ay) if fabs(ay) > m else m
+    if not (m >= ORDER_BAND_LOW and m <= ORDER_BAND_HIGH):
+        return 0                # (NaN too: a vertex that overflowed)
+    eta = m * ORDER_EPS
+    bound = (ORDER_CCW * (fabs(left) + fabs(right))
+             + 2.0 * eta * (fabs(u1) + fabs(u2)) + 4.0 * eta * (fabs(v1) + fabs(v2)) + 24.0 * eta * eta)
+    bound *= ORDER_SLACK         # (the exact magnitudes and differences within a few roundings of these)
+    if t > bound:
+        return 1
+    if t < -bound:
+        return -1
+    return 0
+
+
 cdef int find(int32_t* parent, int v) noexcept nogil:
     cdef int root = v, up
     while parent[root] != root:
@@ -44,7 +99,7 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
                           int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False,
-                          int walk_chunk=WALK_CHUNK):
+                          int walk_chunk=WALK_CHUNK, bint check=False):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -72,6 +127,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     clip_room : bool, leave room after the vertices for the points clip.clip_cells adds on the box
         (at most two per edge, and four corners), so that it writes them there instead of copying the
         vertices: address space only, as rows never written cost no memory.
+    check : bool, also test that every edge is locally Delaunay (a guard for a triangulation whose maker
+        did not: Fortune's sweep without its closing repair), at little cost: the walks have both ends
+        of each Voronoi edge at hand, and the exact in-circle test runs only where their rounded
+        values cannot tell. If some edge is not, the result is only {"illegal": count}: no diagram
+        (the caller repairs the triangulation and builds again).
 
     Returns
     -------
@@ -149,7 +209,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     centre = centre_buf
     tri = np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
-    cdef int n_zero = 0, n_marked = 0
+    cdef int n_zero = 0, n_marked = 0, n_illegal = 0
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
     cdef double* centres = &centre[0, 0] if n_finite > 0 else NULL
     cdef Walk w
@@ -157,7 +217,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     w.vor = &vor[0]; w.vid = &vid[0]; w.tri = tri_rows
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
     w.xs = &xs[0]; w.ys = &ys[0]; w.centre = centres; w.zero = &zero[0]
-    cdef int h0, marked
+    cdef int h0, marked, illegal
+    w.check = check
+    w.exponent = exponent
 
     with nogil:
         # the arrays written whole, faulted in by runs of pages (a part on each thread)
@@ -191,7 +253,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     prefetch(&opp[first_e[a + AHEAD]])
                 h_first[a] = h
                 h0 = h
-                h = walk_site(&w, a, h, 0, &n_marked)
+                h = walk_site(&w, a, h, 0, &n_marked, &n_illegal)
                 if h > h0:
                     face_edge[a] = h0
             h_first[n] = h
@@ -208,10 +270,12 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         prefetch(&tv[first_e[a + AHEAD]])
                         prefetch(&opp[first_e[a + AHEAD]])
                     marked = 0
-                    walk_site(&w, a, h_first[a], a - (a - lo) % walk_chunk, &marked)
+                    illegal = 0
+                    walk_site(&w, a, h_first[a], a - (a - lo) % walk_chunk, &marked, &illegal)
                     if h_first[a + 1] > h_first[a]:
                         face_edge[a] = h_first[a]
                     n_marked += marked
+                    n_illegal += illegal
                 lo = hi
             lo = 0
             while lo < h:
@@ -223,8 +287,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 lo = hi
 
         # the twins of the zero-length edges the walks marked (a twin comes after its edge)
-        if n_marked > 0:
+        if n_marked > 0 and n_illegal == 0:
             n_zero = mark_twins(h, &he_twin[0], &zero[0])
+    if n_illegal > 0:
+        return {"illegal": n_illegal}      # (not a Delaunay triangulation: no diagram)
     if n_zero > 0:
         parent = np.arange(max(n_finite, 1), dtype=np.int32)
         with nogil:
@@ -278,9 +344,11 @@ cdef struct Walk:
     const double* ys
     const double* centre
     signed char* zero
+    bint check                      # test each edge's order too (edge_order), counting illegal ones
+    int exponent                    # the sites are in the unit 2^-exponent of the vertices'
 
 
-cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked) noexcept nogil:
+cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, int* n_illegal) noexcept nogil:
     """The cell of site a, counter-clockwise from first_e[a]; returns the next free half-edge.
 
     One half-edge per Delaunay edge a->b with b finite, from h on: its origin is the vertex of the
@@ -295,6 +363,11 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked) n
     only an edge whose ends have equal rounded centres can join cocircular triangles; the exact
     in-circle test decides. (Distinct vertices that round to one point, nearly cocircular sites, are
     kept apart: the clipper names rounded points by their values.)
+
+    With w.check, every edge is also tested to be locally Delaunay (a guard over a triangulation whose
+    maker did not guarantee it: Fortune's sweep), on the rounded vertices first (edge_order), by the
+    exact in-circle test where they cannot tell; n_illegal counts the edges that are not. The cells are
+    then not to be used: the caller repairs the triangulation and walks again.
     """
     # (locals, so that the stores below do not make the compiler read the struct again)
     cdef const int32_t* tv = w.tv
@@ -306,10 +379,16 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked) n
     cdef int32_t* he_twin = w.he_twin
     cdef int32_t* he_face = w.he_face
     cdef int e0 = w.first_e[a], e, b, t, o, g, vr, vl, inf = w.inf
-    cdef double rx = 0.0, ry = 0.0, lx = 0.0, ly = 0.0
-    cdef bint linked
+    cdef double rx = 0.0, ry = 0.0, lx = 0.0, ly = 0.0, ax = 0.0, ay = 0.0
+    cdef bint linked, check = w.check, rounded_ok = False
+    cdef int sign
     if e0 < 0:
         return h                # a repeated site, or none of the triangles (no cell)
+    if check:
+        # site a in the vertices' unit, exactly (else every edge of this walk goes to the exact test)
+        ax = ldexp(w.xs[a], w.exponent)
+        ay = ldexp(w.ys[a], w.exponent)
+        rounded_ok = ldexp(ax, -w.exponent) == w.xs[a] and ldexp(ay, -w.exponent) == w.ys[a]
     t = opp[e0] // 3
     vr = vid[t]
     if vr >= 0:
@@ -333,8 +412,17 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked) n
             he_twin[g] = h
             he_twin[h] = g if linked else -1 - o
             he_face[h] = a
-            if lx == rx and ly == ry and vr >= 0 and vl >= 0 and b > a:
-                if cocircular(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys):
+            if check:
+                # each edge once, from its smaller site; hull edges (an infinite side) are the hull's
+                if vr >= 0 and vl >= 0 and b > a and (not rounded_ok or edge_order(rx, ry, lx, ly, ax, ay) <= 0):
+                    sign = far_site_inside(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys)
+                    if sign == 0:
+                        w.zero[h] = 1
+                        n_marked[0] += 1
+                    elif sign > 0:
+                        n_illegal[0] += 1
+            elif lx == rx and ly == ry and vr >= 0 and vl >= 0 and b > a:
+                if far_site_inside(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys) == 0:
                     w.zero[h] = 1
                     n_marked[0] += 1
             h += 1
@@ -369,12 +457,13 @@ cdef inline int mark_twin(int g, const int32_t* he_twin, signed char* zero) noex
     return 0
 
 
-cdef inline bint cocircular(int a, int b, const int32_t* t_right, const int32_t* t_left, const double* xs,
-                            const double* ys) noexcept nogil:
-    # the triangles on both sides of Delaunay edge a-b share their circumcircle (exactly)
+cdef inline int far_site_inside(int a, int b, const int32_t* t_right, const int32_t* t_left, const double* xs,
+                                const double* ys) noexcept nogil:
+    # Delaunay edge a->b between triangle (b, a, c) on its right and (a, b, d) on its left (both
+    # counter-clockwise): +1 if d lies strictly inside the circle of (b, a, c) (the edge is illegal),
+    # 0 on it (degenerate case: four cocircular sites, one Voronoi vertex), -1 outside (exact)
     cdef int c = third(t_right, a, b), d = third(t_left, a, b)
-    # degenerate case: four cocircular sites
-    return incircle(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], xs[d], ys[d]) == 0
+    return incircle(xs[b], ys[b], xs[a], ys[a], xs[c], ys[c], xs[d], ys[d])
 
 
 cdef inline int next_in_cell(int g, int h, const int32_t* he_face, const int32_t* face_edge) noexcept nogil:

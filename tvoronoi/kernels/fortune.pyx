@@ -514,7 +514,7 @@ cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap
     s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
 
 
-def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True):
+def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True, bint guard=True):
     """Fortune's sweep over sites sorted by (y, x).
 
     Parameters
@@ -528,6 +528,10 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         Locate each site by a walk along the beach line from an arc met
         lately near its x (beach_line.locate_hinted); False: always down the
         tree. The same arcs either way (tests compare them).
+    guard : bool
+        Close with the exact repair, a guard that finds nothing to flip (``flips`` counts what it
+        flipped). False leaves the guard to the caller: the dual checks every edge as it walks
+        (dual.voronoi_from_delaunay's ``check``), for a fraction of the repair's cost.
 
     Returns
     -------
@@ -671,13 +675,14 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         if s.status != OK:
             out["status"] = s.status
             return out
-        stack = np.empty(3 * s.n_tri, np.int32)
-        queued = np.zeros(3 * s.n_tri, np.int8)
-        with nogil:
-            flips = repair(&s, &stack[0], &queued[0], max_repair_flips(s.n_tri))
-        if flips < 0:
-            out["status"] = NO_REPAIR
-            return out
+        if guard:
+            stack = np.empty(3 * s.n_tri, np.int32)
+            queued = np.zeros(3 * s.n_tri, np.int8)
+            with nogil:
+                flips = repair(&s, &stack[0], &queued[0], max_repair_flips(s.n_tri))
+            if flips < 0:
+                out["status"] = NO_REPAIR
+                return out
         out["tv"] = arrays["tv"][:3 * s.n_tri]
         out["opp"] = arrays["opp"][:3 * s.n_tri]
     out["flips"] = flips
