@@ -107,20 +107,20 @@ def assemble(
     if status != 0:
         raise EngineError("the clipper found a cell whose edges do not chain: please report this input")
 
-    # row maps: the row holding each row's cell, the engine site each row shows, its first half-edge
-    site_of, cell_of_row, face_edge = clip.rows_of_cells(
+    # row maps (the row holding each row's cell, each row's first half-edge) and the cells in input-row
+    # order: the clipper works in engine order, where a cell's edges and vertices lie near its
+    # neighbours' in memory; the rings are read in that order and each written at its row's place
+    site_of, face_edge, cell_offsets, cell_vertices = clip.rows_of_cells(
         owner,
         np.ascontiguousarray(perm, np.int32),
         np.ascontiguousarray(dup, np.int32),
         first8,
         np.ascontiguousarray(out["face_edge"], np.int32),
+        offsets,
+        ring,
         threads,
     )
-
-    # cells to input rows (CSR gather; the clipper works in engine order, where a cell's edges and
-    # vertices lie near its neighbours' in memory)
-    cell_offsets, cell_vertices = clip.cells_by_row(offsets, ring, cell_of_row, threads)
-    del ring, offsets, cell_of_row
+    del ring, offsets
 
     # engine sites to input rows in place (out is this build's own), and the vertices are the first
     # rows of the clipper's points (the same doubles): no second copy of either

@@ -23,12 +23,16 @@ def clip_cells(
     parallel_min: int = ...,
     room: F64 | None = None,
 ) -> tuple[F64, npt.NDArray[np.int64], I32, int]: ...
-def cells_by_row(
-    offsets: npt.NDArray[np.int64], ring: I32, cell_of_row: I32, threads: int = 1
-) -> tuple[npt.NDArray[np.int64], I32]: ...
 def rows_of_cells(
-    owner: I32, perm: I32, dup: I32, first: npt.NDArray[np.int8], face_edge: I32, threads: int = 1
-) -> tuple[I32, I32, I32]: ...
+    owner: I32,
+    perm: I32,
+    dup: I32,
+    first: npt.NDArray[np.int8],
+    face_edge: I32,
+    offsets: npt.NDArray[np.int64],
+    ring: I32,
+    threads: int = 1,
+) -> tuple[I32, I32, npt.NDArray[np.int64], I32]: ...
 def relabel(label: I32, ids: I32, threads: int = 1) -> I32: ...
 def straighten(
     points: F64,

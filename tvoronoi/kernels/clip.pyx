@@ -23,7 +23,7 @@ cdef enum:
     EXIT = 4
     WHOLE = 8       # the whole edge, both ends vertices in the closed box (the interior walk reads only flags)
     PARALLEL_MIN_CELLS = 1 << 15    # fewer cells are clipped on one thread
-    GATHER_AHEAD = 16   # cells_by_row: how many rows ahead a cell's offsets start loading
+    GATHER_AHEAD = 16   # rows_of_cells: how many sites ahead a row's offset starts loading
 
 
 def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] vertices,
@@ -479,87 +479,72 @@ cdef void release(CellEdges* C) noexcept nogil:
         free(C.start); free(C.end); free(C.entry); free(C.exit_); free(C.has); free(C.nbx); free(C.nby)
 
 
-def cells_by_row(const int64_t[::1] offsets, const int32_t[::1] ring, const int32_t[::1] cell_of_row,
-                 int threads=1):
-    """Rings gathered into input-row order: row r shows cell cell_of_row[r] (-1: no cell).
+def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32_t[::1] dup,
+                  const signed char[::1] first, const int32_t[::1] face_edge, const int64_t[::1] offsets,
+                  const int32_t[::1] ring, int threads=1):
+    """The Diagram's row maps and its cells in input-row order, from the clipper's cells in engine order.
 
-    Returns (cell_offsets (rows + 1,) int64, cell_vertices (K,) int32), the CSR of Diagram. The rings
-    are copied on ``threads`` threads (the same arrays for any count).
+    Site k is input row perm[k]; its cell (first[k]: it has one) is held by row owner[k] (a repeated
+    site k shows the cell of the owner of dup[k]); the clipper gave cell k as ring[offsets[k]:offsets[k + 1]].
+
+    Returns (site_of, row_face_edge, cell_offsets, cell_vertices): the row holding each row's cell and
+    each row's first half-edge (-1: none), (n,) int32 each; the CSR of the rows' cells, (n + 1,) int64 and
+    (K,) int32. Two passes over the sites in engine order (the rings read in order, each row's entries
+    written where it lies), on ``threads`` threads: the same arrays for any count (perm and the owners of
+    first sites are one-to-one).
     """
-    cdef Py_ssize_t rows = cell_of_row.shape[0], r
-    cdef int64_t c, total = 0
-    cdef int T = threads if rows >= PARALLEL_MIN_CELLS and threads > 1 else 1
-    cell_offsets_arr = np.empty(rows + 1, np.int64)
+    cdef Py_ssize_t n = perm.shape[0], k, r
+    cdef int T = threads if n >= PARALLEL_MIN_CELLS and threads > 1 else 1
+    cdef int32_t row
+    cdef int64_t total = 0, length, lo, hi, dst, j
+    site_of_arr = np.empty(n, np.int32)
+    face_edge_arr = np.empty(n, np.int32)
+    cell_offsets_arr = np.empty(n + 1, np.int64)
+    cdef int32_t[::1] site_of = site_of_arr, row_face_edge = face_edge_arr
     cdef int64_t[::1] cell_offsets = cell_offsets_arr
-    cdef int64_t length
+    cell_offsets[0] = 0
+    if n == 0:
+        return site_of_arr, face_edge_arr, cell_offsets_arr, np.empty(0, np.int32)
     with nogil:
-        # each row's ring length on the threads (the cells' offsets loaded GATHER_AHEAD rows ahead),
-        # then the offsets by a sum in row order
-        cell_offsets[0] = 0
-        for r in prange(rows, num_threads=T, schedule="static"):
-            if r + GATHER_AHEAD < rows and cell_of_row[r + GATHER_AHEAD] >= 0:
-                prefetch(&offsets[cell_of_row[r + GATHER_AHEAD]])
-            c = cell_of_row[r]
-            cell_offsets[r + 1] = offsets[c + 1] - offsets[c] if c >= 0 else 0
-        for r in range(rows):
+        # (written whole: faulted in by runs of pages, a part on each thread)
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            populate_part(&site_of[0], n * sizeof(int32_t), <int> k, T)
+            fill_int32(&row_face_edge[k * n // T], (k + 1) * n // T - k * n // T, -1)
+            populate_part(&cell_offsets[1], n * sizeof(int64_t), <int> k, T)
+            for r in range(k * n // T, (k + 1) * n // T):
+                cell_offsets[r + 1] = 0
+        # each row: the row holding its cell, and for a row holding one its first half-edge and its
+        # ring's length; then the lengths summed into offsets in row order
+        for k in prange(n, num_threads=T, schedule="static"):
+            r = dup[k] if dup[k] >= 0 else k
+            site_of[perm[k]] = owner[r]
+            if first[k]:
+                row = owner[k]
+                row_face_edge[row] = face_edge[k]
+                cell_offsets[row + 1] = offsets[k + 1] - offsets[k]
+        for r in range(n):
             length = cell_offsets[r + 1]
-            cell_offsets[r + 1] = total + length
             total += length
+            cell_offsets[r + 1] = total
     vertices_arr = np.empty(total, np.int32)
     cdef int32_t[::1] out = vertices_arr
     cdef int32_t* out_p = &out[0] if total > 0 else NULL
-    cdef int64_t k, lo, hi
-    cdef const int32_t* ring_p = &ring[0] if ring.shape[0] > 0 else NULL     # (a prefetch never faults)
+    cdef const int32_t* ring_p = &ring[0] if ring.shape[0] > 0 else NULL
     with nogil:
         for k in prange(T, num_threads=T, schedule="static", chunksize=1):
-            populate_part(out_p, total * sizeof(int32_t), <int> k, T)     # (written whole: by runs of pages)
-        # rows in input order are cells in random engine order: each cell's offsets are loaded GATHER_AHEAD
-        # rows ahead and its ring half as far ahead, so that a copy seldom waits for memory
-        for r in prange(rows, num_threads=T, schedule="static"):
-            if r + GATHER_AHEAD < rows and cell_of_row[r + GATHER_AHEAD] >= 0:
-                prefetch(&offsets[cell_of_row[r + GATHER_AHEAD]])
-            if r + GATHER_AHEAD // 2 < rows and cell_of_row[r + GATHER_AHEAD // 2] >= 0:
-                prefetch(ring_p + offsets[cell_of_row[r + GATHER_AHEAD // 2]])
-            c = cell_of_row[r]
-            if c >= 0:
-                lo = offsets[c]
-                hi = offsets[c + 1]
-                for k in range(hi - lo):
-                    out_p[cell_offsets[r] + k] = ring_p[lo + k]
-    return cell_offsets_arr, vertices_arr
-
-
-def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32_t[::1] dup,
-                  const signed char[::1] first, const int32_t[::1] face_edge, int threads=1):
-    """The Diagram's row maps from engine order, in one pass: site k is input row perm[k], its cell is
-    held by row owner[k] (a repeated site k: by the owner of dup[k]), first[k] says it has a cell.
-
-    Returns (site_of, cell_of_row, row_face_edge), each (n,) int32: the row holding each row's cell; the
-    engine site whose cell each row shows (-1: none); each row's first half-edge (-1: none). The same
-    arrays for any thread count (perm and the owners of first sites are one-to-one).
-    """
-    cdef Py_ssize_t n = perm.shape[0], k
-    cdef int T = threads if n >= PARALLEL_MIN_CELLS and threads > 1 else 1
-    cdef int r
-    site_of_arr = np.empty(n, np.int32)
-    cell_of_row_arr = np.empty(n, np.int32)
-    face_edge_arr = np.empty(n, np.int32)
-    cdef int32_t[::1] site_of = site_of_arr, cell_of_row = cell_of_row_arr, row_face_edge = face_edge_arr
-    if n == 0:
-        return site_of_arr, cell_of_row_arr, face_edge_arr
-    with nogil:
-        # (written whole: faulted in by runs of pages)
-        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
-            populate_part(&site_of[0], n * sizeof(int32_t), <int> k, T)
-            fill_int32(&cell_of_row[k * n // T], (k + 1) * n // T - k * n // T, -1)
-            fill_int32(&row_face_edge[k * n // T], (k + 1) * n // T - k * n // T, -1)
+            populate_part(out_p, total * sizeof(int32_t), <int> k, T)
+        # the rings, read in engine order, each written at its row's place (that place's offset is
+        # loaded GATHER_AHEAD sites ahead, so that the store seldom waits for it)
         for k in prange(n, num_threads=T, schedule="static"):
-            r = dup[k] if dup[k] >= 0 else <int> k
-            site_of[perm[k]] = owner[r]
+            if k + GATHER_AHEAD < n and first[k + GATHER_AHEAD]:
+                prefetch(&cell_offsets[owner[k + GATHER_AHEAD]])
             if first[k]:
-                cell_of_row[owner[k]] = <int32_t> k
-                row_face_edge[owner[k]] = face_edge[k]
-    return site_of_arr, cell_of_row_arr, face_edge_arr
+                lo = offsets[k]
+                hi = offsets[k + 1]
+                dst = cell_offsets[owner[k]]
+                for j in range(hi - lo):
+                    out_p[dst + j] = ring_p[lo + j]
+    return site_of_arr, face_edge_arr, cell_offsets_arr, vertices_arr
 
 
 def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
