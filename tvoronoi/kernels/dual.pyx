@@ -59,7 +59,8 @@ cdef inline int edge_order(double rx, double ry, double lx, double ly, double ax
     the bisector, counted positive the way a's cell runs (counter-clockwise): positive for a locally
     Delaunay edge, zero for cocircular sites, negative for an illegal one. T is taken on the rounded ends
     r = c_r + d_r, l = c_l + d_l, each coordinate within eta = 2^-53 m of the exact one (m: the largest
-    magnitude, in the band where no rounding is subnormal and no product overflows). Expanding the cross
+    magnitude, in a band where no product overflows and the rounding of subnormal values, at most
+    2^-1075 each, lies far below the eta^2 term; a subnormal difference is exact). Expanding the cross
     product, with |cross(x, y)| <= |x|_1 |y|_1, |d_l - d_r|_1 <= 4 eta and |d_r|_1 <= 2 eta:
         |T(r, l) - T| <= 2 eta |l - r|_1 + 4 eta |a - r|_1 + 24 eta^2,
     and evaluating T(r, l) in doubles adds at most (3 + 16 eps) eps (|u1 v2| + |u2 v1|) (Shewchuk's
