@@ -18,7 +18,7 @@ from tests.flips import flip_edges, nxt, prv
 from tvoronoi import build, engines, halves
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.generators import generate
-from tvoronoi.kernels import dual
+from tvoronoi.kernels import dual, fortune
 
 FAMILIES = sorted(adversarial.FAMILIES)
 # powers of two: the same geometry, with the vertices inside edge_order's band, below it and above it
@@ -147,3 +147,21 @@ def test_a_build_by_halves_is_checked_in_its_dual():
         ra = a.cell_points[a.cell_vertices[a.cell_offsets[k] : a.cell_offsets[k + 1]]]
         rb = b.cell_points[b.cell_vertices[b.cell_offsets[k] : b.cell_offsets[k + 1]]]
         assert np.array_equal(ra, rb)
+
+
+def test_a_repair_that_does_not_converge_is_an_error(monkeypatch, rng):
+    """Were the triangulation so broken that the bounded repair gave up (as the sweep's own guard would
+    have, with STATUS_NO_REPAIR), the build stops with an error naming the way out, not a diagram."""
+    t = triangulation(adversarial.make("circle_rounded").points, guard=False)
+    assert t is not None
+    assert flip_edges(t.sites.xs, t.sites.ys, t.tv, t.opp, rng, 10) > 0
+    monkeypatch.setattr(fortune, "legalize", lambda *args, **kw: -1)
+    with pytest.raises(TvoronoiError, match="engine='incremental'"):
+        t.voronoi()
+
+
+def test_renumbering_keeps_an_unchecked_triangulation_unchecked():
+    t = triangulation(adversarial.make("spiral").points, guard=False)
+    assert t is not None and not t.checked
+    assert not engines.renumbered(t).checked
+    assert engines.renumbered(triangulation(adversarial.make("spiral").points, guard=True)).checked

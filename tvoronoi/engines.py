@@ -204,7 +204,11 @@ class Triangulation:
             s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room, check=not self.checked
         )
         if "illegal" in out:
-            fortune.legalize(s.xs, s.ys, self.tv, self.opp)
+            if fortune.legalize(s.xs, s.ys, self.tv, self.opp, bounded=True) < 0:
+                raise TvoronoiError(
+                    f"{fortune.STATUS_MESSAGES[fortune.STATUS_NO_REPAIR]} on {len(s.xs)} points; "
+                    "build with engine='incremental' instead, and please report the input"
+                )
             out = dual.voronoi_from_delaunay(s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room)
         out["dup"] = self.dup
         return out
@@ -253,7 +257,7 @@ def renumbered(t: Triangulation, threads: int = 1, layout: SiteLayout | None = N
     dup = t.dup[layout.new_to_old]
     repeats = dup >= 0
     dup[repeats] = layout.old_to_new[dup[repeats]]
-    return Triangulation(t.engine, layout.sites, tv, opp, dup)
+    return Triangulation(t.engine, layout.sites, tv, opp, dup, checked=t.checked)
 
 
 def triangulate(sites: Sites, *, engine: str, insertion: str = "brio", guard: bool = True) -> Triangulation:

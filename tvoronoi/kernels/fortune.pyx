@@ -723,11 +723,13 @@ cdef dict _state(Sweep* s, dict arrays):
     }
 
 
-def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_t[::1] opp):
+def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_t[::1] opp, bint bounded=False):
     """Flip the edges of a triangulation (tv, opp; vertex n at infinity) until it is Delaunay.
 
-    The exact repair that closes every sweep, exposed for tests. Modifies tv
-    and opp in place; returns the number of flips.
+    The exact repair that closes every sweep (and the one engines.Triangulation.voronoi runs where the
+    dual's check found an illegal edge). Modifies tv and opp in place; returns the number of flips, or
+    -1 when ``bounded`` and more were needed than a sweep's guard allows (then tv, opp were no
+    triangulation).
     """
     cdef Sweep s
     cdef int n_he = tv.shape[0]
@@ -741,7 +743,7 @@ def legalize(const double[::1] xs, const double[::1] ys, int32_t[::1] tv, int32_
     s.opp = &opp[0]
     s.n_tri = n_he // 3
     with nogil:
-        flips = repair(&s, &stack[0], &queued[0], 2_000_000_000)
+        flips = repair(&s, &stack[0], &queued[0], max_repair_flips(s.n_tri) if bounded else 2_000_000_000)
     return flips
 
 
