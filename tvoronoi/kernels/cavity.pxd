@@ -42,8 +42,7 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     # triangles (m.cavity, m.bnd_a, m.bnd_b, m.bnd_twin; m.n_cav, m.n_bnd)
     """
     cdef double px = m.x[i], py = m.y[i]
-    cdef int32_t conflict, tested
-    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, a
+    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, a, came
     # degenerate case: a repeated point; the walk ends on a triangle that has it as a vertex
     if not is_infinite(m, t0):
         for k in range(3):
@@ -53,27 +52,27 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
                 if m.head != NULL:
                     m.where[i] = -1
                 return False
-    m.epoch += 1
-    conflict = 2 * m.epoch
-    tested = conflict + 1
-    m.stamp[t0] = conflict
+    # The cavity's triangles form a tree across their shared edges: every vertex of a cavity triangle
+    # stays a vertex of the triangulation, so it lies on the cavity's boundary and no cavity triangle is
+    # reached twice. The search skips only the edge back to the triangle it came from; a triangle
+    # outside that touches the cavity along two edges is tested twice, with the same exact answer.
     m.cavity[0] = t0
+    m.cav_from[0] = -1
     while j < n_cav:
         t = m.cavity[j]
+        came = m.cav_from[j]
         j += 1
         for k in range(3):
             e = 3 * t + k
+            if e == came:
+                continue
             o = m.opp[e]
             nt = o // 3
-            if m.stamp[nt] == conflict:
+            if in_conflict(m, nt, px, py):
+                m.cavity[n_cav] = nt
+                m.cav_from[n_cav] = o
+                n_cav += 1
                 continue
-            if m.stamp[nt] != tested:
-                if in_conflict(m, nt, px, py):
-                    m.stamp[nt] = conflict
-                    m.cavity[n_cav] = nt
-                    n_cav += 1
-                    continue
-                m.stamp[nt] = tested
             m.bnd_a[n_bnd] = m.tv[e]
             m.bnd_b[n_bnd] = m.tv[nxt(e)]
             m.bnd_twin[n_bnd] = o

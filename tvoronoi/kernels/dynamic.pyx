@@ -118,7 +118,6 @@ cdef class DynamicMesh:
         self.m.jump_g = 0
         self.m.jump_grid = NULL
         self.m.walk_steps = 0
-        self.m.epoch = 0
         self.m.inf = INF_VERTEX
         self.m.n = 0
         self.m.head = NULL
@@ -133,8 +132,8 @@ cdef class DynamicMesh:
         old = self.arrays
         spec = {"x": (cap_v, np.float64), "y": (cap_v, np.float64), "vedge": (cap_v, np.int32),
                 "vmap": (cap_v, np.int32), "dup": (cap_v, np.int32),
-                "tv": (3 * cap_t, np.int32), "opp": (3 * cap_t, np.int32), "stamp": (cap_t, np.int32),
-                "cavity": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
+                "tv": (3 * cap_t, np.int32), "opp": (3 * cap_t, np.int32), "cavity": (cap_t, np.int32),
+                "cav_from": (cap_t, np.int32), "bnd_a": (cap_t + 2, np.int32), "bnd_b": (cap_t + 2, np.int32),
                 "bnd_twin": (cap_t + 2, np.int32), "free_tri": (cap_t, np.int32),
                 "changed": (cap_t + 2, np.int32), "vmark": (cap_v, np.int32), "nextb": (cap_v, np.int32),
                 "ring_state": (cap_v, np.int8), "queued": (cap_v, np.int32)}
@@ -149,7 +148,7 @@ cdef class DynamicMesh:
         self.cap_t = cap_t
         cdef double[::1] x = new["x"], y = new["y"]
         cdef int32_t[::1] vedge = new["vedge"], vmap = new["vmap"], dup = new["dup"], tv = new["tv"]
-        cdef int32_t[::1] opp = new["opp"], stamp = new["stamp"], cavity = new["cavity"]
+        cdef int32_t[::1] opp = new["opp"], cavity = new["cavity"], cav_from = new["cav_from"]
         cdef int32_t[::1] bnd_a = new["bnd_a"], bnd_b = new["bnd_b"], bnd_twin = new["bnd_twin"]
         cdef int32_t[::1] free_tri = new["free_tri"], changed = new["changed"]
         cdef int32_t[::1] vmark = new["vmark"], nextb = new["nextb"]
@@ -168,8 +167,8 @@ cdef class DynamicMesh:
         self.m.dup = &dup[0]
         self.m.tv = &tv[0]
         self.m.opp = &opp[0]
-        self.m.stamp = &stamp[0]
         self.m.cavity = &cavity[0]
+        self.m.cav_from = &cav_from[0]
         self.m.bnd_a = &bnd_a[0]
         self.m.bnd_b = &bnd_b[0]
         self.m.bnd_twin = &bnd_twin[0]

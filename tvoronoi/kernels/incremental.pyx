@@ -159,9 +159,9 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     cdef int max_tri = 2 * n - 2
     cdef int32_t[::1] tv = np.empty(3 * max_tri, np.int32)
     cdef int32_t[::1] opp = np.empty(3 * max_tri, np.int32)
-    cdef int32_t[::1] stamp = np.empty(max_tri, np.int32)
     cdef int32_t[::1] vmap = np.empty(n + 1, np.int32)
     cdef int32_t[::1] cavity = np.empty(max_tri, np.int32)
+    cdef int32_t[::1] cav_from = np.empty(max_tri, np.int32)
     cdef int32_t[::1] bnd_a = np.empty(max_tri + 2, np.int32)
     cdef int32_t[::1] bnd_b = np.empty(max_tri + 2, np.int32)
     cdef int32_t[::1] bnd_twin = np.empty(max_tri + 2, np.int32)
@@ -171,9 +171,9 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     m.y = &ys[0]
     m.tv = &tv[0]
     m.opp = &opp[0]
-    m.stamp = &stamp[0]
     m.vmap = &vmap[0]
     m.cavity = &cavity[0]
+    m.cav_from = &cav_from[0]
     m.bnd_a = &bnd_a[0]
     m.bnd_b = &bnd_b[0]
     m.bnd_twin = &bnd_twin[0]
@@ -203,7 +203,6 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
     m.vedge = NULL
     m.changed = NULL
     m.n_changed = 0
-    m.epoch = 0
     m.n = n
     m.inf = n
     m.n_tri = 0
@@ -214,7 +213,6 @@ def triangulate(const double[::1] xs, const double[::1] ys, bint conflict_lists=
         # faulted in by runs of pages
         populate(&tv[0], 3 * max_tri * sizeof(int32_t))
         populate(&opp[0], 3 * max_tri * sizeof(int32_t))
-        fill_int32(&stamp[0], max_tri, -1)
         status = build(&m, &ins[0], stop_after)
     if status != STATUS_OK:
         return status, np.empty(0, np.int32), np.empty(0, np.int32), np.asarray(dup)

@@ -30,9 +30,9 @@ cdef struct Mesh:
     const double* y
     int32_t* tv
     int32_t* opp
-    int32_t* stamp      # per triangle: 2 * epoch if in the current cavity, 2 * epoch + 1 if tested and not
     int32_t* vmap       # per vertex: the new triangle whose cavity-boundary edge starts there
     int32_t* cavity     # triangles of the current cavity
+    int32_t* cav_from   #   and for each, its half-edge back to the cavity triangle it was reached from
     int32_t* bnd_a      # cavity boundary edges a->b and the outside twin half-edge
     int32_t* bnd_b
     int32_t* bnd_twin
@@ -64,7 +64,6 @@ cdef struct Mesh:
     int vmap_inf        # vmap's entry for the vertex at infinity
     int n_tri
     int last            # a recently created finite triangle: where walks start
-    int epoch           # counts insertions: stamps of older cavities never match
     int n_cav           # the last cavity found: its triangles and boundary edges
     int n_bnd
 
