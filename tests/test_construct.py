@@ -72,6 +72,36 @@ def test_delaunay_triangles_are_correctly_rounded(offset, scale):
         assert got[k, 0] == rounded(ux, e) and got[k, 1] == rounded(uy, e), (a, b, c)
 
 
+@pytest.mark.parametrize("offset, scale, e", [(0.0, 1.0, 0), (1.0, 1.0, 0), (4.5e5, 1e3, 3), (-3.0, 1e-3, -1060)])
+def test_blocks_give_the_centres_one_by_one_gives(offset, scale, e):
+    """The dual's blocks (a vectorized first tier, then circumcentre for what it leaves open) and
+    circumcentre called on each triangle give the same doubles, on a build's triangles and on hard ones
+    (nearly collinear, near ties of a noisy lattice, far from the origin, results out of range), in
+    counts that leave partial blocks."""
+    from tvoronoi import engines
+
+    rng = np.random.default_rng(21)
+    pts = offset + scale * rng.random((30011, 2))
+    s = engines.prepare(pts[:, 0], pts[:, 1], engine="incremental", exponent=engines.scale_exponent(pts))
+    tri = engines.triangulate(s, engine="incremental").voronoi()["triangles"]
+    sets = [(s.xs, s.ys, np.ascontiguousarray(tri))]
+    t = np.linspace(0, 1, 301)
+    line = offset + scale * np.column_stack((t, 1 + 2 * t))
+    k = 40
+    g = np.stack(np.meshgrid(np.arange(k), np.arange(k)), -1).reshape(-1, 2) * 2.0**-6
+    g = offset + scale * (g + 1e-15 * rng.standard_normal(g.shape))
+    for p, m in ((line, 299), (g, 997)):
+        i = rng.integers(0, len(p) - 2, m)
+        idx = np.column_stack((i, i + 1, i + 2)) if p is line else rng.integers(0, len(p), (m, 3))
+        keep = [not collinear(p[a], p[b], p[c]) for a, b, c in idx]
+        sets.append((np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]), idx[keep].astype(np.int32)))
+    for xs, ys, idx in sets:
+        blocks = dual.circumcentres(xs, ys, idx, e)
+        single = dual.circumcentres(xs, ys, idx, e, by_blocks=False)
+        assert len(idx) % 64 != 0
+        np.testing.assert_array_equal(blocks.view(np.int64), single.view(np.int64))
+
+
 def test_nearly_collinear_triangles():
     # sites on y = 1 + 2x rounded to doubles: the determinant is a few ulps, the vertex far away
     t = np.linspace(0, 1, 60)

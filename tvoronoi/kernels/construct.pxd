@@ -20,8 +20,11 @@
 # estimate r of it is refined by comparing p with (r +- half a gap) * q exactly until r is the nearest
 # double. The circumcentre first tries plain doubles with a proven error bound and returns at once
 # when the bound shows that the rounding is already correct (about 5 vertices in 6 of uniform sites),
-# then long double the same way (nearly all of the rest).
+# then pairs of doubles or long double the same way (nearly all of the rest). circumcentres_block does
+# the first tier for a block of triangles in one loop the compiler vectorizes (the dual's way), and
+# calls circumcentre for what it leaves open: the same doubles.
 
+cimport cython
 from libc.math cimport fabs, fabsl, frexp, ldexp, nextafter, INFINITY
 from libc.string cimport memcpy
 from libc.stdint cimport uint64_t
@@ -479,50 +482,77 @@ cdef inline bint pair_settled(double a, double ns, double nl, double m, double s
     return rounds_alike(s0, sm, 1.0001 * w2 + 3.0 * u * fabs(sm) + 1e-300, e, out)
 
 
+cdef struct Estimate:
+    # circumcentre's first tier: the centre relative to a in plain doubles (q) and the bound on its
+    # error (w), with the values the second tier carries on
+    double bax, bay, cax, cay, l, r, det, det_sum, err_det, bb, cc, tx1, tx2, ty1, ty2, nx, ny, inv, qx, qy, wx, wy
+
+
+cdef inline bint usable(double det, double err_det, double det_sum) noexcept nogil:
+    # an Estimate's bound holds: the determinant is well clear of its error, and nothing underflows
+    return fabs(det) > 8.0 * err_det and det_sum > 1e-280
+
+
+@cython.cdivision(True)     # det == 0 gives inf, never an exception (and the estimate is not usable)
+cdef inline void estimate_centre(double ax, double ay, double bx, double by, double cx, double cy,
+                                 Estimate* f) noexcept nogil:
+    """The plain-double estimate of the circumcentre of a, b, c relative to a, and its error bound (only
+    meaningful where usable(f.det, f.err_det, f.det_sum)). Straight-line code, so that a loop over many
+    triangles vectorizes."""
+    cdef double err_det, adet, ig
+    f.bax = bx - ax
+    f.bay = by - ay
+    f.cax = cx - ax
+    f.cay = cy - ay
+    f.l = f.bax * f.cay
+    f.r = f.bay * f.cax
+    f.det = f.l - f.r
+    f.det_sum = fabs(f.l) + fabs(f.r)
+    err_det = CCW_ERRBOUND_A * f.det_sum
+    f.err_det = err_det
+    adet = fabs(f.det)
+    f.bb = f.bax * f.bax + f.bay * f.bay
+    f.cc = f.cax * f.cax + f.cay * f.cay
+    f.tx1 = f.cay * f.bb
+    f.tx2 = f.bay * f.cc
+    f.ty1 = f.bax * f.cc
+    f.ty2 = f.cax * f.bb
+    f.nx = f.tx1 - f.tx2
+    f.ny = f.ty1 - f.ty2
+    # q = n / (2 det) by one division: q = n * inv, two roundings, |q - n / (2 det)| <= 3 eps |q|
+    f.inv = 0.5 / f.det
+    f.qx = f.nx * f.inv
+    f.qy = f.ny * f.inv
+    # |n - N| <= 8 eps (|terms|) (seven roundings on each term); |det - D| <= err_det; then
+    # |n / (2 det) - N / (2 D)| <= A / (2 |det| (|det| - err_det)), A = |n| err_det + |det| err_n, and with
+    # r = err_det / |det| < 1/8: 1 / (2 |det| (|det| - err_det)) = 2 inv^2 / (1 - r) <= 2 inv^2 (1 + 4 err_det |inv|)
+    # (the factor 1 + 1e-5 covers the rounding of the bound itself)
+    ig = 2.00002 * f.inv * f.inv * (1.0 + 4.0 * err_det * fabs(f.inv))
+    # w: the bound, plus what rounds_alike needs for the rounding of q -+ w: w (1 - eps) >= bound + eps |q|
+    # (6 eps |q| for the division's 3 and this 2, with room; 1e-300 for roundings below the normal range)
+    f.wx = (fabs(f.nx) * err_det + adet * 8.0 * EPSILON * (fabs(f.tx1) + fabs(f.tx2))) * ig + 6.0 * EPSILON * fabs(f.qx) + 1e-300
+    f.wy = (fabs(f.ny) * err_det + adet * 8.0 * EPSILON * (fabs(f.ty1) + fabs(f.ty2))) * ig + 6.0 * EPSILON * fabs(f.qy) + 1e-300
+
+
 cdef inline void circumcentre(double ax, double ay, double bx, double by, double cx, double cy, int e,
                               double* ux, double* uy) noexcept nogil:
     """The circumcentre of a, b, c (not collinear), each coordinate correctly rounded, times 2^e."""
-    cdef double bax = bx - ax, bay = by - ay, cax = cx - ax, cay = cy - ay
-    cdef double l = bax * cay, r = bay * cax
-    cdef double det = l - r, det_sum = fabs(l) + fabs(r)
-    cdef double err_det = CCW_ERRBOUND_A * det_sum
-    cdef double bb, cc, tx1, tx2, ty1, ty2, nx, ny, adet, inv, ig, qx, qy, wx, wy
+    cdef Estimate f
     cdef bint done_x, done_y
     cdef int pairs
-    adet = fabs(det)
-    # fast path: relative coordinates in doubles, with a bound on their error; skipped when the
-    # determinant is too close to its error or values could underflow
-    if adet > 8.0 * err_det and det_sum > 1e-280:
-        bb = bax * bax + bay * bay
-        cc = cax * cax + cay * cay
-        tx1 = cay * bb
-        tx2 = bay * cc
-        ty1 = bax * cc
-        ty2 = cax * bb
-        nx = tx1 - tx2
-        ny = ty1 - ty2
-        # q = n / (2 det) by one division: q = n * inv, two roundings, |q - n / (2 det)| <= 3 eps |q|
-        inv = 0.5 / det
-        qx = nx * inv
-        qy = ny * inv
-        # |n - N| <= 8 eps (|terms|) (seven roundings on each term); |det - D| <= err_det; then
-        # |n / (2 det) - N / (2 D)| <= A / (2 |det| (|det| - err_det)), A = |n| err_det + |det| err_n, and with
-        # r = err_det / |det| < 1/8: 1 / (2 |det| (|det| - err_det)) = 2 inv^2 / (1 - r) <= 2 inv^2 (1 + 4 err_det |inv|)
-        # (the factor 1 + 1e-5 covers the rounding of the bound itself)
-        ig = 2.00002 * inv * inv * (1.0 + 4.0 * err_det * fabs(inv))
-        # w: the bound, plus what rounds_alike needs for the rounding of q -+ w: w (1 - eps) >= bound + eps |q|
-        # (6 eps |q| for the division's 3 and this 2, with room; 1e-300 for roundings below the normal range)
-        wx = (fabs(nx) * err_det + adet * 8.0 * EPSILON * (fabs(tx1) + fabs(tx2))) * ig + 6.0 * EPSILON * fabs(qx) + 1e-300
-        wy = (fabs(ny) * err_det + adet * 8.0 * EPSILON * (fabs(ty1) + fabs(ty2))) * ig + 6.0 * EPSILON * fabs(qy) + 1e-300
-        done_x = rounds_alike(ax, qx, wx, e, ux)
-        done_y = rounds_alike(ay, qy, wy, e, uy)
+    estimate_centre(ax, ay, bx, by, cx, cy, &f)
+    # fast path: relative coordinates in doubles, with a bound on their error
+    if usable(f.det, f.err_det, f.det_sum):
+        done_x = rounds_alike(ax, f.qx, f.wx, e, ux)
+        done_y = rounds_alike(ay, f.qy, f.wy, e, uy)
         if done_x and done_y:
             return
         # the coordinates the doubles left open (rarely both): as pairs of doubles where the differences
         # are exact (nearly always; what the pairs leave open is within a few eps^2 of a tie, beyond long
         # double too), else in long double
-        pairs = circumcentre_pairs(ax, ay, bx, by, cx, cy, bax, bay, cax, cay, l, r, det, det_sum, bb, cc, tx1,
-                                   tx2, ty1, ty2, nx, ny, inv, qx, qy, e, not done_x, not done_y, ux, uy)
+        pairs = circumcentre_pairs(ax, ay, bx, by, cx, cy, f.bax, f.bay, f.cax, f.cay, f.l, f.r, f.det,
+                                   f.det_sum, f.bb, f.cc, f.tx1, f.tx2, f.ty1, f.ty2, f.nx, f.ny, f.inv, f.qx,
+                                   f.qy, e, not done_x, not done_y, ux, uy)
         if pairs == 1:
             return
         if pairs == -1 and circumcentre_long(ax, ay, bx, by, cx, cy, e, not done_x, not done_y, ux, uy):
@@ -530,6 +560,44 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
     if circumcentre_relative(ax, ay, bx, by, cx, cy, e, ux, uy):
         return
     circumcentre_exact(ax, ay, bx, by, cx, cy, e, ux, uy)
+
+
+cdef enum:
+    CENTRE_BLOCK = 64     # triangles a block of circumcentres gathers (circumcentres_block)
+
+
+cdef inline void circumcentres_block(int k, const double* ax, const double* ay, const double* bx,
+                                     const double* by, const double* cx, const double* cy, int e,
+                                     double* out, int out_stride) noexcept nogil:
+    """circumcentre of k <= CENTRE_BLOCK triangles given by their corners' coordinates, the centre of
+    triangle j written at out[j * out_stride] (x) and the next double (y): the same doubles, with the
+    first tier of all k in one loop that the compiler vectorizes, and the rest one by one."""
+    cdef Estimate f
+    cdef double lo_x[CENTRE_BLOCK]
+    cdef double hi_x[CENTRE_BLOCK]
+    cdef double lo_y[CENTRE_BLOCK]
+    cdef double hi_y[CENTRE_BLOCK]
+    cdef double det[CENTRE_BLOCK]
+    cdef double err_det[CENTRE_BLOCK]
+    cdef double det_sum[CENTRE_BLOCK]
+    cdef int j
+    # (doubles only, no branch: the compiler vectorizes this loop; the tests follow in the next)
+    for j in range(k):
+        estimate_centre(ax[j], ay[j], bx[j], by[j], cx[j], cy[j], &f)
+        det[j] = f.det
+        err_det[j] = f.err_det
+        det_sum[j] = f.det_sum
+        # rounds_alike's interval, on both coordinates
+        lo_x[j] = ax[j] + (f.qx - f.wx)
+        hi_x[j] = ax[j] + (f.qx + f.wx)
+        lo_y[j] = ay[j] + (f.qy - f.wy)
+        hi_y[j] = ay[j] + (f.qy + f.wy)
+    for j in range(k):
+        if not (usable(det[j], err_det[j], det_sum[j]) and lo_x[j] == hi_x[j] and lo_y[j] == hi_y[j]
+                and scaled_back(lo_x[j], e, &out[j * out_stride])
+                and scaled_back(lo_y[j], e, &out[j * out_stride + 1])):
+            circumcentre(ax[j], ay[j], bx[j], by[j], cx[j], cy[j], e, &out[j * out_stride],
+                         &out[j * out_stride + 1])
 
 
 cdef inline int circumcentre_side(double ax, double ay, double bx, double by, double cx, double cy,

@@ -6,7 +6,7 @@ from cython.parallel cimport prange
 from libc.stdint cimport int32_t, uint64_t
 from libc.math cimport fabs, ldexp
 
-from tvoronoi.kernels.construct cimport circumcentre
+from tvoronoi.kernels.construct cimport circumcentre, circumcentres_block, CENTRE_BLOCK
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
@@ -316,17 +316,28 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int32_t* vid, int32_t* tri,
                           const double* xs, const double* ys, int e, double* centre) noexcept nogil:
     # the finite triangles t0..t1 - 1 numbered from m on (vid), their sites copied to tri and their
-    # circumcentres computed; an infinite triangle's vid is -1
-    cdef int t, a, b, c
-    for t in range(t0, t1):
-        a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-        if a == inf or b == inf or c == inf:
-            vid[t] = -1
-            continue
-        vid[t] = m
-        tri[3 * m] = a; tri[3 * m + 1] = b; tri[3 * m + 2] = c
-        circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], e, &centre[2 * m], &centre[2 * m + 1])
-        m += 1
+    # circumcentres computed (by blocks: construct.circumcentres_block); an infinite triangle's vid is -1
+    cdef double gx[3][CENTRE_BLOCK]
+    cdef double gy[3][CENTRE_BLOCK]
+    cdef int t = t0, a, b, c, k, m0
+    while t < t1:
+        k = 0
+        m0 = m
+        while t < t1 and k < CENTRE_BLOCK:
+            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+            if a == inf or b == inf or c == inf:
+                vid[t] = -1
+                t += 1
+                continue
+            vid[t] = m
+            tri[3 * m] = a; tri[3 * m + 1] = b; tri[3 * m + 2] = c
+            gx[0][k] = xs[a]; gy[0][k] = ys[a]
+            gx[1][k] = xs[b]; gy[1][k] = ys[b]
+            gx[2][k] = xs[c]; gy[2][k] = ys[c]
+            m += 1
+            k += 1
+            t += 1
+        circumcentres_block(k, gx[0], gy[0], gx[1], gy[1], gx[2], gy[2], e, &centre[2 * m0], 2)
 
 
 cdef struct Walk:
@@ -539,15 +550,31 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     return m, h_kept
 
 
-def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0):
-    """Correctly rounded circumcentres (k, 2) of triangles tri (k, 3) of sites xs, ys, times 2^e."""
+def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0,
+                  bint by_blocks=True):
+    """Correctly rounded circumcentres (k, 2) of triangles tri (k, 3) of sites xs, ys, times 2^e (by_blocks:
+    as the dual computes them, construct.circumcentres_block; else one by one: the same doubles)."""
     cdef Py_ssize_t k, n_tri = tri.shape[0]
     cdef double[:, ::1] out = np.empty((n_tri, 2), np.float64)
-    cdef int a, b, c
+    cdef double gx[3][CENTRE_BLOCK]
+    cdef double gy[3][CENTRE_BLOCK]
+    cdef int a, b, c, j, cnt
     with nogil:
-        for k in range(n_tri):
-            a = tri[k, 0]; b = tri[k, 1]; c = tri[k, 2]
-            circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], e, &out[k, 0], &out[k, 1])
+        if not by_blocks:
+            for k in range(n_tri):
+                a = tri[k, 0]; b = tri[k, 1]; c = tri[k, 2]
+                circumcentre(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], e, &out[k, 0], &out[k, 1])
+        else:
+            k = 0
+            while k < n_tri:
+                cnt = <int> min(<Py_ssize_t> CENTRE_BLOCK, n_tri - k)
+                for j in range(cnt):
+                    for a in range(3):
+                        b = tri[k + j, a]
+                        gx[a][j] = xs[b]
+                        gy[a][j] = ys[b]
+                circumcentres_block(cnt, gx[0], gy[0], gx[1], gy[1], gx[2], gy[2], e, &out[k, 0], 2)
+                k += cnt
     return np.asarray(out)
 
 
