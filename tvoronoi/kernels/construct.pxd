@@ -408,11 +408,48 @@ cdef inline bint in_pair_range(double v) noexcept nogil:
     return m == 0.0 or (1e-60 <= m <= 1e60)
 
 
+cdef struct Estimate:
+    # circumcentre's first tier: the centre relative to a in plain doubles (q) and the bound on its
+    # error (w), with the values the second tier carries on
+    double bax, bay, cax, cay, l, r, det, det_sum, err_det, bb, cc, tx1, tx2, ty1, ty2, nx, ny, inv, qx, qy, wx, wy
+
+
+cdef struct PairTerms:
+    # what circumcentre_pairs adds to an Estimate: the roundoffs of D (t) and of N's coordinates
+    double t, nl_x, nl_y
+    double tails    # the roundoffs of the four differences, in magnitude, summed: 0 when all are exact
+
+
+cdef inline void pair_terms(double ax, double ay, double bx, double by, double cx, double cy, const Estimate* f,
+                            PairTerms* p) noexcept nogil:
+    """circumcentre_pairs' roundoffs (meaningful where the differences are exact and in_pair_range).
+    Straight-line code, so that a loop over many triangles vectorizes."""
+    cdef double x, sq1, sq2, lo_b, lo_c, lo1, lo2, lo3, lo4
+    p.tails = (fabs(two_diff_tail(bx, ax, f.bax)) + fabs(two_diff_tail(by, ay, f.bay))
+               + fabs(two_diff_tail(cx, ax, f.cax)) + fabs(two_diff_tail(cy, ay, f.cay)))
+    p.t = two_diff_tail(f.l, f.r, f.det) + (two_product(f.bax, f.cay)[1] - two_product(f.bay, f.cax)[1])
+    x, sq1 = two_square(f.bax)
+    x, sq2 = two_square(f.bay)
+    lo_b = two_sum(f.bax * f.bax, f.bay * f.bay)[1] + (sq1 + sq2)
+    x, sq1 = two_square(f.cax)
+    x, sq2 = two_square(f.cay)
+    lo_c = two_sum(f.cax * f.cax, f.cay * f.cay)[1] + (sq1 + sq2)
+    lo1 = two_product(f.cay, f.bb)[1] + f.cay * lo_b
+    lo2 = two_product(f.bay, f.cc)[1] + f.bay * lo_c
+    p.nl_x = two_diff_tail(f.tx1, f.tx2, f.nx) + (lo1 - lo2)
+    lo3 = two_product(f.bax, f.cc)[1] + f.bax * lo_c
+    lo4 = two_product(f.cax, f.bb)[1] + f.cax * lo_b
+    p.nl_y = two_diff_tail(f.ty1, f.ty2, f.ny) + (lo3 - lo4)
+
+
+cdef inline bint pairs_apply(const Estimate* f, const PairTerms* p) noexcept nogil:
+    # the differences are exact and in_pair_range
+    return (p.tails == 0.0 and in_pair_range(f.bax) and in_pair_range(f.bay) and in_pair_range(f.cax)
+            and in_pair_range(f.cay))
+
+
 cdef inline int circumcentre_pairs(double ax, double ay, double bx, double by, double cx, double cy,
-                                    double bax, double bay, double cax, double cay,
-                                    double l, double r, double det, double det_sum, double bb, double cc,
-                                    double tx1, double tx2, double ty1, double ty2, double nx, double ny,
-                                    double inv, double qx, double qy, int e, bint need_x, bint need_y,
+                                    const Estimate* f, int e, bint need_x, bint need_y,
                                     double* ux, double* uy) noexcept nogil:
     """circumcentre's doubles carried on as pairs (a double and its roundoff), for the coordinates they
     left open (need_x, need_y), when the differences bax .. cay are exact and in_pair_range: N and D are
@@ -430,39 +467,26 @@ cdef inline int circumcentre_pairs(double ax, double ay, double bx, double by, d
       |lo1| <= 3.03 u |tx1| (each term of N likewise)
       N_x = nx + nl, nl = (tx1 - tx2 - nx) + (lo1 - lo2): within 15.2 u^2 M, M = |tx1| + |tx2|,
       |nl| <= 4.1 u M
-    and pair_settled finishes each coordinate."""
-    cdef double t, lo_b, lo_c, lo1, lo2, lo3, lo4, x, sq1, sq2, nl
+    (pair_terms) and pair_settled finishes each coordinate."""
+    cdef PairTerms p
     cdef bint done_x = not need_x, done_y = not need_y
-    if (two_diff_tail(bx, ax, bax) != 0.0 or two_diff_tail(by, ay, bay) != 0.0
-            or two_diff_tail(cx, ax, cax) != 0.0 or two_diff_tail(cy, ay, cay) != 0.0):
+    pair_terms(ax, ay, bx, by, cx, cy, f, &p)
+    if not pairs_apply(f, &p):
         return -1
-    if not (in_pair_range(bax) and in_pair_range(bay) and in_pair_range(cax) and in_pair_range(cay)):
-        return -1
-    t = two_diff_tail(l, r, det) + (two_product(bax, cay)[1] - two_product(bay, cax)[1])
-    x, sq1 = two_square(bax)
-    x, sq2 = two_square(bay)
-    lo_b = two_sum(bax * bax, bay * bay)[1] + (sq1 + sq2)
-    x, sq1 = two_square(cax)
-    x, sq2 = two_square(cay)
-    lo_c = two_sum(cax * cax, cay * cay)[1] + (sq1 + sq2)
     if need_x:
-        lo1 = two_product(cay, bb)[1] + cay * lo_b
-        lo2 = two_product(bay, cc)[1] + bay * lo_c
-        nl = two_diff_tail(tx1, tx2, nx) + (lo1 - lo2)
-        done_x = pair_settled(ax, nx, nl, fabs(tx1) + fabs(tx2), det, t, det_sum, inv, qx, e, ux)
+        done_x = pair_settled(ax, f.nx, p.nl_x, fabs(f.tx1) + fabs(f.tx2), f.det, p.t, f.det_sum, f.inv, f.qx,
+                              e, ux)
     if need_y:
-        lo3 = two_product(bax, cc)[1] + bax * lo_c
-        lo4 = two_product(cax, bb)[1] + cax * lo_b
-        nl = two_diff_tail(ty1, ty2, ny) + (lo3 - lo4)
-        done_y = pair_settled(ay, ny, nl, fabs(ty1) + fabs(ty2), det, t, det_sum, inv, qy, e, uy)
+        done_y = pair_settled(ay, f.ny, p.nl_y, fabs(f.ty1) + fabs(f.ty2), f.det, p.t, f.det_sum, f.inv, f.qy,
+                              e, uy)
     return 1 if done_x and done_y else 0
 
 
-cdef inline bint pair_settled(double a, double ns, double nl, double m, double s, double t, double p, double inv,
-                              double q1, int e, double* out) noexcept nogil:
+cdef inline void pair_interval(double a, double ns, double nl, double m, double s, double t, double p,
+                               double inv, double q1, double* lo, double* hi) noexcept nogil:
     """a + N / (2 D), N = ns + nl within 15.2 u^2 m, D = s + t within 3.01 u^2 p (|t| <= 2.01 u p, and
-    |s| > 24 u p: circumcentre's guard), q1 = fl(ns inv), inv = fl(0.5 / s): its rounding if it settles
-    (then 2^e times it; rounds_alike).
+    |s| > 24 u p: circumcentre's guard), q1 = fl(ns inv), inv = fl(0.5 / s): rounds_alike's interval
+    for it, [lo, hi] (it settles where they are equal).
 
     2 s q1 = r1 + r1e exactly, and ns - r1 = h exactly (r1 is within three roundings of ns), so
     N - 2 D q1 = rp + E, rp = ((h - r1e) + nl) - 2 t q1 as computed (four roundings of terms below
@@ -470,7 +494,7 @@ cdef inline bint pair_settled(double a, double ns, double nl, double m, double s
     |N / (2 D) - q1 - q2| <= u |q2| (5 p |inv| + 2.1) + 1.11 u^2 (17 |ns| + 42 m + 26 p |q1|) |inv|
     (1 / (2 D) = inv (1 + rho), |rho| <= 2.2 u p / |s| < 0.1), which w2 bounds with room; a + q1 = s0 + s1
     exactly, and s1 + q2 rounds to sm."""
-    cdef double r1, r1e, h, rp, q2, w2, s0, s1, sm, u = EPSILON
+    cdef double r1, r1e, h, rp, q2, w2, s0, s1, sm, w, u = EPSILON
     r1, r1e = two_product(2.0 * s, q1)
     h = ns - r1
     rp = ((h - r1e) + nl) - 2.0 * t * q1
@@ -479,13 +503,17 @@ cdef inline bint pair_settled(double a, double ns, double nl, double m, double s
     s0, s1 = two_sum(a, q1)
     sm = s1 + q2
     # rounds_alike's slack: the bound, the rounding of sm, and w's own (w (1 - u) >= w2 + 2 u |sm|)
-    return rounds_alike(s0, sm, 1.0001 * w2 + 3.0 * u * fabs(sm) + 1e-300, e, out)
+    w = 1.0001 * w2 + 3.0 * u * fabs(sm) + 1e-300
+    lo[0] = s0 + (sm - w)
+    hi[0] = s0 + (sm + w)
 
 
-cdef struct Estimate:
-    # circumcentre's first tier: the centre relative to a in plain doubles (q) and the bound on its
-    # error (w), with the values the second tier carries on
-    double bax, bay, cax, cay, l, r, det, det_sum, err_det, bb, cc, tx1, tx2, ty1, ty2, nx, ny, inv, qx, qy, wx, wy
+cdef inline bint pair_settled(double a, double ns, double nl, double m, double s, double t, double p, double inv,
+                              double q1, int e, double* out) noexcept nogil:
+    # pair_interval's rounding if it settles (then 2^e times it; rounds_alike)
+    cdef double lo, hi
+    pair_interval(a, ns, nl, m, s, t, p, inv, q1, &lo, &hi)
+    return lo == hi and scaled_back(lo, e, out)
 
 
 cdef inline bint usable(double det, double err_det, double det_sum) noexcept nogil:
@@ -550,9 +578,7 @@ cdef inline void circumcentre(double ax, double ay, double bx, double by, double
         # the coordinates the doubles left open (rarely both): as pairs of doubles where the differences
         # are exact (nearly always; what the pairs leave open is within a few eps^2 of a tie, beyond long
         # double too), else in long double
-        pairs = circumcentre_pairs(ax, ay, bx, by, cx, cy, f.bax, f.bay, f.cax, f.cay, f.l, f.r, f.det,
-                                   f.det_sum, f.bb, f.cc, f.tx1, f.tx2, f.ty1, f.ty2, f.nx, f.ny, f.inv, f.qx,
-                                   f.qy, e, not done_x, not done_y, ux, uy)
+        pairs = circumcentre_pairs(ax, ay, bx, by, cx, cy, &f, e, not done_x, not done_y, ux, uy)
         if pairs == 1:
             return
         if pairs == -1 and circumcentre_long(ax, ay, bx, by, cx, cy, e, not done_x, not done_y, ux, uy):
@@ -570,9 +596,12 @@ cdef inline void circumcentres_block(int k, const double* ax, const double* ay, 
                                      const double* by, const double* cx, const double* cy, int e,
                                      double* out, int out_stride) noexcept nogil:
     """circumcentre of k <= CENTRE_BLOCK triangles given by their corners' coordinates, the centre of
-    triangle j written at out[j * out_stride] (x) and the next double (y): the same doubles, with the
-    first tier of all k in one loop that the compiler vectorizes, and the rest one by one."""
+    triangle j written at out[j * out_stride] (x) and the next double (y): the same doubles. The first
+    tier of all k runs in one loop that the compiler vectorizes, then the pairs of those it leaves open
+    in another; circumcentre takes the few left. (Each tier's result, where it settles, is the correctly
+    rounded centre: which tier settles a coordinate does not change it.)"""
     cdef Estimate f
+    cdef PairTerms pt
     cdef double lo_x[CENTRE_BLOCK]
     cdef double hi_x[CENTRE_BLOCK]
     cdef double lo_y[CENTRE_BLOCK]
@@ -580,7 +609,10 @@ cdef inline void circumcentres_block(int k, const double* ax, const double* ay, 
     cdef double det[CENTRE_BLOCK]
     cdef double err_det[CENTRE_BLOCK]
     cdef double det_sum[CENTRE_BLOCK]
-    cdef int j
+    cdef double g[6][CENTRE_BLOCK]      # the open triangles' corners, gathered
+    cdef double tails[CENTRE_BLOCK]
+    cdef int at[CENTRE_BLOCK]
+    cdef int j, q, n_open = 0
     # (doubles only, no branch: the compiler vectorizes this loop; the tests follow in the next)
     for j in range(k):
         estimate_centre(ax[j], ay[j], bx[j], by[j], cx[j], cy[j], &f)
@@ -596,6 +628,27 @@ cdef inline void circumcentres_block(int k, const double* ax, const double* ay, 
         if not (usable(det[j], err_det[j], det_sum[j]) and lo_x[j] == hi_x[j] and lo_y[j] == hi_y[j]
                 and scaled_back(lo_x[j], e, &out[j * out_stride])
                 and scaled_back(lo_y[j], e, &out[j * out_stride + 1])):
+            at[n_open] = j
+            g[0][n_open] = ax[j]; g[1][n_open] = ay[j]; g[2][n_open] = bx[j]
+            g[3][n_open] = by[j]; g[4][n_open] = cx[j]; g[5][n_open] = cy[j]
+            n_open += 1
+    # the second tier (circumcentre_pairs), both coordinates, in one vectorized loop
+    for q in range(n_open):
+        estimate_centre(g[0][q], g[1][q], g[2][q], g[3][q], g[4][q], g[5][q], &f)
+        pair_terms(g[0][q], g[1][q], g[2][q], g[3][q], g[4][q], g[5][q], &f, &pt)
+        tails[q] = pt.tails
+        pair_interval(g[0][q], f.nx, pt.nl_x, fabs(f.tx1) + fabs(f.tx2), f.det, pt.t, f.det_sum, f.inv, f.qx,
+                      &lo_x[q], &hi_x[q])
+        pair_interval(g[1][q], f.ny, pt.nl_y, fabs(f.ty1) + fabs(f.ty2), f.det, pt.t, f.det_sum, f.inv, f.qy,
+                      &lo_y[q], &hi_y[q])
+    for q in range(n_open):
+        j = at[q]
+        if not (usable(det[j], err_det[j], det_sum[j]) and tails[q] == 0.0
+                and in_pair_range(bx[j] - ax[j]) and in_pair_range(by[j] - ay[j])
+                and in_pair_range(cx[j] - ax[j]) and in_pair_range(cy[j] - ay[j])
+                and lo_x[q] == hi_x[q] and lo_y[q] == hi_y[q]
+                and scaled_back(lo_x[q], e, &out[j * out_stride])
+                and scaled_back(lo_y[q], e, &out[j * out_stride + 1])):
             circumcentre(ax[j], ay[j], bx[j], by[j], cx[j], cy[j], e, &out[j * out_stride],
                          &out[j * out_stride + 1])
 
