@@ -49,28 +49,27 @@ cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
     edge that p sees strictly: either way p is strictly inside its circle.
     The visibility walk terminates in a Delaunay triangulation.
     """
-    cdef int k, e, a, b, came = -1, steps = 0
-    cdef bint moved
+    cdef int e, a0, a1, a2, came = -1, steps = 0
+    cdef double x0, y0, x1, y1, x2, y2
     while True:
         steps += 1
-        if is_infinite(m, t):
+        a0 = m.tv[3 * t]; a1 = m.tv[3 * t + 1]; a2 = m.tv[3 * t + 2]
+        if a0 == m.inf or a1 == m.inf or a2 == m.inf:
             m.walk_steps = steps
             return t
-        moved = False
-        for k in range(3):
-            e = 3 * t + k
-            if e == came:
-                continue
-            a = m.tv[e]
-            b = m.tv[nxt(e)]
-            if orient2d(m.x[a], m.y[a], m.x[b], m.y[b], px, py) < 0:
-                came = m.opp[e]
-                t = came // 3
-                moved = True
-                break
-        if not moved:
+        # the corners read once; edge 3t + k runs from corner k to corner k + 1
+        x0 = m.x[a0]; y0 = m.y[a0]; x1 = m.x[a1]; y1 = m.y[a1]; x2 = m.x[a2]; y2 = m.y[a2]
+        e = 3 * t
+        if e != came and orient2d(x0, y0, x1, y1, px, py) < 0:
+            came = m.opp[e]
+        elif e + 1 != came and orient2d(x1, y1, x2, y2, px, py) < 0:
+            came = m.opp[e + 1]
+        elif e + 2 != came and orient2d(x2, y2, x0, y0, px, py) < 0:
+            came = m.opp[e + 2]
+        else:
             m.walk_steps = steps
             return t
+        t = came // 3
 
 
 cdef inline void list_site(Mesh* m, int t, int s) noexcept nogil:
