@@ -67,7 +67,7 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
             if e == came:
                 continue
             o = m.opp[e]
-            nt = o // 3
+            nt = <int> (<unsigned> o // 3)     # (o >= 0: the unsigned division is shorter)
             if in_conflict(m, nt, px, py):
                 m.cavity[n_cav] = nt
                 m.cav_from[n_cav] = o

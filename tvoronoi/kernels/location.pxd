@@ -69,7 +69,7 @@ cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
         else:
             m.walk_steps = steps
             return t
-        t = came // 3
+        t = <int> (<unsigned> came // 3)
 
 
 cdef inline void list_site(Mesh* m, int t, int s) noexcept nogil:
