@@ -500,24 +500,25 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
     group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
     each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts."""
-    cdef int g, k, u, w, r, a, last_face = -1, h_kept
-    # the merges (each zero-length edge from its half-edge of smaller index: its twin joins the same two
-    # vertices), and each kept half-edge's new number (how many before it are kept)
+    cdef int g, k, u, w, r, a, q, c, last_face = -1, h_kept
+    # each kept half-edge's new number (how many before it are kept), and the zero-length edges listed,
+    # each from its half-edge of smaller index (its twin joins the same two vertices), in vmap (free
+    # until the vertices are renumbered; they form a forest: fewer than m). No branch: where zero-length
+    # edges lie follows no pattern the processor could learn (sites numbered along a BRIO curve)
     k = 0
+    c = 0
     for g in range(h):
         newh[g] = k
-        if zero[g]:
-            if he_twin[g] < g:
-                continue
-            u = find(parent, he_origin[g])
-            w = find(parent, he_origin[next_in_cell(g, h, he_face, face_edge)])
-            if u < w:
-                parent[w] = u
-            elif w < u:
-                parent[u] = w
-        else:
-            k += 1
+        k += 1 - zero[g]
+        vmap[c] = g
+        c += zero[g] & (he_twin[g] > g)
     h_kept = k
+    # the merges: both ends of each zero-length edge in one group, named by its smallest vertex
+    for q in range(c):
+        g = vmap[q]
+        u = find(parent, he_origin[g])
+        w = find(parent, he_origin[next_in_cell(g, h, he_face, face_edge)])
+        parent[max(u, w)] = min(u, w)
     # the vertices renumbered in order: a root takes the next number, any other vertex its root's (a
     # merge keeps the smaller root, so that root is numbered already)
     k = 0
@@ -536,9 +537,10 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
     # from and to infinity, or three at least)
     for g in range(n):
         face_edge[g] = -1
+    # (a zero-length half-edge is written too, with no branch, at the place of the next kept one, which
+    # then overwrites it: every place is written after it was read, k = newh[g] <= g; those after the
+    # last kept half-edge land beyond the kept ones. Its face's first is the next kept one's place)
     for g in range(h):
-        if zero[g]:
-            continue
         k = newh[g]
         he_origin[k] = vmap[he_origin[g]] if he_origin[g] >= 0 else -1
         he_twin[k] = newh[he_twin[g]]
