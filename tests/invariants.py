@@ -93,12 +93,29 @@ def check_cells(d, *, sites_in_box=True):
         assert p.area > 0
         if sites_in_box:
             assert p.covers(shapely.Point(frame(d.sites[i])[0])), f"site {i} outside its cell"
+    check_ring_starts(d)
     total = sum(p.area for p in polys.values())
     if d.n_sites == 0:
         assert total == 0
         return
     assert abs(total - box_area) <= AREA_RTOL * box_area, f"cells cover {total}, box {box_area}"
     assert shapely.coverage_is_valid(shapely.GeometryCollection(list(polys.values())))
+
+
+def check_ring_starts(d):
+    """Every ring starts at its lowest point (smallest y, then smallest x), as the clipper promises: the
+    same ring from either engine, whichever half-edge its cell began with."""
+    offsets = np.asarray(d.cell_offsets)
+    lengths = np.diff(offsets)
+    starts = offsets[:-1][lengths > 0]
+    if len(starts) == 0:
+        return
+    xy = np.asarray(d.cell_points)[np.asarray(d.cell_vertices)]
+    low_y = np.minimum.reduceat(xy[:, 1], starts)
+    ring_of = np.repeat(np.arange(len(starts)), lengths[lengths > 0])
+    low_x = np.minimum.reduceat(np.where(xy[:, 1] == low_y[ring_of], xy[:, 0], np.inf), starts)
+    bad = np.flatnonzero((xy[starts, 1] != low_y) | (xy[starts, 0] != low_x))
+    assert len(bad) == 0, f"{len(bad)} rings do not start at their lowest point, the first at {starts[bad[0]]}"
 
 
 def validate(d, *, sites_in_box=True):

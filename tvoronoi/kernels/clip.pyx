@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from libc.math cimport hypot
+from libc.math cimport hypot, fabs
 from libc.stdlib cimport calloc, malloc, free
 from libc.string cimport memcpy, memmove
 from cython.parallel cimport prange
@@ -11,7 +11,7 @@ from tvoronoi.kernels.construct cimport bisector_at
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
-    finish_ring, first_right_turn, turn, convex_ring, bent,
+    finish_ring, first_right_turn, turn, convex_ring, bent, TURN_BAND_LOW, TURN_BAND_HIGH,
 )
 from tvoronoi.kernels.prefetch cimport prefetch
 from tvoronoi.kernels.populate cimport populate_part, fill_int32
@@ -89,13 +89,16 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef bint has_o, has_d
 
     cdef int T = threads if n >= parallel_min and threads > 1 else 1
+    # per thread: 1 if some vertex lies outside turn()'s band of magnitudes (clipper.pxd)
+    cdef int[::1] off_band = np.zeros(T, np.intc)
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
         # (each thread a run of them, in a function of its own: its pointers stay in registers across
         # the byte stores, which could alias them for the compiler)
         for k in prange(T, num_threads=T, schedule="static", chunksize=1):
             n_ties += vertex_codes(<int> (<int64_t> k * m // T), <int> (<int64_t> (k + 1) * m // T),
-                                   &vertices[0, 0] if m > 0 else NULL, &box, &vcx[0], &vcy[0], tie, v_in)
+                                   &vertices[0, 0] if m > 0 else NULL, &box, &vcx[0], &vcy[0], tie, v_in,
+                                   &off_band[k])
         v_in_buf[0] = 0
         for h in range(n_he if n_ties > 0 else 0):
             v = he_origin[h]
@@ -225,6 +228,9 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     S.seg_end = seg_end
     S.box = &box
     S.P = &P
+    S.in_band = True
+    for k in range(T):
+        S.in_band = S.in_band and off_band[k] == 0
     with nogil:
         if T == 1:
             ends[0] = clip_range(&S, 0, n, &ring[0], &offsets[0], 0, &bent[0], &stat[0])
@@ -263,15 +269,17 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
 
 
 cdef int vertex_codes(int lo, int hi, const double* vertices, const Box* box, signed char* vcx, signed char* vcy,
-                      signed char* tie, signed char* v_in) noexcept nogil:
+                      signed char* tie, signed char* v_in, int* off_band) noexcept nogil:
     # vertices lo..hi-1 against the box, by their rounded coordinates: codes, and 1 in v_in for those
     # in it; a coordinate equal to a side is a tie (marked 1, codes 0 until the exact test); returns the
-    # count of ties
-    cdef int v, n_ties = 0
+    # count of ties. off_band: 1 if some coordinate is nonzero and outside turn()'s band of magnitudes
+    cdef int v, n_ties = 0, off = 0
     cdef double x, y
     for v in range(lo, hi):
         x = vertices[2 * v]
         y = vertices[2 * v + 1]
+        off |= ((fabs(x) >= TURN_BAND_HIGH) | (fabs(y) >= TURN_BAND_HIGH)
+                | ((x != 0.0) & (fabs(x) < TURN_BAND_LOW)) | ((y != 0.0) & (fabs(y) < TURN_BAND_LOW)))
         if x == box.xmin or x == box.xmax or y == box.ymin or y == box.ymax:
             tie[v] = 1
             n_ties += 1
@@ -282,6 +290,7 @@ cdef int vertex_codes(int lo, int hi, const double* vertices, const Box* box, si
             vcx[v] = -2 if x < box.xmin else (2 if x > box.xmax else 0)
             vcy[v] = -2 if y < box.ymin else (2 if y > box.ymax else 0)
             v_in[v] = vcx[v] == 0 and vcy[v] == 0
+    off_band[0] = off
     return n_ties
 
 
@@ -354,6 +363,7 @@ cdef struct CellPass:
     const int32_t* seg_end
     Box* box
     Points* P
+    bint in_band                    # every Voronoi vertex lies in turn()'s band (convex_ring)
 
 
 cdef int64_t clip_range(CellPass* S, int lo, int hi, int32_t* ring, int64_t* offsets, int64_t n_ring,
@@ -390,7 +400,7 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
             if h == S.face_edge[i]:
                 break
         if h == S.face_edge[i] and cnt > 0:
-            k = convex_ring(&ring[n_ring], cnt, pts)
+            k = convex_ring(&ring[n_ring], cnt, pts, S.in_band)
             if k < 0:
                 k = finish_ring(&ring[n_ring], cnt, pts)
                 if k > 0 and first_right_turn(&ring[n_ring], k, pts) >= 0:

@@ -26,7 +26,7 @@ from tvoronoi.kernels.construct cimport (
     circumcentre_denominator,
 )
 from tvoronoi.kernels.predicates cimport (
-    orient2d, two_diff, difference_expansion, expansion_product, expansion_sign, negate_expansion,
+    orient2d, CCW_ERRBOUND_A, two_diff, difference_expansion, expansion_product, expansion_sign, negate_expansion,
     fast_expansion_sum_zeroelim,
 )
 
@@ -554,45 +554,99 @@ cdef inline int finish_ring(int32_t* ring, int n, const double* pts) noexcept no
 cdef enum:
     CONVEX_FAST_MAX = 64      # rings up to this many points try convex_ring first (a stack buffer)
 
+cdef extern from *:
+    """
+    #ifdef __SSE2__
+    #include <emmintrin.h>
+    #endif
+    /* Of points 1..n of lx, ly (3 <= n <= 64), the place of the lowest: smallest y, then smallest x,
+       the first of equals. Usually one point has the smallest y: it is found by comparisons on pairs
+       of points, without branches (where it lies in a ring is random to a branch predictor); a tie in
+       y is settled point by point. */
+    static inline int tvoronoi_lowest_point(const double* lx, const double* ly, int n) {
+        int k, start = 1;
+    #ifdef __SSE2__
+        __m128d low = _mm_set1_pd(ly[1]);
+        unsigned long long at = 0;
+        for (k = 1; k < n; k += 2)
+            low = _mm_min_pd(low, _mm_loadu_pd(ly + k));
+        if (k == n)
+            low = _mm_min_pd(low, _mm_set1_pd(ly[n]));
+        low = _mm_min_pd(low, _mm_shuffle_pd(low, low, 1));
+        for (k = 1; k < n; k += 2)
+            at |= (unsigned long long) _mm_movemask_pd(_mm_cmpeq_pd(_mm_loadu_pd(ly + k), low)) << (k - 1);
+        if (k == n)
+            at |= (unsigned long long) (ly[n] == _mm_cvtsd_f64(low)) << (n - 1);
+        if (at != 0 && (at & (at - 1)) == 0)
+            return __builtin_ctzll(at) + 1;
+    #endif
+        for (k = 2; k <= n; k++)
+            if (ly[k] < ly[start] || (ly[k] == ly[start] && lx[k] < lx[start]))
+                start = k;
+        return start;
+    }
+    """
+    int lowest_point "tvoronoi_lowest_point"(const double* lx, const double* ly, int n) noexcept nogil
 
-cdef inline int convex_ring(int32_t* ring, int n, const double* pts) noexcept nogil:
+
+cdef inline int convex_ring(int32_t* ring, int n, const double* pts, bint in_band) noexcept nogil:
     """The usual case of finish_ring and first_right_turn together, on one read of the ring's points:
     when every turn is strictly to the left (then no point repeats and none folds back) and the
     magnitudes lie in turn()'s band, rotate the ring to its canonical start and return n. Otherwise
-    return -1, changing nothing: the caller runs finish_ring and first_right_turn."""
-    cdef double lx[CONVEX_FAST_MAX]
-    cdef double ly[CONVEX_FAST_MAX]
-    cdef double v, small = INFINITY, large = 0.0
-    cdef int k, prev, nxt_k, start = 0
+    return -1, changing nothing: the caller runs finish_ring and first_right_turn. in_band: the caller
+    knows every point of the ring lies in the band (clip.pyx checks the Voronoi vertices once)."""
+    # the points, with the last one before the first and the first after the last: turn k (at point
+    # k + 1) reads places k, k + 1, k + 2
+    cdef double lx[CONVEX_FAST_MAX + 2]
+    cdef double ly[CONVEX_FAST_MAX + 2]
+    cdef double v, small = INFINITY, large = 0.0, acx, acy, bcx, bcy, det_left, det_right, unsure = 0.0
+    cdef int32_t twice[2 * CONVEX_FAST_MAX]
+    cdef int k, start = 1
     if n < 3 or n > CONVEX_FAST_MAX:
         return -1
     for k in range(n):
-        lx[k] = pts[2 * ring[k]]
-        ly[k] = pts[2 * ring[k] + 1]
-        v = fabs(lx[k])
-        if v > large:
-            large = v
-        if v != 0.0 and v < small:
-            small = v
-        v = fabs(ly[k])
-        if v > large:
-            large = v
-        if v != 0.0 and v < small:
-            small = v
-    if not (small >= TURN_BAND_LOW and large < TURN_BAND_HIGH):
-        return -1
-    prev = n - 1
-    for k in range(n):
-        nxt_k = k + 1 if k + 1 < n else 0
-        if orient2d(lx[prev], ly[prev], lx[k], ly[k], lx[nxt_k], ly[nxt_k]) <= 0:
+        twice[k] = ring[k]
+        twice[n + k] = ring[k]
+        lx[k + 1] = pts[2 * ring[k]]
+        ly[k + 1] = pts[2 * ring[k] + 1]
+    lx[0] = lx[n]
+    ly[0] = ly[n]
+    lx[n + 1] = lx[1]
+    ly[n + 1] = ly[1]
+    if not in_band:
+        for k in range(1, n + 1):
+            v = fabs(lx[k])
+            if v > large:
+                large = v
+            if v != 0.0 and v < small:
+                small = v
+            v = fabs(ly[k])
+            if v > large:
+                large = v
+            if v != 0.0 and v < small:
+                small = v
+        if not (small >= TURN_BAND_LOW and large < TURN_BAND_HIGH):
             return -1
-        prev = k
-        # the canonical start: the lowest point (smallest y, then x)
-        if ly[k] < ly[start] or (ly[k] == ly[start] and lx[k] < lx[start]):
-            start = k
-    reverse(ring, 0, start)
-    reverse(ring, start, n)
-    reverse(ring, 0, n)
+    # orient2d's filter on every turn in one loop without branches (the compiler runs it on pairs of
+    # turns): a turn is surely to the left when its rounded determinant exceeds the filter's error
+    # bound; any other turn sends the ring to orient2d, turn by turn
+    for k in range(n):
+        acx = lx[k] - lx[k + 2]
+        acy = ly[k] - ly[k + 2]
+        bcx = lx[k + 1] - lx[k + 2]
+        bcy = ly[k + 1] - ly[k + 2]
+        det_left = acx * bcy
+        det_right = acy * bcx
+        unsure = unsure if det_left - det_right > CCW_ERRBOUND_A * (fabs(det_left) + fabs(det_right)) else 1.0
+    if unsure != 0.0:
+        for k in range(n):
+            if orient2d(lx[k], ly[k], lx[k + 1], ly[k + 1], lx[k + 2], ly[k + 2]) <= 0:
+                return -1
+    # the canonical start: the lowest point (smallest y, then x)
+    start = lowest_point(lx, ly, n)
+    # the ring rotated to start there, from a copy of it twice over (one loop of n, whatever the start)
+    for k in range(n):
+        ring[k] = twice[start - 1 + k]
     return n
 
 

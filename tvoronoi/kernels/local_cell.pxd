@@ -230,7 +230,7 @@ cdef inline bint cell_is_bent(Mesh* m, int site, Box* box, CentreMemo* memo, Cel
     box is read from memoised circumcentres, and one whose every turn is strictly left is not bent
     (the usual case); the others are clipped as cell_ring reads them."""
     cdef int k = interior_ring(m, site, box, memo, b.pts, b.ring)
-    if k > 0 and convex_ring(b.ring, k, b.pts) == k:
+    if k > 0 and convex_ring(b.ring, k, b.pts, False) == k:
         return False
     if k > 0:
         k = finish_ring(b.ring, k, b.pts)
