@@ -33,6 +33,20 @@ cdef inline bint in_conflict(Mesh* m, int t, double px, double py) noexcept nogi
     return o == 0 and strictly_between(m, u, w, px, py)
 
 
+cdef inline void cross_edge(Mesh* m, int e, double px, double py, int* n_cav, int* n_bnd) noexcept nogil:
+    # the triangle across half-edge e of a cavity triangle joins the cavity, or e is a boundary edge
+    cdef int o = m.opp[e]
+    cdef int nt = <int> (<unsigned> o // 3)     # (o >= 0: the unsigned division is shorter)
+    cdef int inside = in_conflict(m, nt, px, py)
+    m.cavity[n_cav[0]] = nt
+    m.cav_from[n_cav[0]] = o
+    m.bnd_a[n_bnd[0]] = m.tv[e]
+    m.bnd_b[n_bnd[0]] = m.tv[nxt(e)]
+    m.bnd_twin[n_bnd[0]] = o
+    n_cav[0] += inside
+    n_bnd[0] += 1 - inside
+
+
 cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     """The conflict region of site i, which contains triangle t0; False for a repeated point.
 
@@ -42,7 +56,7 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     # triangles (m.cavity, m.bnd_a, m.bnd_b, m.bnd_twin; m.n_cav, m.n_bnd)
     """
     cdef double px = m.x[i], py = m.y[i]
-    cdef int n_cav = 1, n_bnd = 0, j = 0, k, e, o, nt, t, a, came
+    cdef int n_cav = 1, n_bnd = 0, j, k, t, a, came
     # degenerate case: a repeated point; the walk ends on a triangle that has it as a vertex
     if not is_infinite(m, t0):
         for k in range(3):
@@ -56,27 +70,21 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     # stays a vertex of the triangulation, so it lies on the cavity's boundary and no cavity triangle is
     # reached twice. The search skips only the edge back to the triangle it came from; a triangle
     # outside that touches the cavity along two edges is tested twice, with the same exact answer.
+    # Which edges cross into the cavity is random to a branch predictor, so each edge is written both
+    # as the next cavity triangle and as the next boundary edge, and the verdict advances one of the
+    # two counts (the write past the end is overwritten or never read; the arrays have room for it:
+    # a cavity never holds every triangle). The first triangle's three edges, then two of each next
+    # one's (those after the edge it was reached by, in the order 0, 1, 2).
     m.cavity[0] = t0
-    m.cav_from[0] = -1
+    for k in range(3):
+        cross_edge(m, 3 * t0 + k, px, py, &n_cav, &n_bnd)
+    j = 1
     while j < n_cav:
         t = m.cavity[j]
-        came = m.cav_from[j]
+        came = m.cav_from[j] - 3 * t
         j += 1
-        for k in range(3):
-            e = 3 * t + k
-            if e == came:
-                continue
-            o = m.opp[e]
-            nt = <int> (<unsigned> o // 3)     # (o >= 0: the unsigned division is shorter)
-            if in_conflict(m, nt, px, py):
-                m.cavity[n_cav] = nt
-                m.cav_from[n_cav] = o
-                n_cav += 1
-                continue
-            m.bnd_a[n_bnd] = m.tv[e]
-            m.bnd_b[n_bnd] = m.tv[nxt(e)]
-            m.bnd_twin[n_bnd] = o
-            n_bnd += 1
+        cross_edge(m, 3 * t + (came == 0), px, py, &n_cav, &n_bnd)
+        cross_edge(m, 3 * t + 2 - (came == 2), px, py, &n_cav, &n_bnd)
     m.n_cav = n_cav
     m.n_bnd = n_bnd
     return True
