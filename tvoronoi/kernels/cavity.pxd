@@ -33,18 +33,18 @@ cdef inline bint in_conflict(Mesh* m, int t, double px, double py) noexcept nogi
     return o == 0 and strictly_between(m, u, w, px, py)
 
 
-cdef inline void cross_edge(Mesh* m, int e, double px, double py, int* n_cav, int* n_bnd) noexcept nogil:
-    # the triangle across half-edge e of a cavity triangle joins the cavity, or e is a boundary edge
+cdef inline int cross_edge(Mesh* m, int e, double px, double py, int n_cav, int n_bnd) noexcept nogil:
+    # the triangle across half-edge e of a cavity triangle joins the cavity (returns 1), or e is a
+    # boundary edge (0); written as both, at places n_cav and n_bnd (the compiler keeps this out of
+    # line: its three calls inlined, or one call in a loop, measured slower)
     cdef int o = m.opp[e]
     cdef int nt = <int> (<unsigned> o // 3)     # (o >= 0: the unsigned division is shorter)
-    cdef int inside = in_conflict(m, nt, px, py)
-    m.cavity[n_cav[0]] = nt
-    m.cav_from[n_cav[0]] = o
-    m.bnd_a[n_bnd[0]] = m.tv[e]
-    m.bnd_b[n_bnd[0]] = m.tv[nxt(e)]
-    m.bnd_twin[n_bnd[0]] = o
-    n_cav[0] += inside
-    n_bnd[0] += 1 - inside
+    m.cavity[n_cav] = nt
+    m.cav_from[n_cav] = o
+    m.bnd_a[n_bnd] = m.tv[e]
+    m.bnd_b[n_bnd] = m.tv[nxt(e)]
+    m.bnd_twin[n_bnd] = o
+    return in_conflict(m, nt, px, py)
 
 
 cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
@@ -56,7 +56,7 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     # triangles (m.cavity, m.bnd_a, m.bnd_b, m.bnd_twin; m.n_cav, m.n_bnd)
     """
     cdef double px = m.x[i], py = m.y[i]
-    cdef int n_cav = 1, n_bnd = 0, j, k, t, a, came
+    cdef int n_cav = 1, n_bnd = 0, j, k, t, a, came, inside
     # degenerate case: a repeated point; the walk ends on a triangle that has it as a vertex
     if not is_infinite(m, t0):
         for k in range(3):
@@ -74,17 +74,23 @@ cdef inline bint find_cavity(Mesh* m, int i, int t0) noexcept nogil:
     # as the next cavity triangle and as the next boundary edge, and the verdict advances one of the
     # two counts (the write past the end is overwritten or never read; the arrays have room for it:
     # a cavity never holds every triangle). The first triangle's three edges, then two of each next
-    # one's (those after the edge it was reached by, in the order 0, 1, 2).
+    # one's (those other than the edge it was reached by, in the order 0, 1, 2).
     m.cavity[0] = t0
     for k in range(3):
-        cross_edge(m, 3 * t0 + k, px, py, &n_cav, &n_bnd)
+        inside = cross_edge(m, 3 * t0 + k, px, py, n_cav, n_bnd)
+        n_cav += inside
+        n_bnd += 1 - inside
     j = 1
     while j < n_cav:
         t = m.cavity[j]
         came = m.cav_from[j] - 3 * t
         j += 1
-        cross_edge(m, 3 * t + (came == 0), px, py, &n_cav, &n_bnd)
-        cross_edge(m, 3 * t + 2 - (came == 2), px, py, &n_cav, &n_bnd)
+        inside = cross_edge(m, 3 * t + (came == 0), px, py, n_cav, n_bnd)
+        n_cav += inside
+        n_bnd += 1 - inside
+        inside = cross_edge(m, 3 * t + 2 - (came == 2), px, py, n_cav, n_bnd)
+        n_cav += inside
+        n_bnd += 1 - inside
     m.n_cav = n_cav
     m.n_bnd = n_bnd
     return True
