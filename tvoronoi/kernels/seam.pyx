@@ -38,7 +38,7 @@ cdef enum:
 
 STATUS_OK = OK
 
-# The circumdisk test in doubles, with a bound on its rounding error (see disk_clear), for sites scaled
+# The circumdisk test in doubles, with a bound on its rounding error (see disks_clear), for sites scaled
 # below 1 in magnitude (as the engines scale them). Triangles whose sides' product of three
 # (|b'|_1 |c'|_1 (|b'|_1 + |c'|_1)) is below TINY, where products of differences could underflow, and
 # triangles whose determinant is below FLAT times its magnitude (nearly flat) are left to the seam:
@@ -51,10 +51,17 @@ cdef double FLAT = 2.0 ** -20
 cdef double TINY = 2.0 ** -900
 
 
-cdef inline bint disk_clear(double ax, double ay, double bx, double by, double cx, double cy,
-                            double split, int axis, bint below) noexcept nogil:
-    """True only if the closed circumdisk of triangle abc lies strictly below the line (below) or strictly
-    above it; False also when the doubles cannot tell (the triangle is then left to the seam).
+cdef enum:
+    DISK_BLOCK = 64     # kept_triangles: triangles whose disks are tested in one vectorized loop
+
+
+cdef void disks_clear(const double* xs, const double* ys, const int32_t* tv, Py_ssize_t t0, int count, int inf,
+                      double split, int axis, bint below, double* clear) noexcept nogil:
+    """For triangles t0 .. t0 + count - 1 (count <= DISK_BLOCK), clear[j] = 1.0 only if the closed
+    circumdisk of triangle t0 + j lies strictly below the line (below) or strictly above it; 0.0 also
+    when the doubles cannot tell (the triangle is then left to the seam). In a loop without branches
+    that the compiler runs on pairs of triangles. A triangle with a corner at infinity reads site 0
+    there; its entry is not to be used.
 
     With b' = b - a, c' = c - a, the centre is a + u, u = (c'y B - b'y C, b'x C - c'x B) / d, where
     B = |b'|^2, C = |c'|^2, d = 2 (b'x c'y - b'y c'x), and the radius is |u| <= |u|_1. With D = |b'|_1 |c'|_1
@@ -63,30 +70,45 @@ cdef inline bint disk_clear(double ax, double ay, double bx, double by, double c
     computed u is off in the 1-norm by at most 14 e D (|b'|_1 + |c'|_1) / |d| + |u|_1 (6 e D / |d| + 3 e);
     the centre's coordinate adds e of itself, the final sum 2 e of its terms. SLACK times each term
     covers all of it about three times over.
-    """
-    cdef double bx_ = bx - ax, by_ = by - ay, cx_ = cx - ax, cy_ = cy - ay
-    cdef double nb = fabs(bx_) + fabs(by_), nc = fabs(cx_) + fabs(cy_)
-    cdef double big = nb * nc, d, ux, uy, r, err, base, centre, wb, wc
-    if not big * (nb + nc) > TINY:
-        return False                # products of three differences could underflow
-    d = 2.0 * (bx_ * cy_ - by_ * cx_)
-    if not fabs(d) > FLAT * big:
-        return False                # nearly flat: a huge circle, left to the seam
-    wb = bx_ * bx_ + by_ * by_
-    wc = cx_ * cx_ + cy_ * cy_
-    ux = (cy_ * wb - by_ * wc) / d
-    uy = (bx_ * wc - cx_ * wb) / d
-    r = fabs(ux) + fabs(uy)
-    if axis == 0:
-        base = ax
-        centre = ax + ux
-    else:
-        base = ay
-        centre = ay + uy
-    err = SLACK * (big * (nb + nc) / fabs(d) + r * big / fabs(d) + r + fabs(base) + fabs(split))
-    if below:
-        return centre + r + err < split
-    return centre - r - err > split
+
+    The line is x = split; for y = split (axis 1) the coordinates are read swapped, which mirrors the
+    triangle: d and both numerators are negated, u's components swap, and the bound is the same. The
+    test above the line is the one below it on negated coordinates along the axis."""
+    cdef double pax[DISK_BLOCK]
+    cdef double pay[DISK_BLOCK]
+    cdef double pbx[DISK_BLOCK]
+    cdef double pby[DISK_BLOCK]
+    cdef double pcx[DISK_BLOCK]
+    cdef double pcy[DISK_BLOCK]
+    cdef double bx_, by_, cx_, cy_, nb, nc, big, d, wb, wc, ux, uy, r, err, centre, verdict
+    cdef double slack = SLACK, flat = FLAT, tiny = TINY, sign = 1.0 if below else -1.0
+    cdef const double* along = xs if axis == 0 else ys        # the coordinate across the line, read as x
+    cdef const double* other = ys if axis == 0 else xs
+    cdef int j, a, b, c
+    for j in range(count):
+        a = tv[3 * (t0 + j)]; b = tv[3 * (t0 + j) + 1]; c = tv[3 * (t0 + j) + 2]
+        a = a if a != inf else 0
+        b = b if b != inf else 0
+        c = c if c != inf else 0
+        pax[j] = along[a]; pay[j] = other[a]; pbx[j] = along[b]; pby[j] = other[b]
+        pcx[j] = along[c]; pcy[j] = other[c]
+    for j in range(count):
+        bx_ = pbx[j] - pax[j]; by_ = pby[j] - pay[j]; cx_ = pcx[j] - pax[j]; cy_ = pcy[j] - pay[j]
+        nb = fabs(bx_) + fabs(by_)
+        nc = fabs(cx_) + fabs(cy_)
+        big = nb * nc
+        d = 2.0 * (bx_ * cy_ - by_ * cx_)
+        wb = bx_ * bx_ + by_ * by_
+        wc = cx_ * cx_ + cy_ * cy_
+        ux = (cy_ * wb - by_ * wc) / d
+        uy = (bx_ * wc - cx_ * wb) / d
+        r = fabs(ux) + fabs(uy)
+        centre = pax[j] + ux
+        err = slack * (big * (nb + nc) / fabs(d) + r * big / fabs(d) + r + fabs(pax[j]) + fabs(split))
+        # the verdict, then the cases the bound does not cover (tiny, nearly flat): not clear
+        verdict = 1.0 if (sign * centre + r) + err < sign * split else 0.0
+        verdict = verdict if fabs(d) > flat * big else 0.0
+        clear[j] = verdict if big * (nb + nc) > tiny else 0.0
 
 
 def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
@@ -109,15 +131,19 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
     cdef int a, b, c, u, w, k, o, d
     cdef double qx[4]
     cdef double qy[4]
+    cdef double clear[DISK_BLOCK]
     if keep.shape[0] != n_tri or opp.shape[0] != tv.shape[0] or seam.shape[0] < inf:
         raise ValueError("kept_triangles: keep must hold one entry a triangle, opp one a half-edge, seam one a site")
     cdef int32_t[::1] queue = np.empty(max(n_tri, 1), np.int32)
     qx[0] = ox0; qy[0] = oy0; qx[1] = ox1; qy[1] = oy0; qx[2] = ox1; qy[2] = oy1; qx[3] = ox0; qy[3] = oy1
     with nogil:
         for t in range(n_tri):
+            if t % DISK_BLOCK == 0:
+                disks_clear(&xs[0], &ys[0], &tv[0], t, <int> min(DISK_BLOCK, n_tri - t), inf, split, axis, below,
+                            clear)
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             if a != inf and b != inf and c != inf:
-                keep[t] = disk_clear(xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], split, axis, below)
+                keep[t] = clear[t % DISK_BLOCK] != 0.0
                 if not keep[t]:
                     seam[a] = 1; seam[b] = 1; seam[c] = 1
                 continue
