@@ -123,6 +123,23 @@ def test_sweep_order_is_a_stable_sort_by_y_then_x(rows):
     assert np.array_equal(sweep_order(pts[:, 0], pts[:, 1]), want)
 
 
+@settings(max_examples=300, deadline=None)
+@given(
+    ulps=st.lists(st.integers(-40, 40), min_size=2, max_size=300),
+    far=st.lists(st.sampled_from([5e-324, -5e-324, 1e-300, -1e300, 1e300, -0.0]), max_size=5),
+    xs=st.lists(st.sampled_from([-1.0, 0.0, 2.0]), min_size=305, max_size=305),
+)
+def test_sweep_order_sorts_y_a_few_units_apart_among_far_values(ulps, far, xs):
+    # y from 1e-300 to 1e300 beside values a few units apart: the integer keys are shifted to leave room
+    # for the row, so nearby y share a key, and each run of equal keys is sorted again exactly
+    ys = np.array([1.0 + u * 2.0**-52 for u in ulps] + far)
+    x = np.array(xs[: len(ys)])
+    want = np.lexsort((np.arange(len(ys)), x, ys))
+    got = sweep_order(x, ys)
+    assert got.dtype == np.int32
+    assert np.array_equal(got, want)
+
+
 # ---------------------------------------------------------------------------------------------------------
 # locating sites from hints (beach_line.locate_hinted): the same arcs as the tree's search
 

@@ -103,21 +103,38 @@ def lift_dcel(sub: dict, idx: np.ndarray, n: int) -> dict:
 
 
 def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """Event order of Fortune's sweep: by y, then x (int32)."""
-    perm = np.argsort(ys)
-    sy = ys[perm]
-    tie = sy[1:] == sy[:-1]
-    if len(sy) > 1 and tie.any():
-        # rows of equal y: each run ordered by x, then by input row (as a stable sort by (y, x) would);
-        # only the sites in such runs are sorted again
-        tied = np.zeros(len(sy), bool)
+    """Event order of Fortune's sweep: by y, then x, then input row (int32).
+
+    One sort of 64-bit integers, each a site's y as an unsigned integer of the same order (-0.0 read
+    as +0.0), less the smallest, shifted right just enough that the row fits below it, and the row.
+    Sites whose shifted keys are equal (equal y, or y a few units apart when the span of y needs the
+    shift) are then sorted again, by y, x and row, run by run."""
+    n = len(ys)
+    if n < 2:
+        return np.arange(n, dtype=np.int32)
+    row_bits = (n - 1).bit_length()
+    key = np.add(ys, 0.0).view(np.uint64)  # (a copy)
+    # negative y: every bit flipped; the others: the sign bit set
+    key ^= (np.uint64(0) - (key >> np.uint64(63))) | np.uint64(1 << 63)
+    low = key.min()
+    shift = max(0, int(key.max() - low).bit_length() - (64 - row_bits))
+    key -= low
+    key >>= np.uint64(shift)
+    key <<= np.uint64(row_bits)
+    key |= np.arange(n, dtype=np.uint64)
+    key.sort()
+    perm = (key & np.uint64((1 << row_bits) - 1)).astype(np.int32)
+    key >>= np.uint64(row_bits)
+    tie = key[1:] == key[:-1]
+    if tie.any():
+        tied = np.zeros(n, bool)
         tied[1:] = tie
         tied[:-1] |= tie
         at = np.flatnonzero(tied)
-        run = np.cumsum(np.r_[True, ~tie])[at]  # the run of equal y each tied position is in
+        run = np.cumsum(np.r_[True, ~tie])[at]  # the run of equal keys each tied position is in
         rows = perm[at]
-        perm[at] = rows[np.lexsort((rows, xs[rows], run))]
-    return perm.astype(np.int32)
+        perm[at] = rows[np.lexsort((rows, xs[rows], ys[rows], run))]
+    return perm
 
 
 def engine_order(xs: np.ndarray, ys: np.ndarray, *, engine: str, insertion: str = "brio", seed: int = 0) -> np.ndarray:

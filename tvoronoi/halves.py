@@ -121,13 +121,17 @@ def half(
     n, k = len(xs), len(rows)
     mine = slice(first, first + k)
     if engine == "fortune":
-        s = engines.prepare(hx, hy, engine=engine, seed=seed, exponent=0)
+        # the sites in sweep order, gathered straight into their part of the joined arrays, where the
+        # sweep reads them
+        sweep = engines.sweep_order(hx, hy)
+        renumber.sites_into(hx, hy, rows, None, sweep, out.xs[mine], out.ys[mine], out.perm[mine])
+        del hx, hy
+        s = engines.Sites(0, sweep, out.xs[mine], out.ys[mine])
         t = engines.triangulate(s, engine=engine, guard=False)  # (the joined one is checked in its dual)
         if t.tv is None or t.opp is None:
             return None
         tv_h, opp_h, dup_h = t.tv, t.opp, t.dup
-        out.xs[mine], out.ys[mine], out.perm[mine] = s.xs, s.ys, rows[s.perm]
-        del s, t
+        del s, t, sweep
     else:
         # the sites numbered along the curve that orders their insertion (BRIO), inserted in that order:
         # the numbering the dual and the clipper walk best, with no renumbering after the triangulation
