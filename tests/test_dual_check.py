@@ -21,8 +21,9 @@ from tvoronoi.generators import generate
 from tvoronoi.kernels import dual, fortune
 
 FAMILIES = sorted(adversarial.FAMILIES)
-# powers of two: the same geometry, with the vertices inside edge_order's band, below it and above it
-SCALES = [1.0, 2.0**-1000, 2.0**900]
+# powers of two: the same geometry, with the vertices inside edge_order's band, below it and above it,
+# and subnormal sites (their unit beyond the normal powers of two: the walk's ldexp path)
+SCALES = [1.0, 2.0**-1000, 2.0**900, 2.0**-1040]
 
 
 def triangulation(pts: np.ndarray, engine: str = "fortune", guard: bool = True):

@@ -221,6 +221,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int h0, marked, illegal
     w.check = check
     w.exponent = exponent
+    w.up = ldexp(1.0, exponent) if -1022 <= exponent <= 1022 else 0.0
+    w.down = ldexp(1.0, -exponent) if -1022 <= exponent <= 1022 else 0.0
 
     with nogil:
         # the arrays written whole, faulted in by runs of pages (a part on each thread)
@@ -358,6 +360,8 @@ cdef struct Walk:
     signed char* zero
     bint check                      # test each edge's order too (edge_order), counting illegal ones
     int exponent                    # the sites are in the unit 2^-exponent of the vertices'
+    double up                       # 2^exponent and 2^-exponent, when both are normal doubles
+    double down
 
 
 cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, int* n_illegal) noexcept nogil:
@@ -398,9 +402,16 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
         return h                # a repeated site, or none of the triangles (no cell)
     if check:
         # site a in the vertices' unit, exactly (else every edge of this walk goes to the exact test)
-        ax = ldexp(w.xs[a], w.exponent)
-        ay = ldexp(w.ys[a], w.exponent)
-        rounded_ok = ldexp(ax, -w.exponent) == w.xs[a] and ldexp(ay, -w.exponent) == w.ys[a]
+        # (by the powers of two themselves where both are normal doubles: each product is then one
+        # rounding of the exact value, as ldexp's result is, without a call per site)
+        if -1022 <= w.exponent <= 1022:
+            ax = w.xs[a] * w.up
+            ay = w.ys[a] * w.up
+            rounded_ok = ax * w.down == w.xs[a] and ay * w.down == w.ys[a]
+        else:
+            ax = ldexp(w.xs[a], w.exponent)
+            ay = ldexp(w.ys[a], w.exponent)
+            rounded_ok = ldexp(ax, -w.exponent) == w.xs[a] and ldexp(ay, -w.exponent) == w.ys[a]
     t = opp[e0] // 3
     vr = vid[t]
     if vr >= 0:
