@@ -181,6 +181,21 @@ def test_a_large_build_goes_by_halves_and_threads_agree(engine):
     assert np.array_equal(w.cell_points[w.cell_vertices], two.cell_points[two.cell_vertices])
 
 
+@pytest.mark.parametrize(("tall", "sweep_axis", "plain_axis"), [(1.05, 0, 1), (1.9, 0, 1), (2.2, 1, 1), (0.8, 0, 0)])
+def test_fortune_cuts_its_halves_narrow(tall, sweep_axis, plain_axis):
+    """Fortune's sweep goes up in y and its beach line grows with the width of a half: it cuts at the x
+    median unless the box is more than twice as tall as wide; the incremental engine cuts the longer
+    side. Either cut gives the whole triangulation's cells."""
+    pts = generate("uniform", halves.SPLIT_MIN_SITES + 3000, seed=5) * [1.0, tall]
+    assert halves.cut(pts[:, 0], pts[:, 1], sweep=True).axis == sweep_axis
+    assert halves.cut(pts[:, 0], pts[:, 1]).axis == plain_axis
+    w = whole(pts)
+    for engine in ("fortune", "incremental"):
+        d = api.voronoi(pts, engine=engine, threads=1)
+        assert np.array_equal(w.cell_offsets, d.cell_offsets)
+        assert np.array_equal(w.cell_points[w.cell_vertices], d.cell_points[d.cell_vertices])
+
+
 def test_coordinates_near_the_double_range_cut_without_overflow():
     """Sites from -1e308 to 1e308 in x and -1.7e308 to 1.7e308 in y, above the size that splits: the
     cut measures its spans without overflow (no warning, even as an error), cuts the longer side (y),

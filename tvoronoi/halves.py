@@ -39,10 +39,15 @@ class Cut:
     box_right: tuple[float, float, float, float]
 
 
-def cut(xs: np.ndarray, ys: np.ndarray, bounds=None) -> Cut | None:
+def cut(xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False) -> Cut | None:
     """The cut at the median of the longer side of the sites' box (else of the other side), or None when
     neither gives two halves of at least LEAST_SHARE of the sites each (xs, ys may be strided; bounds:
-    the sites' box (xmin, ymin, xmax, ymax) when known)."""
+    the sites' box (xmin, ymin, xmax, ymax) when known).
+
+    sweep: for Fortune's sweep, which goes up in y and whose beach line grows with the width of what
+    it sweeps (its arcs about sqrt(k w / h) for k sites in a box w by h): the x median first unless the
+    box is more than twice as tall as wide, so that each half is narrow (at 10^6 uniform sites a
+    half swept 7% faster than a wide one)."""
     n = len(xs)
     if n < 4:
         return None
@@ -50,7 +55,8 @@ def cut(xs: np.ndarray, ys: np.ndarray, bounds=None) -> Cut | None:
         bounds = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
     # (half spans: a span of the unscaled coordinates may overflow, as from -1e308 to 1e308)
     spans = (bounds[2] / 2 - bounds[0] / 2, bounds[3] / 2 - bounds[1] / 2)
-    for axis in (0, 1) if spans[0] >= spans[1] else (1, 0):
+    x_first = spans[0] >= (spans[1] / 2 if sweep else spans[1])
+    for axis in (0, 1) if x_first else (1, 0):
         c = xs if axis == 0 else ys
         split = float(np.partition(c, n // 2)[n // 2])
         rows, n_left, box_left, box_right = renumber.split_rows(xs, ys, axis, split)
@@ -175,7 +181,7 @@ def triangulate(
     half of them. Each half's sites are scaled as they are gathered: no scaled copy of all of them.
     bounds: the sites' box (xmin, ymin, xmax, ymax), unscaled, when known (api.checked_points).
     """
-    c = cut(xs, ys, bounds)
+    c = cut(xs, ys, bounds, sweep=engine == "fortune")
     if c is None:
         return None
     c = scaled(c, exponent)
