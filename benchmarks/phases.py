@@ -3,7 +3,8 @@
 For each distribution and size, and each engine and thread count, the phases of a build to bounded
 cells are timed one after the other, in interleaved repeats (the median is reported):
 
-  order     exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
+  order     the check of the points that tvoronoi.voronoi() makes (one pass, which also finds their
+            bounds), exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
   tri       the Delaunay triangulation (Bowyer-Watson walking, or Fortune's sweep), then for the
             incremental engine its sites and triangles renumbered along a Z-curve. From
             halves.SPLIT_MIN_SITES sites on, both engines go by halves (tvoronoi.halves): each half
@@ -43,7 +44,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from benchmarks.common import atomic_write, describe_machine, machine, parse_sizes, subprocess_env  # noqa: E402
 from tvoronoi import build, engines, halves  # noqa: E402
-from tvoronoi.api import default_bbox  # noqa: E402
+from tvoronoi.api import checked_points, default_bbox  # noqa: E402
 from tvoronoi.generators import generate  # noqa: E402
 
 PHASES = ("order", "tri", "dual", "cells")
@@ -63,16 +64,19 @@ def points(dist: str, n: int) -> np.ndarray:
 
 
 def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
-    """One build to bounded cells, phase by phase (seconds), as tvoronoi.build.build_diagram makes it."""
-    box = default_bbox(pts)
+    """One build to bounded cells, phase by phase (seconds), as tvoronoi.voronoi() makes it: its check of
+    the points (one pass, which also finds their bounds: counted in the first phase), then
+    tvoronoi.build.build_diagram's phases."""
     with build.build_arrays():
         k0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
         t0 = time.perf_counter()
-        e = engines.scale_exponent(pts)
+        pts, bounds = checked_points(pts)
+        box = default_bbox(pts, bounds)
+        e = engines.scale_exponent(bounds)
         by_halves = len(pts) >= halves.SPLIT_MIN_SITES
         if by_halves:  # each half is ordered and triangulated on its own thread: one figure for both
             t1 = t0
-            t = build.triangulation(pts, e, engine=engine, insertion="brio", seed=0, threads=threads)
+            t = build.triangulation(pts, e, engine=engine, insertion="brio", seed=0, threads=threads, bounds=bounds)
         else:
             s = engines.prepare(pts[:, 0], pts[:, 1], engine=engine, exponent=e)
             t1 = time.perf_counter()
