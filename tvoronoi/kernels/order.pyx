@@ -8,6 +8,17 @@ from libc.stdlib cimport malloc, free
 from libc.string cimport memcpy
 
 from tvoronoi.kernels.interrupt cimport poll_signals
+
+cdef extern from *:
+    """
+    /* the trailing zeros of a nonzero word (one instruction where there is one) */
+    #if defined(__GNUC__) || defined(__clang__)
+    #define tv_trailing_zeros(w) __builtin_ctzll(w)
+    #else
+    static int tv_trailing_zeros(unsigned long long w) { int r = 0; while (!(w & 1)) { w >>= 1; r++; } return r; }
+    #endif
+    """
+    int trailing_zeros "tv_trailing_zeros"(uint64_t w) noexcept nogil
 from tvoronoi.kernels.populate cimport populate
 
 cdef enum:
@@ -22,6 +33,8 @@ cdef enum:
     # bits of a key sorted by each pass of the radix sort (a count array of 2^11; two passes up to
     # 2^20 sites)
     RADIX_BITS = 11
+    # passes for the longest keys (MAX_KEY_BITS)
+    RADIX_PASSES = 3
     # a cell with more sites is ordered again, on a grid over its own sites
     CROWDED = 32
     # at most this many sites are sorted by insertion, more by radix
@@ -177,27 +190,33 @@ cdef int curve_keys(const double* xs, const double* ys, Keyed* items, Py_ssize_t
 cdef void radix_sort(Keyed* a, Keyed* tmp, Py_ssize_t count, int bits) noexcept nogil:
     """Sort a[0:count] stably by key (keys below 2^bits), in passes of RADIX_BITS (tmp: scratch)."""
     cdef Py_ssize_t k, c
-    cdef Py_ssize_t start[1 << RADIX_BITS]
-    cdef int shift = 0, d
+    cdef Py_ssize_t start[RADIX_PASSES][1 << RADIX_BITS]
+    cdef int shift = 0, d, p, passes = (bits + RADIX_BITS - 1) // RADIX_BITS
+    cdef uint32_t key
     cdef Keyed* src = a
     cdef Keyed* dst = tmp
     cdef Keyed* swap
-    while shift < bits:
+    # every pass's counts in one read of the keys (a pass's counts do not depend on the order before it)
+    for p in range(passes):
         for d in range(1 << RADIX_BITS):
-            start[d] = 0
-        for k in range(count):
-            start[(src[k].key >> shift) & ((1 << RADIX_BITS) - 1)] += 1
+            start[p][d] = 0
+    for k in range(count):
+        key = src[k].key
+        for p in range(passes):
+            start[p][(key >> (p * RADIX_BITS)) & ((1 << RADIX_BITS) - 1)] += 1
+    for p in range(passes):
         c = 0
         for d in range(1 << RADIX_BITS):
-            c, start[d] = c + start[d], c
+            c, start[p][d] = c + start[p][d], c
+    for p in range(passes):
+        shift = p * RADIX_BITS
         for k in range(count):
             d = (src[k].key >> shift) & ((1 << RADIX_BITS) - 1)
-            dst[start[d]] = src[k]
-            start[d] += 1
+            dst[start[p][d]] = src[k]
+            start[p][d] += 1
         swap = src
         src = dst
         dst = swap
-        shift += RADIX_BITS
     if src != a:
         memcpy(a, src, count * sizeof(Keyed))
 
@@ -344,10 +363,9 @@ def brio_order(const double[::1] xs, const double[::1] ys, seed=0, bint along_cu
                 count[r] = 0
             for k in range(n):
                 word = next_random(&state)
-                r = 0
-                while r < last and (word >> r) & 1 == 0:
-                    r += 1
-                # r trailing zeros: round last - r, so that round last - r has probability 2^-(r + 1)
+                # r trailing zeros (at most last; no branch for the random count): round last - r, so
+                # that round last - r has probability 2^-(r + 1)
+                r = trailing_zeros(word | (<uint64_t> 1 << last))
                 round_of[k] = <int8_t> (last - r)
                 count[last - r + 1] += 1
                 a[k].i = <int32_t> k
