@@ -74,7 +74,7 @@ def test_same_seed_same_order(rng):
     assert np.array_equal(np.sort(brio_order(xs, ys, -1)), np.arange(5000))  # any int seeds
 
 
-@pytest.mark.parametrize("bits", [0, 1, 2, 3, 6])
+@pytest.mark.parametrize("bits", [0, 1, 2, 3, 4, 5, 6, 7, 9])
 def test_the_curve_visits_every_cell_once_each_next_to_the_last(bits):
     """The Hilbert curve the rounds follow: a permutation of the cells of a 2^bits square, each cell
     a side's neighbour of the one before, from (0, 0) to (2^bits - 1, 0) (so that squares side by

@@ -3,7 +3,7 @@
 import numpy as np
 
 from libc.math cimport INFINITY, floor, log2
-from libc.stdint cimport int8_t, int32_t, uint8_t, uint32_t, uint64_t
+from libc.stdint cimport int8_t, int32_t, uint8_t, uint16_t, uint32_t, uint64_t
 from libc.stdlib cimport malloc, free
 from libc.string cimport memcpy
 
@@ -98,7 +98,24 @@ cdef void fill_two_levels() noexcept:
                                                           | (NEXT[q1][lo] << 4))
 
 
+# four levels a step, the same way: for state q and the four bits of x and of y (xb << 4 | yb), the
+# eight digits (low byte) and the state after them (bits 8, 9): half the dependent loads of two levels
+cdef uint16_t FOUR_LEVELS[4][256]
+
+
+cdef void fill_four_levels() noexcept:
+    cdef int q, xb, yb, hi, lo, q1
+    for q in range(4):
+        for xb in range(16):
+            for yb in range(16):
+                hi = TWO_LEVELS[q][((xb >> 2) << 2) | (yb >> 2)]
+                q1 = hi >> 4
+                lo = TWO_LEVELS[q1][((xb & 3) << 2) | (yb & 3)]
+                FOUR_LEVELS[q][(xb << 4) | yb] = <uint16_t> ((((hi & 15) << 4) | (lo & 15)) | ((lo >> 4) << 8))
+
+
 fill_two_levels()
+fill_four_levels()
 
 
 cdef inline uint32_t hilbert_index(uint32_t x, uint32_t y, int bits) noexcept nogil:
@@ -110,11 +127,16 @@ cdef inline uint32_t hilbert_index(uint32_t x, uint32_t y, int bits) noexcept no
         quadrant = (((x >> level) & 1) << 1) | ((y >> level) & 1)
         d = DIGIT[0][quadrant]
         q = NEXT[0][quadrant]
-    while level > 0:
+    if level & 2:
         level -= 2
         step = TWO_LEVELS[q][(((x >> level) & 3) << 2) | ((y >> level) & 3)]
         d = (d << 4) | (step & 15)
         q = step >> 4
+    while level > 0:
+        level -= 4
+        step = FOUR_LEVELS[q][(((x >> level) & 15) << 4) | ((y >> level) & 15)]
+        d = (d << 8) | (step & 255)
+        q = step >> 8
     return d
 
 
