@@ -154,33 +154,6 @@ def test_a_freed_mapping_is_given_to_the_next_array_and_zeros_are_zeros():
 
 
 @pytest.mark.skipif(not pages.MAPS or not os.path.exists("/proc/self/statm"), reason="no mappings here")
-def test_a_sparse_array_takes_no_kept_pages_and_leaves_none():
-    """An array made in a sparse() block (Fortune's arcs and events: a worst case, mostly untouched)
-    gets a fresh mapping, not the kept one, which goes to the next ordinary array; freed, it is
-    unmapped at once rather than kept; its data are kept while it lives."""
-    with build_arrays():
-        a = np.full(BIG * 4, 7.0)
-        where = data_address(a)
-        del a
-        with pages.sparse():
-            s = np.empty(BIG * 4)
-        assert data_address(s) != where
-        s[::512] = 5.0  # a few pages touched
-        assert (s[::512] == 5.0).all()
-        b = np.empty(BIG * 4)
-        assert data_address(b) == where  # the kept pages, still there for an array that fills them
-        del b
-        held = resident_mib()
-        with pages.sparse():
-            t = np.ones(2 << 20)  # 16 MiB, all touched
-        del t
-        assert abs(resident_mib() - held) < 2  # unmapped, not kept
-        del s
-        c = np.empty(BIG * 4)
-        assert data_address(c) == where  # the sparse one was never kept
-
-
-@pytest.mark.skipif(not pages.MAPS or not os.path.exists("/proc/self/statm"), reason="no mappings here")
 def test_kept_mappings_are_handed_back_when_the_build_ends():
     """At most 32 MiB of freed mappings are kept, and only until the build's block ends."""
     with build_arrays():

@@ -14,7 +14,6 @@ from libc.stdlib cimport malloc, free
 
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.populate cimport populate
-from tvoronoi.kernels.pages import sparse
 
 from tvoronoi.kernels.predicates cimport orient2d, incircle, incircle_filter
 from tvoronoi.kernels.mesh cimport nxt, prv
@@ -518,26 +517,6 @@ cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap
     s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
 
 
-def _sparse_arrays(int cap_arcs, int cap_ev, int cap_shown):
-    """The sweep's arcs and events (and a trace's record fields), sized for the worst case."""
-    return {
-        "arc_site": np.empty(cap_arcs, np.int32), "arc_prev": np.empty(cap_arcs, np.int32),
-        "arc_next": np.empty(cap_arcs, np.int32), "left": np.empty(cap_arcs, np.int32),
-        "right": np.empty(cap_arcs, np.int32), "parent": np.empty(cap_arcs, np.int32),
-        "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
-        "arc_edge": np.empty(cap_arcs, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
-        "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
-        "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
-        "ev_fine_state": np.empty(cap_ev, np.int8),
-        "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
-        "ev_sites": np.empty(3 * cap_ev, np.int32), "ev_class": np.empty(cap_ev, np.int64),
-        "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
-        "free_events": np.empty(cap_ev, np.int32),
-        "rec_a": np.empty(cap_shown, np.int32), "rec_b": np.empty(cap_shown, np.int32),
-        "rec_x": np.empty(cap_shown, np.float64), "rec_y": np.empty(cap_shown, np.float64),
-    }
-
-
 def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True, bint guard=True):
     """Fortune's sweep over sites sorted by (y, x).
 
@@ -578,12 +557,23 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     # (the records' sites and starts only for a trace's state: a whole sweep would write 24 bytes an
     # edge that nothing reads)
     cdef int cap_shown = cap_rec if stop_after >= 0 else 1
-    # the arcs and events, sized for the worst case but recycled (about sqrt(n) live on uniform sites):
-    # fresh mappings, whose untouched pages cost nothing (pages.sparse)
-    with sparse():
-        arrays = _sparse_arrays(cap_arcs, cap_ev, cap_shown)
-    arrays |= {
+    arrays = {
+        "arc_site": np.empty(cap_arcs, np.int32), "arc_prev": np.empty(cap_arcs, np.int32),
+        "arc_next": np.empty(cap_arcs, np.int32), "left": np.empty(cap_arcs, np.int32),
+        "right": np.empty(cap_arcs, np.int32), "parent": np.empty(cap_arcs, np.int32),
+        "height": np.empty(cap_arcs, np.int8), "arc_event": np.empty(cap_arcs, np.int32),
+        "arc_edge": np.empty(cap_arcs, np.int32),
+        "ev_y": np.empty(cap_ev, np.float64), "ev_x": np.empty(cap_ev, np.float64),
+        "ev_span": np.empty(2 * cap_ev, np.float64), "ev_rise": np.empty(3 * cap_ev, np.float64),
+        "ev_fine_state": np.empty(cap_ev, np.int8),
+        "ev_cy": np.empty(cap_ev, np.float64), "ev_arc": np.empty(cap_ev, np.int32),
+        "ev_sites": np.empty(3 * cap_ev, np.int32),
+        "ev_class": np.empty(cap_ev, np.int64),
+        "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
+        "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
+        "rec_a": np.empty(cap_shown, np.int32), "rec_b": np.empty(cap_shown, np.int32),
         "rec_e0": np.empty(cap_rec, np.int32), "rec_e1": np.empty(cap_rec, np.int32),
+        "rec_x": np.empty(cap_shown, np.float64), "rec_y": np.empty(cap_shown, np.float64),
         "tv": np.empty(3 * cap_tri, np.int32), "opp": np.empty(3 * cap_tri, np.int32),
         "dup": np.full(n, -1, np.int32),
     }

@@ -14,9 +14,7 @@ that made it, so arrays that outlive the build are freed correctly whenever they
 In the checked build (AddressSanitizer) every array comes from malloc, so that the sanitizer sees them.
 While a build runs, freed mappings (up to 32 MiB) are kept and given to the next large arrays, resized in
 place: their pages are resident already, where a fresh mapping's are faulted in and zeroed by the kernel.
-They are unmapped when the last ``mapped()`` block ends. Arrays made in a ``sparse()`` block (sized for
-a worst case, mostly never touched) take fresh mappings and are unmapped when freed: kept pages given
-to them would be resident for nothing. ``trim_heap()`` hands back what the C library's heap holds freed (the kernels' own scratch comes from
+They are unmapped when the last ``mapped()`` block ends. ``trim_heap()`` hands back what the C library's heap holds freed (the kernels' own scratch comes from
 malloc); a build calls it between phases.
 """
 
@@ -41,11 +39,8 @@ cdef extern from *:
     #endif
 
     /* every block starts with a header of 64 bytes (the arrays keep numpy's 64-byte alignment):
-       the length of its own mapping, 0 for a malloc'd block, the size asked for, and 1 for a mapping
-       made in a sparse() block */
+       the length of its own mapping, 0 for a malloc'd block, and the size asked for */
     #define TV_HEAD 64
-    /* set in a sparse() block (this thread): its mappings neither take kept pages nor are kept */
-    static __thread int tv_sparse = 0;
     #define TV_MAP_MIN ((size_t) 1 << 20)
     #define TV_HUGE_MIN ((size_t) 4 << 20)
     #define TV_HUGE_PAGE ((size_t) 2 << 20)
@@ -162,7 +157,7 @@ cdef extern from *:
     #if TV_MAPS
         if (len >= TV_MAP_MIN) {
     #if defined(MREMAP_MAYMOVE)
-            p = tv_sparse ? NULL : tv_reuse(len, &had);
+            p = tv_reuse(len, &had);
             if (p != NULL && had != len) {
                 char* q = (char*) mremap(p, had, len, MREMAP_MAYMOVE);
                 if (q == MAP_FAILED) { munmap(p, had); p = NULL; }
@@ -179,14 +174,12 @@ cdef extern from *:
                 }
                 ((size_t*) p)[0] = len;
                 ((size_t*) p)[1] = n;
-                ((size_t*) p)[2] = 0;
                 return p + TV_HEAD;
             }
             p = tv_map(len);
             if (p == NULL) return NULL;
             ((size_t*) p)[0] = len;
             ((size_t*) p)[1] = n;
-            ((size_t*) p)[2] = (size_t) tv_sparse;
             return p + TV_HEAD;
         }
     #endif
@@ -209,11 +202,7 @@ cdef extern from *:
         if (ptr == NULL) return;
         p = (char*) ptr - TV_HEAD;
     #if TV_MAPS
-        if (((size_t*) p)[0] != 0) {
-            if (((size_t*) p)[2]) munmap(p, ((size_t*) p)[0]);
-            else tv_release(p, ((size_t*) p)[0]);
-            return;
-        }
+        if (((size_t*) p)[0] != 0) { tv_release(p, ((size_t*) p)[0]); return; }
     #endif
         free(p);
     }
@@ -264,7 +253,6 @@ cdef extern from *:
     PyDataMem_Handler tv_handler
     int TV_MAPS
     int tv_trim() nogil
-    int tv_sparse
     void tv_enter() nogil
     void tv_leave() nogil
 
@@ -288,20 +276,6 @@ def mapped():
     finally:
         PyDataMem_SetHandler(old)
         tv_leave()
-
-
-@contextmanager
-def sparse():
-    """Arrays made in this block (in this thread) are sized for a worst case and mostly never touched
-    (Fortune's arcs and events, which it recycles): fresh mappings, whose untouched pages cost nothing,
-    not the pages kept from freed arrays (resident, wasted there and kept out of the arrays that fill
-    them), and unmapped when freed rather than kept."""
-    global tv_sparse
-    tv_sparse = 1
-    try:
-        yield
-    finally:
-        tv_sparse = 0
 
 
 def trim_heap():
