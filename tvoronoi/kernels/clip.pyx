@@ -552,8 +552,14 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
                 lo = offsets[k]
                 hi = offsets[k + 1]
                 dst = cell_offsets[owner[k]]
-                for j in range(hi - lo):
-                    out_p[dst + j] = ring_p[lo + j]
+                if 4 <= hi - lo <= 8:
+                    # (most rings: two moves of four entries, the second ending at the ring's end, with
+                    # no loop whose length a predictor would miss)
+                    memcpy(&out_p[dst], &ring_p[lo], 16)
+                    memcpy(&out_p[dst + (hi - lo) - 4], &ring_p[hi - 4], 16)
+                else:
+                    for j in range(hi - lo):
+                        out_p[dst + j] = ring_p[lo + j]
     return site_of_arr, face_edge_arr, cell_offsets_arr, vertices_arr
 
 
