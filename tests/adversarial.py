@@ -160,6 +160,57 @@ def sine_wave(n: int = 2000, *, seed: int = SEED) -> Case:
     return Case(_pts(np.column_stack([x, np.sin(20.0 * x)])), note="sine wave, step 1e-3")
 
 
+def sunflower(n: int = 1500, *, seed: int = SEED) -> Case:
+    """A sunflower (Vogel's spiral: golden-angle turns, radius sqrt(k)), rounded: near-regular rings of
+    neighbours at every radius, each cell close to a hexagon."""
+    k = np.arange(n, dtype=np.float64)
+    t = k * math.pi * (3.0 - math.sqrt(5.0))
+    r = np.sqrt(k)
+    return Case(_pts(np.column_stack([r * np.cos(t), r * np.sin(t)])), note="sunflower, golden angle")
+
+
+def pencil_of_lines(lines: int = 24, per_line: int = 40, *, decimals: int | None = None, seed: int = SEED) -> Case:
+    """Sites on rays from one centre at even angles, at unit steps of radius (rounded, or to some
+    decimals), with the centre: collinear runs meeting at one point, and near-cocircular rings."""
+    t = np.arange(lines) * (2.0 * math.pi / lines)
+    r = np.arange(1, per_line + 1, dtype=np.float64)
+    x = np.outer(r, np.cos(t)).ravel()
+    y = np.outer(r, np.sin(t)).ravel()
+    if decimals is not None:
+        x, y = np.round(x, decimals), np.round(y, decimals)
+    return Case(_pts(np.concatenate([[[0.0, 0.0]], np.column_stack([x, y])])), note=f"{lines} rays from one point")
+
+
+def rectangle_perimeter(side: int = 300, *, height: int = 170, step: float = 1.0, seed: int = SEED) -> Case:
+    """Sites along the four sides of a rectangle at even steps (integers, or tenths rounded): every
+    four sites symmetric across both axes are exactly (or nearly) cocircular, far apart across it."""
+    xs = np.arange(side + 1) * step
+    ys = np.arange(1, height) * step
+    w, h = side * step, height * step
+    pts = np.concatenate(
+        [
+            np.column_stack([xs, np.zeros_like(xs)]),
+            np.column_stack([xs, np.full_like(xs, h)]),
+            np.column_stack([np.zeros_like(ys), ys]),
+            np.column_stack([np.full_like(ys, w), ys]),
+        ]
+    )
+    rng = np.random.default_rng(seed)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"perimeter of a {side} x {height} rectangle, step {step}")
+
+
+def overlaid_grids(*, a: int = 3, b: int = 5, size: int = 120, seed: int = SEED) -> Case:
+    """Two integer grids of steps a and b over one square (their common points once): exactly cocircular
+    groups of many sizes where the grids meet, and cells of both sizes side by side."""
+    g1 = np.arange(0, size + 1, a)
+    g2 = np.arange(0, size + 1, b)
+    p1 = np.stack(np.meshgrid(g1, g1), -1).reshape(-1, 2)
+    p2 = np.stack(np.meshgrid(g2, g2), -1).reshape(-1, 2)
+    pts = np.unique(np.concatenate([p1, p2]), axis=0).astype(np.float64)
+    rng = np.random.default_rng(seed)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"grids of steps {a} and {b}")
+
+
 def ellipse_rounded(n: int = 800, *, seed: int = SEED) -> Case:
     """Points on a thin ellipse (axes 1 and 1e-4) and its two foci: sites on both sides very close."""
     rng = np.random.default_rng(seed)
@@ -529,6 +580,15 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "parabola_decimal": parabola_decimal,
     "sine_wave": sine_wave,
     "ellipse_thin_with_foci": ellipse_rounded,
+    "sunflower": sunflower,
+    "pencil_of_lines": pencil_of_lines,
+    "pencil_of_lines_3dec": partial(pencil_of_lines, 36, 30, decimals=3),
+    "rectangle_perimeter": rectangle_perimeter,
+    "rectangle_perimeter_tenths": partial(rectangle_perimeter, 200, height=90, step=0.1),
+    "overlaid_grids_3_5": overlaid_grids,
+    "overlaid_grids_4_6_tenths": lambda seed=SEED: Case(
+        overlaid_grids(a=4, b=6, size=96, seed=seed).points * 0.1, note="grids of steps 0.4 and 0.6 (rounded)"
+    ),
     # instruments
     "gps_6dec": gps_degrees,
     "gps_4dec": partial(gps_degrees, decimals=4),
