@@ -63,10 +63,18 @@ def check_vertices(d):
 
 
 def box_frame(d):
-    """Map coordinates into the unit box, so that areas of tiny or huge diagrams stay representable."""
-    xmin, ymin, xmax, ymax = d.bbox
-    size = max(xmax - xmin, ymax - ymin)
-    return lambda xy: (np.asarray(xy, float).reshape(-1, 2) - (xmin, ymin)) / size
+    """Map coordinates into about the unit square by a power of two alone, so that areas of tiny or huge
+    diagrams stay representable and every point keeps its exact value relative to the others: shapely's
+    validity, orientation and coverage tests then judge the rings the Diagram holds, not a rounded copy
+    (a translation, or a division by the box's width, rounds each point and can make a valid ring cross
+    itself -- or an invalid one pass)."""
+    corners = np.abs(np.asarray(d.bbox, float))
+    top = float(corners.max()) if corners.size and np.isfinite(corners).all() else 0.0
+    exponent = int(np.frexp(top)[1]) if top > 0.0 else 0
+    every = np.concatenate([np.asarray(d.cell_points, float).ravel(), np.asarray(d.sites, float).ravel()])
+    if not np.array_equal(np.ldexp(np.ldexp(every, -exponent), exponent), every, equal_nan=True):
+        exponent = 0  # scaling would take some point below the normal range: the points as they are
+    return lambda xy: np.ldexp(np.asarray(xy, float).reshape(-1, 2), -exponent)
 
 
 def cell_polygons(d):
