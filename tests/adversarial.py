@@ -211,6 +211,67 @@ def overlaid_grids(*, a: int = 3, b: int = 5, size: int = 120, seed: int = SEED)
     return Case(_pts(pts[rng.permutation(len(pts))]), note=f"grids of steps {a} and {b}")
 
 
+def grid_with_holes(
+    side: int = 40, *, keep: float = 0.65, degrees: float = 0.0, decimals: int | None = None, seed: int = SEED
+) -> Case:
+    """A lattice with a random part of its points missing (raster centres with gaps in the data), turned
+    and rounded if asked: cocircular unit squares next to empty ones, and cells of many shapes."""
+    rng = np.random.default_rng(seed)
+    g = np.array([(i, j) for i in range(side) for j in range(side)], float)
+    g = g[rng.random(len(g)) < keep]
+    if degrees:
+        t = math.radians(degrees)
+        g = np.column_stack(
+            [math.cos(t) * g[:, 0] - math.sin(t) * g[:, 1], math.sin(t) * g[:, 0] + math.cos(t) * g[:, 1]]
+        )
+    if decimals is not None:
+        g = np.round(g, decimals)
+    return Case(_pts(g[rng.permutation(len(g))]), note=f"lattice with holes, turned {degrees} deg")
+
+
+def mirrored_pairs(n: int = 600, *, decimals: int | None = 3, seed: int = SEED) -> Case:
+    """Random points (rounded) with their mirror images across the diagonal (coordinates swapped,
+    exact) and across the line x = 0.3 (0.6 - x, rounded): many bisectors on one line, Voronoi edges
+    along it, and sites on it."""
+    rng = np.random.default_rng(seed)
+    p = rng.random((n, 2))
+    if decimals is not None:
+        p = np.round(p, decimals)
+    swapped = p[:, ::-1]
+    across = np.column_stack([0.6 - p[:, 0], p[:, 1]])
+    pts = np.unique(np.concatenate([p, swapped, across]), axis=0)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note="points mirrored across y = x and x = 0.3")
+
+
+def huge_circle_arc(n: int = 800, *, radius: float = 1e6, half_width: float = 50.0, seed: int = SEED) -> Case:
+    """Points on a short arc of a huge circle (centre far below), rounded: nearly collinear and nearly
+    cocircular at once, their Voronoi vertices far outside the box, the edges between them nearly
+    parallel."""
+    rng = np.random.default_rng(seed)
+    x = np.sort(rng.uniform(-half_width, half_width, n))
+    y = np.sqrt(radius * radius - x * x) - radius
+    return Case(_pts(np.column_stack([x, y])[rng.permutation(n)]), note=f"arc of a circle of radius {radius:g}")
+
+
+def refined_cells(levels: int = 4, *, size: int = 8, seed: int = SEED) -> Case:
+    """The centres of a quadtree's leaves (adaptive refinement): a square of size x size unit cells,
+    random ones split in four, level after level (dyadic, exact): cells of sizes 1 to 2^-levels side by
+    side, with cocircular groups of many sizes where they meet."""
+    rng = np.random.default_rng(seed)
+    leaves = [(float(i), float(j), 1.0) for i in range(size) for j in range(size)]
+    for _ in range(levels):
+        nxt = []
+        for x, y, w in leaves:
+            if rng.random() < 0.35:
+                h = w / 2.0
+                nxt += [(x, y, h), (x + h, y, h), (x, y + h, h), (x + h, y + h, h)]
+            else:
+                nxt.append((x, y, w))
+        leaves = nxt
+    pts = np.array([(x + w / 2.0, y + w / 2.0) for x, y, w in leaves])
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"quadtree leaf centres, {levels} levels")
+
+
 def ellipse_rounded(n: int = 800, *, seed: int = SEED) -> Case:
     """Points on a thin ellipse (axes 1 and 1e-4) and its two foci: sites on both sides very close."""
     rng = np.random.default_rng(seed)
@@ -588,6 +649,19 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "overlaid_grids_3_5": overlaid_grids,
     "overlaid_grids_4_6_tenths": lambda seed=SEED: Case(
         overlaid_grids(a=4, b=6, size=96, seed=seed).points * 0.1, note="grids of steps 0.4 and 0.6 (rounded)"
+    ),
+    "grid_with_holes": grid_with_holes,
+    "grid_with_holes_23deg_2dec": partial(grid_with_holes, 40, degrees=23.0, decimals=2),
+    "grid_with_holes_tenths": lambda seed=SEED: Case(
+        grid_with_holes(40, seed=seed).points * 0.1, note="lattice with holes, step 0.1 (rounded)"
+    ),
+    "mirrored_pairs_3dec": mirrored_pairs,
+    "mirrored_pairs_raw": partial(mirrored_pairs, 500, decimals=None),
+    "huge_circle_arc": huge_circle_arc,
+    "huge_circle_arc_1e9": partial(huge_circle_arc, 600, radius=1e9, half_width=500.0),
+    "refined_cells": refined_cells,
+    "refined_cells_offset": lambda seed=SEED: Case(
+        refined_cells(5, size=6, seed=seed).points + 1000.3, note="quadtree leaf centres at 1000.3 (rounded)"
     ),
     # instruments
     "gps_6dec": gps_degrees,
