@@ -314,6 +314,40 @@ def survey_rows(rows: int = 40, per_row: int = 40, *, seed: int = SEED) -> Case:
     return Case(_pts(np.column_stack([x, y])), note="survey rows, centimetres")
 
 
+def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
+    """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
+    lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
+    apart, fixes repeated where rounding joins them, legs crossing."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(tracks):
+        p = np.array([-122.4, 37.7]) + rng.uniform(-2e-3, 2e-3, 2)
+        left = 0
+        for _ in range(steps):
+            if left == 0:
+                heading = rng.uniform(0.0, 2.0 * math.pi)
+                left = int(rng.integers(20, 120))
+            p = p + 1e-5 * np.array([math.cos(heading), math.sin(heading)]) * rng.uniform(0.8, 1.2)
+            out.append(p.copy())
+            left -= 1
+    return Case(_pts(np.round(np.array(out), decimals)), note=f"GPS tracks, {decimals} decimals")
+
+
+def contour_lines(levels: int = 12, per_level: int = 150, *, decimals: int = 2, seed: int = SEED) -> Case:
+    """Points along the contour lines of a smooth surface (two hills), sampled evenly in angle and
+    rounded to centimetres: nested closed curves, near-cocircular runs along each, far closer along a
+    line than across."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 2.0 * math.pi, per_level, endpoint=False)
+    out = []
+    for centre, phase in (((0.0, 0.0), 0.0), ((55.0, 10.0), 0.7)):
+        for k in range(1, levels + 1):
+            r = 3.0 * k * (1.0 + 0.15 * np.sin(3.0 * t + phase + 0.2 * k))
+            out.append(np.column_stack([centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)]))
+    pts = np.round(np.concatenate(out), decimals)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"contour lines, {decimals} decimals")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -666,6 +700,10 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     # instruments
     "gps_6dec": gps_degrees,
     "gps_4dec": partial(gps_degrees, decimals=4),
+    "gps_tracks_6dec": gps_tracks,
+    "gps_tracks_5dec": partial(gps_tracks, 8, 250, decimals=5),
+    "contour_lines_cm": contour_lines,
+    "contour_lines_dm": partial(contour_lines, 10, 200, decimals=1),
     "utm_mm": utm_millimetres,
     "float32_sensor": float32_sensor,
     "survey_rows_cm": survey_rows,
