@@ -1,5 +1,7 @@
 """Invariants every Diagram must satisfy, checked without stored answers."""
 
+import types
+
 import numpy as np
 import shapely
 
@@ -157,3 +159,21 @@ def assert_same_diagram(a, b):
         assert x.dtype == y.dtype and x.shape == y.shape, name
         assert np.array_equal(x, y), f"{name} differs"
     assert a.bbox == b.bbox
+
+
+def with_rings(d, rings):
+    """A stand-in for Diagram d with its sites and box and the given rings (one per site, in site order,
+    empty for none): for tests that spoil a cell and expect a check to catch it."""
+    lengths = [len(r) for r in rings]
+    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+    points = np.vstack([np.asarray(r, float).reshape(-1, 2) for r in rings]) if sum(lengths) else np.zeros((0, 2))
+    return types.SimpleNamespace(
+        sites=d.sites,
+        site_of=d.site_of,
+        n_sites=d.n_sites,
+        bbox=d.bbox,
+        cell_points=points,
+        cell_vertices=np.arange(len(points), dtype=np.int32),
+        cell_offsets=offsets,
+        cell_polygon=lambda i: points[offsets[i] : offsets[i + 1]],
+    )

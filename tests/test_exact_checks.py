@@ -1,12 +1,11 @@
 """The exact checks themselves catch what they are for, at spans GEOS cannot handle (unit sites, a 1e300 box)."""
 
-import types
-
 import numpy as np
 import pytest
 
 import exact_checks as ec
 import tvoronoi
+from invariants import with_rings
 
 
 def huge_box_diagram():
@@ -14,20 +13,6 @@ def huge_box_diagram():
     d = tvoronoi.voronoi(pts, bbox=(-1e300, -1e300, 1e300, 1e300))
     assert ec.magnitude_span(d) > ec.GEOS_SPAN_BITS
     return d
-
-
-def with_cells(d, rings):
-    """A stand-in diagram with the same sites and box and the given rings."""
-    offsets = np.concatenate([[0], np.cumsum([len(r) for r in rings])]).astype(np.int64)
-    points = np.vstack([r for r in rings if len(r)]) if any(len(r) for r in rings) else np.zeros((0, 2))
-    return types.SimpleNamespace(
-        sites=d.sites,
-        site_of=d.site_of,
-        n_sites=d.n_sites,
-        bbox=d.bbox,
-        cell_points=points,
-        cell_polygon=lambda i: points[offsets[i] : offsets[i + 1]],
-    )
 
 
 def test_the_huge_box_diagram_passes():
@@ -43,7 +28,7 @@ def test_a_moved_shared_vertex_is_caught():
     i = next(i for i, r in enumerate(rings) if len(r) and np.abs(r).max() < 10)
     rings[i][0] = rings[i][0] + 1e-3 * (rings[i][1] - rings[i][0])
     with pytest.raises(AssertionError, match="(no neighbour|cover)"):
-        ec.check_tiling(with_cells(d, rings))
+        ec.check_tiling(with_rings(d, rings))
 
 
 def test_a_self_intersecting_cell_is_caught():
@@ -53,7 +38,7 @@ def test_a_self_intersecting_cell_is_caught():
     r = rings[i]
     r[[1, 2]] = r[[2, 1]]  # a bow tie
     with pytest.raises(AssertionError, match="(not simple|clockwise|flat)"):
-        ec.check_cells_valid(with_cells(d, rings))
+        ec.check_cells_valid(with_rings(d, rings))
 
 
 def test_a_site_outside_its_cell_by_more_than_rounding_is_caught():
@@ -69,4 +54,4 @@ def test_a_site_outside_its_cell_by_more_than_rounding_is_caught():
         # the cell moved up until its lowest point is 1e-9 above its site
         rings[i] = rings[i] + np.array([0.0, d.sites[i][1] - rings[i][:, 1].min() + 1e-9])
         with pytest.raises(AssertionError, match="outside its cell"):
-            ec.check_cells_valid(with_cells(d, rings))
+            ec.check_cells_valid(with_rings(d, rings))

@@ -7,8 +7,6 @@ it made valid rings cross themselves: a false alarm at 1,000 sites, and the same
 hide a ring that does cross itself. The frame is now a power of two, exact.
 """
 
-import types
-
 import numpy as np
 import pytest
 import shapely
@@ -21,23 +19,6 @@ import tvoronoi
 def perimeter_diagram(seed: int, engine: str):
     case = adversarial.rectangle_perimeter(300, height=200, step=0.1, seed=seed)
     return tvoronoi.voronoi(case.points, engine=engine)
-
-
-def stand_in(d, rings):
-    """A diagram with d's sites and box and the given rings (one per site, in site order)."""
-    lengths = [len(r) for r in rings]
-    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-    points = np.vstack([np.asarray(r, float).reshape(-1, 2) for r in rings])
-    return types.SimpleNamespace(
-        sites=d.sites,
-        site_of=d.site_of,
-        n_sites=d.n_sites,
-        bbox=d.bbox,
-        cell_points=points,
-        cell_vertices=np.arange(len(points), dtype=np.int32),
-        cell_offsets=offsets,
-        cell_polygon=lambda i: points[offsets[i] : offsets[i + 1]],
-    )
 
 
 @pytest.mark.parametrize("engine", ["fortune", "incremental"])
@@ -89,4 +70,4 @@ def test_a_ring_crossing_itself_by_an_ulp_is_caught():
     # the ring's first point, moved across its opposite edge's line: swap two neighbours
     rings[k] = r[[0, 2, 1, 3]]
     with pytest.raises(AssertionError, match=f"cell {k} invalid"):
-        invariants.check_cells(stand_in(d, rings))
+        invariants.check_cells(invariants.with_rings(d, rings))
