@@ -757,6 +757,17 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "box_on_lattice_edges": box_on_lattice_edges,
     "box_on_lattice_edges_tenths": partial(box_on_lattice_edges, 30, step=0.1),
     "box_corner_on_vertex": box_corner_on_vertex,
+    "box_on_perimeter_sites_tenths": lambda seed=SEED: Case(
+        rectangle_perimeter(60, height=40, step=0.1, seed=seed).points,
+        bbox=(0.0, 0.0, 6.0, 4.0),
+        note="sites along the box's own sides, at tenths",
+    ),
+    "box_on_mirror_axis": lambda seed=SEED: Case(
+        mirrored_pairs(200, seed=seed).points, bbox=(0.0, 0.0, 0.3, 1.0), note="box side on the mirror line"
+    ),
+    "box_through_refined_cells": lambda seed=SEED: Case(
+        refined_cells(4, size=6, seed=seed).points, bbox=(0.5, 0.5, 5.0, 5.0), note="box sides on leaf edges"
+    ),
     "box_corner_on_vertex_pythagorean": partial(box_corner_on_vertex, 20, pythagorean=True),
     # neighbours an ulp apart
     "ulp_pairs_3dec": ulp_pairs,

@@ -16,6 +16,7 @@ import exact_checks
 import tvoronoi
 from tvoronoi.api import as_bbox, check_engine
 from tvoronoi.engines import BOX_SCALED_MAX
+from tvoronoi.errors import CoordinateRangeError
 
 # -- points ---------------------------------------------------------------------------------------
 
@@ -37,6 +38,25 @@ def test_bad_points_are_named(bad, message):
 def test_dynamic_range_beyond_exact_arithmetic_is_refused():
     with pytest.raises(tvoronoi.TvoronoiError, match="point 2: .* 2\\^170"):
         tvoronoi.voronoi([[0.0, 0.0], [0.0, 1.0], [1e-60, 0.5]])
+
+
+def test_a_dynamic_box_that_sets_the_scale_is_named_in_the_range_error():
+    """A dynamic diagram's scale is its box's and its first sites': when a huge box sets it, the message
+    measures the sites against the box (not against the largest site, which is in range of them) and
+    advises a smaller box. The batch build takes the same box (its scale is the sites' alone)."""
+    pts = np.random.default_rng(1).random((5, 2)) + 0.5
+    box = (-1e300, -1e300, 1e300, 1e300)
+    with pytest.raises(CoordinateRangeError) as caught:
+        tvoronoi.DynamicVoronoi(pts, bbox=box)
+    message = str(caught.value)
+    assert message.startswith("point 0: coordinate ")
+    assert "smaller than the scale of the box (about 1.34e+300)" in message
+    assert "choose a box nearer the points' scale" in message
+    assert "largest coordinate" not in message
+    assert tvoronoi.voronoi(pts, bbox=box).n_sites == 5
+    # where the sites themselves set the scale, the message is the batch build's
+    with pytest.raises(CoordinateRangeError, match="than the largest coordinate, 1e\\+60 \\(point 0\\)"):
+        tvoronoi.DynamicVoronoi([[1e60, 0.0], [1.0, 2.0]], bbox=(-1e61, -1e61, 1e61, 1e61))
 
 
 # -- the box ----------------------------------------------------------------------------------------

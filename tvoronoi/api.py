@@ -26,12 +26,15 @@ BBOX_MARGIN = 0.10
 RANGE_BITS = 170
 
 
-def check_range(pts: np.ndarray, e: int, *, what: str = "point", scale_of: str | None = None) -> None:
+def check_range(
+    pts: np.ndarray, e: int, *, what: str = "point", scale_of: str | None = None, remedy: str | None = None
+) -> None:
     """Refuse nonzero coordinates more than 2^170 from the scale 2^e (naming the first row at fault).
 
     ``what`` names the rows ("point" gives "point 3"; a name starting with "the " names a single one).
     ``scale_of`` names where the scale comes from when it is not these points' own ("the diagram" for a
     new site or a query point): the message then measures against it, not against the largest of them.
+    ``remedy``: what the message advises instead of rounding tiny values or removing the outlier.
 
     Raises
     ------
@@ -63,6 +66,7 @@ def check_range(pts: np.ndarray, e: int, *, what: str = "point", scale_of: str |
             rows=(row, top_row),
             values=(float(pts[row, col]), top),
             small=bool(mag[row, col] < low),
+            remedy=remedy,
             locate=lambda i: (
                 (what if what.startswith("the ") else f"{what} {i}") if i >= 0 else f"the scale of {scale_of}"
             ),

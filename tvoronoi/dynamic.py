@@ -123,7 +123,11 @@ class DynamicVoronoi:
         # the one range rule (tvoronoi.api): the mesh holds sites scaled by 2^-e, e fixed by the box and
         # the first sites, so later sites anywhere within 2^170 of that scale stay exact
         self._e = engines.scale_exponent(pts, self.bbox)
-        check_range(pts, self._e)
+        if len(pts) and engines.scale_exponent(pts) < self._e:
+            # the box sets the scale: measure against it, not against the largest of the points
+            check_range(pts, self._e, scale_of="the box", remedy="choose a box nearer the points' scale")
+        else:
+            check_range(pts, self._e)
         engines.check_box_scale(self.bbox, self._e)
         n = len(pts)
         self._xy = np.full((max(2 * n, 16), 2), np.nan)

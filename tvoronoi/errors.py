@@ -21,8 +21,11 @@ class CoordinateRangeError(TvoronoiError):
     that knows where they are in a file.
     """
 
-    def __init__(self, *, rows: tuple[int, int], values: tuple[float, float], small: bool, locate):
+    def __init__(
+        self, *, rows: tuple[int, int], values: tuple[float, float], small: bool, locate, remedy: str | None = None
+    ):
         self.rows, self.values, self.small = rows, values, small
+        self.remedy = remedy or "round tiny values to 0, or remove the outlier"
         super().__init__(self.explain(locate))
 
     def explain(self, locate) -> str:
@@ -38,5 +41,5 @@ class CoordinateRangeError(TvoronoiError):
         around = locate(top_row) if top_row < 0 else "the largest coordinate"
         return (
             f"{locate(row)}: coordinate {value!r} is {what}: exact arithmetic covers a range of 2^170 "
-            f"(about 1e51) around {around}; round tiny values to 0, or remove the outlier"
+            f"(about 1e51) around {around}; {self.remedy}"
         )
