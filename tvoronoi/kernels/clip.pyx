@@ -74,6 +74,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef signed char* tie = <signed char*> scratch.take(max(m, 1), True)
     cdef int32_t* seg_start = <int32_t*> scratch.take(max(n_he, 1) * sizeof(int32_t), False)
     cdef int32_t* seg_end = <int32_t*> scratch.take(max(n_he, 1) * sizeof(int32_t), False)
+    cdef int32_t* cross = <int32_t*> scratch.take(max(n_he, 1) * sizeof(int32_t), False)   # whole_edges
     cdef signed char[::1] flags = np.zeros(n_he, np.int8)
     cdef int64_t[::1] offsets = np.zeros(n + 1, np.int64)
     cdef double[:, ::1] pts, room_pts
@@ -91,6 +92,7 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
     cdef int T = threads if n >= parallel_min and threads > 1 else 1
     # per thread: 1 if some vertex lies outside turn()'s band of magnitudes (clipper.pxd)
     cdef int[::1] off_band = np.zeros(T, np.intc)
+    cdef int[::1] n_cross_of = np.zeros(T, np.intc)
     with nogil:
         # vertices against the box: rounded comparisons, exact where a coordinate equals a side
         # (each thread a run of them, in a function of its own: its pointers stay in registers across
@@ -114,12 +116,16 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             vcy[v] = axis_code(vertices[v, 1], box.ymin, box.ymax, box.symin, box.symax,
                                xs[a], ys[a], xs[b], ys[b], xs[c], ys[c], True)
             v_in[v] = code_in(vcx[v]) and code_in(vcy[v])
-        # the edges with both ends vertices in the box are whole; the others counted
+        # the edges with both ends vertices in the box are whole; the others listed, each thread's
+        # from the start of its run of half-edges
         for k in prange(T, num_threads=T, schedule="static", chunksize=1):
-            n_cross += whole_edges(<int> (<int64_t> k * n_he // T), <int> (<int64_t> (k + 1) * n_he // T), n_he,
-                                   &he_origin[0] if n_he > 0 else NULL, &he_twin[0] if n_he > 0 else NULL,
-                                   &he_face[0] if n_he > 0 else NULL, &face_edge[0] if n > 0 else NULL,
-                                   v_in, &flags[0] if n_he > 0 else NULL)
+            n_cross_of[k] = whole_edges(<int> (<int64_t> k * n_he // T), <int> (<int64_t> (k + 1) * n_he // T),
+                                        n_he, &he_origin[0] if n_he > 0 else NULL,
+                                        &he_twin[0] if n_he > 0 else NULL, &he_face[0] if n_he > 0 else NULL,
+                                        &face_edge[0] if n > 0 else NULL, v_in, &flags[0] if n_he > 0 else NULL,
+                                        cross)
+        for k in range(T):
+            n_cross += n_cross_of[k]
     cdef bint in_room = False
     if room is not None:
         room_pts = room
@@ -143,49 +149,48 @@ def clip_cells(const double[::1] xs, const double[::1] ys, const double[:, ::1] 
             pt_a[v] = he_face[h]
             pt_b[v] = he_face[he_twin[h]]
             pt_c[v] = he_face[he_twin[prev_in_cell(h, n_he, &he_face[0], &face_edge[0])]]
-        for v in range(m):
+        # (codes -1 and 1, on a side, are a tie's alone: vertex_codes gives the others -2, 0 or 2)
+        for v in range(m if n_ties > 0 else 0):
             if (vcx[v] == 1 or vcx[v] == -1 or vcy[v] == 1 or vcy[v] == -1) and code_in(vcx[v]) and code_in(vcy[v]):
                 pt_side[v] = code_side(vcx[v], vcy[v])
 
-        # clip each edge that is not whole once, along the half-edge of smaller index; its twin runs the
-        # other way
-        for h in range(n_he if n_cross > 0 else 0):
-            if flags[h] != 0:
-                continue                # whole, or the twin of an edge clipped already
-            tw = he_twin[h]
-            if tw < h:
-                continue
-            o = he_origin[h]
-            d = he_origin[tw]
-            has_o = o >= 0
-            has_d = d >= 0
-            a = he_face[h]
-            b = he_face[tw]
-            clip_edge(&box, xs[a], ys[a], xs[b], ys[b],
-                      has_o, vcx[o] if has_o else 0, vcy[o] if has_o else 0,
-                      has_d, vcx[d] if has_d else 0, vcy[d] if has_d else 0, &part)
-            if not part.has:
-                continue
-            if part.start_at == AT_POINT:
-                pts[n_pts, 0] = part.sx; pts[n_pts, 1] = part.sy
-                pt_side[n_pts] = part.s_side
-                pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
-                seg_start[h] = n_pts
-                n_pts += 1
-            else:
-                seg_start[h] = o if part.start_at == AT_ORIGIN else d
-            if part.end_at == AT_POINT:
-                pts[n_pts, 0] = part.ex; pts[n_pts, 1] = part.ey
-                pt_side[n_pts] = part.e_side
-                pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
-                seg_end[h] = n_pts
-                n_pts += 1
-            else:
-                seg_end[h] = o if part.end_at == AT_ORIGIN else d
-            flags[h] = HAS | (ENTRY if part.entry else 0) | (EXIT if part.exit else 0)
-            seg_start[tw] = seg_end[h]
-            seg_end[tw] = seg_start[h]
-            flags[tw] = HAS | (ENTRY if part.exit else 0) | (EXIT if part.entry else 0)
+        # clip each edge that is not whole once, along the half-edge of smaller index (as whole_edges
+        # listed them, each thread's in increasing order); its twin runs the other way
+        for i in range(T * (n_cross > 0)):
+            for k in range(n_cross_of[i]):
+                h = cross[<int> (<int64_t> i * n_he // T) + k]
+                tw = he_twin[h]
+                o = he_origin[h]
+                d = he_origin[tw]
+                has_o = o >= 0
+                has_d = d >= 0
+                a = he_face[h]
+                b = he_face[tw]
+                clip_edge(&box, xs[a], ys[a], xs[b], ys[b],
+                          has_o, vcx[o] if has_o else 0, vcy[o] if has_o else 0,
+                          has_d, vcx[d] if has_d else 0, vcy[d] if has_d else 0, &part)
+                if not part.has:
+                    continue
+                if part.start_at == AT_POINT:
+                    pts[n_pts, 0] = part.sx; pts[n_pts, 1] = part.sy
+                    pt_side[n_pts] = part.s_side
+                    pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
+                    seg_start[h] = n_pts
+                    n_pts += 1
+                else:
+                    seg_start[h] = o if part.start_at == AT_ORIGIN else d
+                if part.end_at == AT_POINT:
+                    pts[n_pts, 0] = part.ex; pts[n_pts, 1] = part.ey
+                    pt_side[n_pts] = part.e_side
+                    pt_a[n_pts] = a; pt_b[n_pts] = b; pt_c[n_pts] = -1
+                    seg_end[h] = n_pts
+                    n_pts += 1
+                else:
+                    seg_end[h] = o if part.end_at == AT_ORIGIN else d
+                flags[h] = HAS | (ENTRY if part.entry else 0) | (EXIT if part.exit else 0)
+                seg_start[tw] = seg_end[h]
+                seg_end[tw] = seg_start[h]
+                flags[tw] = HAS | (ENTRY if part.exit else 0) | (EXIT if part.entry else 0)
 
         corner0 = n_pts
         for k in range(4):
@@ -296,16 +301,17 @@ cdef int vertex_codes(int lo, int hi, const double* vertices, const Box* box, si
 
 cdef int whole_edges(int lo, int hi, int n_he, const int32_t* he_origin, const int32_t* he_twin,
                      const int32_t* he_face, const int32_t* face_edge, const signed char* v_in,
-                     signed char* flags) noexcept nogil:
+                     signed char* flags, int32_t* cross) noexcept nogil:
     # half-edges lo..hi-1 with both ends in the box flagged whole (each on its own: its end is where the
     # next one of its cell starts, and the twin reaches the same verdict; v_in reads 0 at infinity, -1);
-    # returns the count of the other edges, from the half-edge of smaller index (each makes at most two
-    # new points)
+    # the other edges, each from its half-edge of smaller index (each makes at most two new points),
+    # listed in increasing order from cross[lo] on; returns their count
     cdef int h, k, n_cross = 0
     for h in range(lo, hi):
         k = v_in[he_origin[h]] & v_in[he_origin[next_in_cell(h, n_he, he_face, face_edge)]]
         flags[h] = k * (HAS | WHOLE)
         if k == 0 and he_twin[h] > h:
+            cross[lo + n_cross] = h
             n_cross += 1
     return n_cross
 
