@@ -146,6 +146,8 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
                 keep[t] = clear[t % DISK_BLOCK] != 0.0
                 if not keep[t]:
                     seam[a] = 1; seam[b] = 1; seam[c] = 1
+                    queue[tail] = <int32_t> t       # (for the pass on cocircular sites below)
+                    tail += 1
                 continue
             # an infinite triangle (u, w, inf): its region is the open half-plane left of u->w
             if a == inf:
@@ -165,10 +167,7 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
         # the next (the bound reads the circle from the triangle's first corner), so a kept triangle whose
         # neighbour not kept is on the same circle (exact in-circle 0) is not kept either, until none is:
         # the edges between kept triangles and the rest then have no site on the kept circle's far arc
-        for t in range(n_tri):
-            if not keep[t] and tv[3 * t] != inf and tv[3 * t + 1] != inf and tv[3 * t + 2] != inf:
-                queue[tail] = <int32_t> t
-                tail += 1
+        # (the queue starts with the finite triangles not kept, listed above)
         while head < tail:
             t = queue[head]
             head += 1
