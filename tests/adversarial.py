@@ -348,6 +348,22 @@ def contour_lines(levels: int = 12, per_level: int = 150, *, decimals: int = 2, 
     return Case(_pts(pts[rng.permutation(len(pts))]), note=f"contour lines, {decimals} decimals")
 
 
+def mercator_graticule(step: float = 5.0, *, decimals: int = 2, seed: int = SEED) -> Case:
+    """A longitude/latitude graticule in Web Mercator metres (sphere of 6,378,137 m), rounded to
+    centimetres: a rectilinear grid whose rows spread apart towards the poles, at magnitudes near 2e7.
+    Every column shares its rounded x and every row its rounded y, so each grid cell's four sites are
+    exactly cocircular, at every row spacing."""
+    rng = np.random.default_rng(seed)
+    radius = 6378137.0
+    lon0 = rng.uniform(-step, 0.0)
+    lons = np.radians(np.arange(lon0 - 180.0, 180.0, step))
+    lats = np.radians(np.arange(-80.0 + rng.uniform(0.0, step), 80.0, step))
+    x = np.round(radius * lons, decimals)
+    y = np.round(radius * np.log(np.tan(math.pi / 4.0 + lats / 2.0)), decimals)
+    gx, gy = np.meshgrid(x, y)
+    return Case(_pts(np.column_stack([gx.ravel(), gy.ravel()])), note=f"Mercator graticule every {step} degrees")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -390,6 +406,30 @@ def decimal_circles(circles: int = 150, *, decimals: int = 3, seed: int = SEED) 
         ring = circles_at[rng.integers(0, len(circles_at))]
         parts.append(np.round(c + ring[rng.random(len(ring)) < 0.6] * q, decimals))
     return Case(_pts(np.concatenate(parts)), note=f"{circles} decimal circles, {decimals} decimals")
+
+
+def sobol_net(m: int = 11, *, unit: float = 1.0, seed: int = SEED) -> Case:
+    """The first 2^m points of the two-dimensional Sobol sequence (unscrambled) on the integer grid
+    0 .. 2^m - 1, each axis XOR-shifted by a seeded integer (a digital shift: still a (0, m, 2)-net,
+    one point in every dyadic box of area 2^m), times ``unit``: a permutation of a grid, so full of
+    exactly cocircular quadruples and of collinear runs in dyadic directions; unit 0.001 rounds them."""
+    from scipy.stats import qmc
+
+    rng = np.random.default_rng(seed)
+    grid = np.rint(qmc.Sobol(2, scramble=False).random_base2(m) * (1 << m)).astype(np.int64)
+    grid ^= rng.integers(0, 1 << m, 2)
+    return Case(_pts(grid * unit), note=f"Sobol (0, {m}, 2)-net, unit {unit}")
+
+
+def halton_rounded(n: int = 3000, *, decimals: int = 3, seed: int = SEED) -> Case:
+    """Halton points in bases 2 and 3 (unscrambled, from a seeded start) scaled to 100 and rounded: a
+    low-discrepancy set whose thirds round in every coordinate, nearly regular everywhere."""
+    from scipy.stats import qmc
+
+    rng = np.random.default_rng(seed)
+    h = qmc.Halton(2, scramble=False)
+    h.fast_forward(int(rng.integers(0, 10_000)))
+    return Case(_pts(np.round(100.0 * h.random(n), decimals)), note=f"Halton points, {decimals} decimals")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -707,6 +747,8 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "utm_mm": utm_millimetres,
     "float32_sensor": float32_sensor,
     "survey_rows_cm": survey_rows,
+    "mercator_graticule_cm": mercator_graticule,
+    "mercator_graticule_m": partial(mercator_graticule, 4.0, decimals=0),
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
@@ -718,6 +760,10 @@ FAMILIES: dict[str, Callable[..., Case]] = {
         decimal_pythagorean(600, decimals=2, seed=seed).points + 1000.0, note="decimal circles of 5 at 1000"
     ),
     "decimal_circles_3dec": partial(decimal_circles, 60, decimals=3),
+    "sobol_net": sobol_net,
+    "sobol_net_mm": partial(sobol_net, 11, unit=0.001),
+    "halton_3dec": halton_rounded,
+    "halton_1dec": partial(halton_rounded, 2000, decimals=1),
     # circles
     "circle_rounded": partial(circle_rounded, 500),
     "circle_rounded_offset": partial(circle_rounded, 300, radius=1e-3, centre=(1e4, -1e4)),
