@@ -76,3 +76,37 @@ def test_each_origin_is_the_centre_of_the_triangle_on_the_right(engine):
             assert origin[g] == right
             checked += 1
     assert checked > 0.9 * len(face)
+
+
+@pytest.mark.parametrize("check", [False, True])
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize("name", sorted(adversarial.FAMILIES))
+def test_a_triangulation_given_up_gives_the_same_dcel_with_its_triangles_in_place(name, engine, check):
+    """give_tv: the finite triangles are moved to the front of tv itself (no copy); everything else is
+    what a dual that keeps tv makes, on one thread and on two (Fortune's check reads tv's rows too)."""
+    got = triangulated(adversarial.make(name).points, engine)
+    if got is None:
+        return
+    t, e = got
+    s = t.sites
+    for threads in (1, 2):
+        want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, check=check)
+        tv = t.tv.copy()
+        given = dual.voronoi_from_delaunay(s.xs, s.ys, tv, t.opp, e, threads, parallel_min=1, check=check, give_tv=True)
+        assert set(given) == set(want)
+        for key in want:
+            assert np.array_equal(given[key], want[key]), key
+        assert np.array_equal(given["triangles"], finite_rows(t))
+        if len(given["triangles"]):
+            assert np.shares_memory(given["triangles"], tv) and given["triangles"].flags.writeable
+
+
+def test_a_read_only_triangulation_is_not_written_when_given_up():
+    t, e = triangulated(generate("uniform", 500, seed=3), "incremental")
+    s = t.sites
+    tv = t.tv.copy()
+    tv.flags.writeable = False
+    out = dual.voronoi_from_delaunay(s.xs, s.ys, tv, t.opp, e, give_tv=True)
+    assert np.array_equal(tv, t.tv)
+    assert not np.shares_memory(out["triangles"], tv)
+    assert np.array_equal(out["triangles"], finite_rows(t))

@@ -32,8 +32,9 @@ def build_diagram(
     with build_arrays():
         t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads, bounds=bounds)
         pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
-        s, out = t.sites, t.voronoi(threads, clip_room=True)
-        del t  # the triangulation is not needed to clip
+        # (the triangulation is not needed to clip: its tv becomes the Diagram's triangles, in place)
+        s, out = t.sites, t.voronoi(threads, clip_room=True, give_tv=True)
+        del t
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 
 

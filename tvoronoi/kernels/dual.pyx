@@ -5,6 +5,7 @@ import numpy as np
 from cython.parallel cimport prange
 from libc.stdint cimport int32_t, uint64_t
 from libc.math cimport fabs, ldexp
+from libc.string cimport memmove
 
 from tvoronoi.kernels.construct cimport circumcentre, circumcentres_block, CENTRE_BLOCK
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -100,7 +101,7 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
                           int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False,
-                          int walk_chunk=WALK_CHUNK, bint check=False):
+                          int walk_chunk=WALK_CHUNK, bint check=False, bint give_tv=False):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -133,6 +134,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         of each Voronoi edge at hand, and the exact in-circle test runs only where their rounded
         values cannot tell. If some edge is not, the result is only {"illegal": count}: no diagram
         (the caller repairs the triangulation and builds again).
+    give_tv : bool, the caller gives tv up (it must be writable and not read again): the finite
+        triangles are moved to its start in place and ``triangles`` is a view of it, not a copy (a
+        result of only {"illegal": count} leaves tv as it was).
 
     Returns
     -------
@@ -162,6 +166,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
     if n < parallel_min:
         threads = 1
+    if give_tv and not (isinstance(tv.base, np.ndarray) and tv.base.flags.writeable):
+        give_tv = False         # (not an array it can write: the triangles are copied)
 
     with nogil:
         fill_int32(&first_e[0], n, -1)      # (written whole: faulted in by runs of pages)
@@ -208,14 +214,16 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     # (an edge is dual to a Delaunay edge between two sites, n_he_d bounds twice their number)
     centre_buf = np.empty((n_finite + (n_he_d + 4 if clip_room else 0), 2), np.float64)
     centre = centre_buf
-    tri = np.empty((n_finite, 3), np.int32)
+    # the finite triangles: written as the vertices are numbered, unless tv is given up (then moved
+    # within it once the walks are done)
+    tri = None if give_tv else np.empty((n_finite, 3), np.int32)
     cdef signed char[::1] zero = np.zeros(max(n_he_d, 1), np.int8)   # zero-length: cocircular triangles
     cdef int n_zero = 0, n_marked = 0, n_illegal = 0
-    cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 else NULL
+    cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 and not give_tv else NULL
     cdef double* centres = &centre[0, 0] if n_finite > 0 else NULL
     cdef Walk w
     w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
-    w.vor = &vor[0]; w.vid = &vid[0]; w.tri = tri_rows
+    w.vor = &vor[0]; w.vid = &vid[0]
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
     w.xs = &xs[0]; w.ys = &ys[0]; w.centre = centres; w.zero = &zero[0]
     cdef int h0, marked, illegal
@@ -294,6 +302,12 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             n_zero = mark_twins(h, &he_twin[0], &zero[0])
     if n_illegal > 0:
         return {"illegal": n_illegal}      # (not a Delaunay triangulation: no diagram)
+    if give_tv:
+        with nogil:
+            finite_to_front(<int32_t*> &tv[0] if n_tri > 0 else NULL, n_tri, inf)
+        triangles = np.asarray(tv.base).reshape(-1)[: 3 * n_finite].reshape(n_finite, 3)
+    else:
+        triangles = np.asarray(tri)
     if n_zero > 0:
         parent = np.arange(max(n_finite, 1), dtype=np.int32)
         with nogil:
@@ -308,7 +322,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         "he_twin": np.asarray(he_twin)[:h],
         "he_face": np.asarray(he_face)[:h],
         "face_edge": np.asarray(face_edge)[:n],
-        "triangles": np.asarray(tri),
+        "triangles": triangles,
     }
     if clip_room:
         out["vertex_room"] = centre_buf
@@ -317,8 +331,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
 
 cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int32_t* vid, int32_t* tri,
                           const double* xs, const double* ys, int e, double* centre) noexcept nogil:
-    # the finite triangles t0..t1 - 1 numbered from m on (vid), their sites copied to tri and their
-    # circumcentres computed (by blocks: construct.circumcentres_block); an infinite triangle's vid is -1
+    # the finite triangles t0..t1 - 1 numbered from m on (vid), their sites copied to tri (unless NULL)
+    # and their circumcentres computed (by blocks: construct.circumcentres_block); an infinite triangle's vid is -1
     cdef double gx[3][CENTRE_BLOCK]
     cdef double gy[3][CENTRE_BLOCK]
     cdef int t = t0, a, b, c, k, m0
@@ -332,7 +346,8 @@ cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int
                 t += 1
                 continue
             vid[t] = m
-            tri[3 * m] = a; tri[3 * m + 1] = b; tri[3 * m + 2] = c
+            if tri != NULL:
+                tri[3 * m] = a; tri[3 * m + 1] = b; tri[3 * m + 2] = c
             gx[0][k] = xs[a]; gy[0][k] = ys[a]
             gx[1][k] = xs[b]; gy[1][k] = ys[b]
             gx[2][k] = xs[c]; gy[2][k] = ys[c]
@@ -340,6 +355,23 @@ cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int
             k += 1
             t += 1
         circumcentres_block(k, gx[0], gy[0], gx[1], gy[1], gx[2], gy[2], e, &centre[2 * m0], 2)
+
+
+cdef void finite_to_front(int32_t* tv, int n_tri, int inf) noexcept nogil:
+    # the finite triangles of tv moved to its start, in their order: each run of them between infinite
+    # ones by one move (the hull's few infinite triangles lie scattered; nothing moves before the first)
+    cdef int t = 0, run, m = 0
+    while t < n_tri:
+        if tv[3 * t] == inf or tv[3 * t + 1] == inf or tv[3 * t + 2] == inf:
+            t += 1
+            continue
+        run = t
+        while run < n_tri and tv[3 * run] != inf and tv[3 * run + 1] != inf and tv[3 * run + 2] != inf:
+            run += 1
+        if m != t:
+            memmove(&tv[3 * m], &tv[3 * t], 3 * (run - t) * sizeof(int32_t))
+        m += run - t
+        t = run
 
 
 cdef struct Walk:
@@ -350,7 +382,6 @@ cdef struct Walk:
     int inf
     int32_t* vor
     const int32_t* vid
-    const int32_t* tri
     int32_t* he_origin
     int32_t* he_twin
     int32_t* he_face
@@ -438,14 +469,14 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
             if check:
                 # each edge once, from its smaller site; hull edges (an infinite side) are the hull's
                 if vr >= 0 and vl >= 0 and b > a and (not rounded_ok or edge_order(rx, ry, lx, ly, ax, ay) <= 0):
-                    sign = far_site_inside(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys)
+                    sign = far_site_inside(a, b, &tv[3 * t], &tv[3 * (e // 3)], w.xs, w.ys)
                     if sign == 0:
                         w.zero[h] = 1
                         n_marked[0] += 1
                     elif sign > 0:
                         n_illegal[0] += 1
             elif lx == rx and ly == ry and vr >= 0 and vl >= 0 and b > a:
-                if far_site_inside(a, b, &w.tri[3 * vr], &w.tri[3 * vl], w.xs, w.ys) == 0:
+                if far_site_inside(a, b, &tv[3 * t], &tv[3 * (e // 3)], w.xs, w.ys) == 0:
                     w.zero[h] = 1
                     n_marked[0] += 1
             h += 1
