@@ -50,40 +50,76 @@ def test_vertices_come_in_the_triangles_order(name, engine):
         assert {tuple(v) for v in out["vertices"]} <= {tuple(c) for c in centres}
 
 
-@pytest.mark.parametrize("engine", ["incremental", "fortune"])
-def test_each_origin_is_the_centre_of_the_triangle_on_the_right(engine):
+def origins_checked(out) -> int:
     """Half-edge g of site a's cell lies on the bisector of a and b (its twin's site); its origin is the
     circumcentre of the triangle on the right of the Delaunay edge a->b: the one in which a follows b
-    counter-clockwise; -1 where that triangle is infinite."""
-    pts = generate("uniform", 3000, seed=12)
-    t, e = triangulated(pts, engine)
-    s = t.sites
-    out = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e)
-    tri = out["triangles"]
+    counter-clockwise; -1 where that triangle is infinite. Around a cell, each half-edge starts where
+    the one before it ends (its twin's origin). Returns how many origins were finite."""
     # each finite triangle's vertex number, by the directed edges it holds: (p, q) -> the triangle
     # where q follows p counter-clockwise
     by_edge = {}
-    for k, (p, q, r) in enumerate(tri.tolist()):
+    for k, (p, q, r) in enumerate(out["triangles"].tolist()):
         by_edge[(p, q)] = by_edge[(q, r)] = by_edge[(r, p)] = k
     face, twin, origin = out["he_face"], out["he_twin"], out["he_origin"]
     checked = 0
     for g in range(len(face)):
         a, b = int(face[g]), int(face[twin[g]])
+        assert twin[twin[g]] == g and a != b
+        if g + 1 < len(face) and face[g + 1] == a:
+            assert origin[g + 1] == origin[twin[g]]
         right = by_edge.get((b, a))
         if right is None:
             assert origin[g] == -1
         else:
             assert origin[g] == right
             checked += 1
-    assert checked > 0.9 * len(face)
+    return checked
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_each_origin_is_the_centre_of_the_triangle_on_the_right(engine):
+    pts = generate("uniform", 3000, seed=12)
+    t, e = triangulated(pts, engine)
+    s = t.sites
+    out = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e)
+    assert origins_checked(out) > 0.9 * len(out["he_face"])
+
+
+@pytest.mark.parametrize("given", [False, True])
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_sites_of_hundreds_of_neighbours_have_their_cells_in_order(engine, given):
+    """The walks gather a cell's edges in runs (dual.RING at a time): hubs of 150 to 1,500 Delaunay
+    neighbours (a centre inside a ring of sites, rounded to a grid, some of it on the hull) give the
+    same cells on one thread and on two, each half-edge on the triangle on its right."""
+    rng = np.random.default_rng(5)
+    parts = []
+    for k, (cx, cy, count) in enumerate([(0, 0, 1500), (5000, 0, 150), (0, 5000, 400)]):
+        angle = np.sort(rng.uniform(0, 2 * np.pi, count))
+        ring = np.column_stack([cx + 1000 * np.cos(angle), cy + 1000 * np.sin(angle)])
+        parts += [np.round(ring, 6 - k), [[cx + 0.5, cy - 0.25]]]
+    t, e = triangulated(np.vstack(parts), engine)
+    s = t.sites
+    runs = []
+    for threads in (1, 2):
+        tv, opp = (t.tv.copy(), t.opp.copy()) if given else (t.tv, t.opp)
+        out = dual.voronoi_from_delaunay(
+            s.xs, s.ys, tv, opp, e, threads, parallel_min=1, walk_chunk=8, give_triangulation=given
+        )
+        degree = np.bincount(out["he_face"], minlength=len(s.xs))
+        assert degree.max() >= 1500 and (degree > 64).sum() >= 3
+        assert origins_checked(out) > 0.9 * len(out["he_face"])
+        runs.append(out)
+    for key in runs[0]:
+        assert np.array_equal(runs[0][key], runs[1][key]), key
 
 
 @pytest.mark.parametrize("check", [False, True])
 @pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize("name", sorted(adversarial.FAMILIES))
 def test_a_triangulation_given_up_gives_the_same_dcel_with_its_triangles_in_place(name, engine, check):
-    """give_tv: the finite triangles are moved to the front of tv itself (no copy); everything else is
-    what a dual that keeps tv makes, on one thread and on two (Fortune's check reads tv's rows too)."""
+    """give_triangulation: the finite triangles are moved to the front of tv itself (no copy) and the
+    walks write in opp; everything else is what a dual that keeps both makes, on one thread and on two
+    (Fortune's check reads tv's rows too)."""
     got = triangulated(adversarial.make(name).points, engine)
     if got is None:
         return
@@ -91,22 +127,31 @@ def test_a_triangulation_given_up_gives_the_same_dcel_with_its_triangles_in_plac
     s = t.sites
     for threads in (1, 2):
         want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, check=check)
-        tv = t.tv.copy()
-        given = dual.voronoi_from_delaunay(s.xs, s.ys, tv, t.opp, e, threads, parallel_min=1, check=check, give_tv=True)
+        tv, opp = t.tv.copy(), t.opp.copy()
+        given = dual.voronoi_from_delaunay(
+            s.xs, s.ys, tv, opp, e, threads, parallel_min=1, check=check, give_triangulation=True
+        )
         assert set(given) == set(want)
         for key in want:
             assert np.array_equal(given[key], want[key]), key
         assert np.array_equal(given["triangles"], finite_rows(t))
         if len(given["triangles"]):
             assert np.shares_memory(given["triangles"], tv) and given["triangles"].flags.writeable
+            assert not np.array_equal(opp, t.opp)  # (written: no array of its own)
 
 
-def test_a_read_only_triangulation_is_not_written_when_given_up():
+@pytest.mark.parametrize("read_only", ["tv", "opp", "both"])
+def test_a_read_only_triangulation_is_not_written_when_given_up(read_only):
     t, e = triangulated(generate("uniform", 500, seed=3), "incremental")
     s = t.sites
-    tv = t.tv.copy()
-    tv.flags.writeable = False
-    out = dual.voronoi_from_delaunay(s.xs, s.ys, tv, t.opp, e, give_tv=True)
-    assert np.array_equal(tv, t.tv)
-    assert not np.shares_memory(out["triangles"], tv)
-    assert np.array_equal(out["triangles"], finite_rows(t))
+    want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e)
+    tv, opp = t.tv.copy(), t.opp.copy()
+    for name, a in (("tv", tv), ("opp", opp)):
+        a.flags.writeable = read_only not in (name, "both")
+    out = dual.voronoi_from_delaunay(s.xs, s.ys, tv, opp, e, give_triangulation=True)
+    for key in want:
+        assert np.array_equal(out[key], want[key]), key
+    if read_only != "opp":
+        assert np.array_equal(tv, t.tv) and not np.shares_memory(out["triangles"], tv)
+    if read_only != "tv":
+        assert np.array_equal(opp, t.opp)

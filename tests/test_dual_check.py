@@ -168,18 +168,32 @@ def test_renumbering_keeps_an_unchecked_triangulation_unchecked():
     assert engines.renumbered(triangulation(adversarial.make("spiral").points, guard=True)).checked
 
 
-def test_a_triangulation_given_up_is_left_as_it_was_when_an_edge_is_illegal(rng):
-    """give_tv moves the triangles only once the walks found every edge legal: an illegal one leaves tv
-    for the repair (Triangulation.voronoi then repairs it and builds again, still giving tv up)."""
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_triangulation_given_up_is_left_as_it_was_when_an_edge_is_illegal(rng, threads):
+    """give_triangulation moves the triangles only once the walks found every edge legal, and the walks
+    that wrote in opp restore it: an illegal edge leaves tv and opp as they were for the repair
+    (Triangulation.voronoi then repairs it and builds again, still giving it up)."""
     pts = adversarial.make("circle_rounded").points
     guarded = triangulation(pts, guard=True)
     unguarded = triangulation(pts, guard=False)
     assert flip_edges(unguarded.sites.xs, unguarded.sites.ys, unguarded.tv, unguarded.opp, rng, 30) > 0
     s = unguarded.sites
-    before = unguarded.tv.copy()
-    got = dual.voronoi_from_delaunay(s.xs, s.ys, unguarded.tv, unguarded.opp, s.exponent, check=True, give_tv=True)
-    assert got.get("illegal", 0) > 0 and np.array_equal(unguarded.tv, before)
-    want, repaired = guarded.voronoi(), unguarded.voronoi(give_tv=True)
+    before = unguarded.tv.copy(), unguarded.opp.copy()
+    got = dual.voronoi_from_delaunay(
+        s.xs,
+        s.ys,
+        unguarded.tv,
+        unguarded.opp,
+        s.exponent,
+        threads,
+        parallel_min=1,
+        walk_chunk=16,
+        check=True,
+        give_triangulation=True,
+    )
+    assert got.get("illegal", 0) > 0
+    assert np.array_equal(unguarded.tv, before[0]) and np.array_equal(unguarded.opp, before[1])
+    want, repaired = guarded.voronoi(), unguarded.voronoi(threads, give_triangulation=True)
     assert np.shares_memory(repaired["triangles"], unguarded.tv)
     assert len(repaired["he_origin"]) == len(want["he_origin"])
     assert np.array_equal(np.unique(repaired["vertices"], axis=0), np.unique(want["vertices"], axis=0))

@@ -33,7 +33,7 @@ def build_diagram(
         t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads, bounds=bounds)
         pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
         # (the triangulation is not needed to clip: its tv becomes the Diagram's triangles, in place)
-        s, out = t.sites, t.voronoi(threads, clip_room=True, give_tv=True)
+        s, out = t.sites, t.voronoi(threads, clip_room=True, give_triangulation=True)
         del t
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
 

@@ -207,10 +207,11 @@ class Triangulation:
         """True when the distinct sites are collinear: no triangle, parallel strips for cells."""
         return self.tv is None
 
-    def voronoi(self, threads: int = 1, clip_room: bool = False, give_tv: bool = False) -> dict:
+    def voronoi(self, threads: int = 1, clip_room: bool = False, give_triangulation: bool = False) -> dict:
         """The Voronoi DCEL (vertices in the user's unit, correctly rounded) with ``dup``, in engine order;
-        the same for any thread count (clip_room: see dual.voronoi_from_delaunay). give_tv: this
-        triangulation is not used again: the DCEL's triangles are its own tv, compacted in place.
+        the same for any thread count (clip_room: see dual.voronoi_from_delaunay). give_triangulation:
+        this triangulation is not used again: the DCEL's triangles are its own tv, compacted in place,
+        and the dual writes in its opp (restored if the triangulation needs a repair).
 
         An unchecked triangulation is checked as the dual walks it; were some edge not locally
         Delaunay (never seen: the sweep's decisions are exact), it is repaired by exact flips in
@@ -218,26 +219,16 @@ class Triangulation:
         s = self.sites
         if self.flat:
             return collinear_dcel(s.xs, s.ys)
-        out = dual.voronoi_from_delaunay(
-            s.xs,
-            s.ys,
-            self.tv,
-            self.opp,
-            s.exponent,
-            threads,
-            clip_room=clip_room,
-            check=not self.checked,
-            give_tv=give_tv,
-        )
+        args = (s.xs, s.ys, self.tv, self.opp, s.exponent, threads)
+        given = {"clip_room": clip_room, "give_triangulation": give_triangulation}
+        out = dual.voronoi_from_delaunay(*args, check=not self.checked, **given)
         if "illegal" in out:
             if fortune.legalize(s.xs, s.ys, self.tv, self.opp, bounded=True) < 0:
                 raise TvoronoiError(
                     f"{fortune.STATUS_MESSAGES[fortune.STATUS_NO_REPAIR]} on {len(s.xs)} points; "
                     "build with engine='incremental' instead, and please report the input"
                 )
-            out = dual.voronoi_from_delaunay(
-                s.xs, s.ys, self.tv, self.opp, s.exponent, threads, clip_room=clip_room, give_tv=give_tv
-            )
+            out = dual.voronoi_from_delaunay(*args, **given)
         out["dup"] = self.dup
         return out
 

@@ -101,7 +101,7 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
                           int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False,
-                          int walk_chunk=WALK_CHUNK, bint check=False, bint give_tv=False):
+                          int walk_chunk=WALK_CHUNK, bint check=False, bint give_triangulation=False):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -134,9 +134,11 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         of each Voronoi edge at hand, and the exact in-circle test runs only where their rounded
         values cannot tell. If some edge is not, the result is only {"illegal": count}: no diagram
         (the caller repairs the triangulation and builds again).
-    give_tv : bool, the caller gives tv up (it must be writable and not read again): the finite
-        triangles are moved to its start in place and ``triangles`` is a view of it, not a copy (a
-        result of only {"illegal": count} leaves tv as it was).
+    give_triangulation : bool, the caller gives tv and opp up (not to be read again; each is written
+        only if it is an array the dual can write): the finite triangles are moved to the start of tv in
+        place and ``triangles`` is a view of it, not a copy; opp holds, as the walks go, each Delaunay
+        half-edge's Voronoi half-edge, instead of an array of its own. A result of only {"illegal": count}
+        leaves both as they were (opp is restored from the half-edges).
 
     Returns
     -------
@@ -154,7 +156,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] h_first = np.zeros(n + 1, np.int32)    # the cell's first half-edge (a count first)
     cdef int32_t[::1] v_block = np.zeros(n_blocks + 1, np.int32)  # the first vertex of each block of triangles
     cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # triangle -> its vertex, -1 if infinite
-    cdef int32_t[::1] vor = np.empty(n_he_d, np.int32)        # Delaunay half-edge -> Voronoi half-edge
+    cdef int32_t[::1] link_own      # Delaunay half-edge -> the Voronoi half-edge of its twin (walk_site)
+    cdef int32_t* link              # (that, or opp itself when it is given up)
     cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
@@ -162,12 +165,19 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
     cdef double[:, ::1] centre
     cdef int32_t[:, ::1] tri
+    cdef int32_t[::1] edge_of
     cdef int t, e, a, b, c, h = 0, m = 0, n_finite = 0, n_hull, g, k, lo, hi, count, bk
 
     if n < parallel_min:
         threads = 1
-    if give_tv and not (isinstance(tv.base, np.ndarray) and tv.base.flags.writeable):
-        give_tv = False         # (not an array it can write: the triangles are copied)
+    # (what is given up is written only if the dual can: else the triangles are copied, link is its own)
+    cdef bint give_tv = give_triangulation and n_he_d > 0 and writable(tv)
+    cdef bint give_opp = give_triangulation and n_he_d > 0 and writable(opp)
+    if give_opp:
+        link = <int32_t*> &opp[0]
+    else:
+        link_own = np.empty(max(n_he_d, 1), np.int32)
+        link = &link_own[0]
 
     with nogil:
         fill_int32(&first_e[0], n, -1)      # (written whole: faulted in by runs of pages)
@@ -223,7 +233,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef double* centres = &centre[0, 0] if n_finite > 0 else NULL
     cdef Walk w
     w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
-    w.vor = &vor[0]; w.vid = &vid[0]
+    w.link = link; w.vid = &vid[0]
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
     w.xs = &xs[0]; w.ys = &ys[0]; w.centre = centres; w.zero = &zero[0]
     cdef int h0, marked, illegal
@@ -238,7 +248,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             populate_part(&vid[0], n_tri * sizeof(int32_t), k, threads)
             populate_part(tri_rows, 3 * n_finite * sizeof(int32_t), k, threads)
             populate_part(centres, 2 * n_finite * sizeof(double), k, threads)
-            populate_part(&vor[0], n_he_d * sizeof(int32_t), k, threads)
+            if not give_opp:
+                populate_part(link, n_he_d * sizeof(int32_t), k, threads)
             populate_part(&he_origin[0], n_he_d * sizeof(int32_t), k, threads)
             populate_part(&he_twin[0], n_he_d * sizeof(int32_t), k, threads)
             populate_part(&he_face[0], n_he_d * sizeof(int32_t), k, threads)
@@ -270,8 +281,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             h_first[n] = h
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; a
-            # twin that another run may not have made yet is left as its Delaunay half-edge and looked up
-            # once every walk is done (the arrays are the same for any count)
+            # twin that another run may not have made yet is left as its own Delaunay half-edge, looked up
+            # in link once every walk is done (the arrays are the same for any count)
             lo = 0
             while lo < n:
                 poll_signals()
@@ -294,13 +305,16 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 hi = lo + BLOCK if lo + BLOCK < h else h
                 for g in prange(lo, hi, num_threads=threads, schedule="static"):
                     if he_twin[g] < 0:
-                        he_twin[g] = vor[-1 - he_twin[g]]
+                        he_twin[g] = link[-1 - he_twin[g]]
                 lo = hi
 
         # the twins of the zero-length edges the walks marked (a twin comes after its edge)
         if n_marked > 0 and n_illegal == 0:
             n_zero = mark_twins(h, &he_twin[0], &zero[0])
     if n_illegal > 0:
+        if give_opp:
+            edge_of = np.empty(max(h, 1), np.int32)
+            restore_opp(&tv[0], link, n_he_d, inf, &he_twin[0], &edge_of[0])
         return {"illegal": n_illegal}      # (not a Delaunay triangulation: no diagram)
     if give_tv:
         with nogil:
@@ -312,7 +326,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         parent = np.arange(max(n_finite, 1), dtype=np.int32)
         with nogil:
             m, h = drop_zero_edges(h, n_finite, n, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
-                                   &zero[0], &parent[0], &vid[0], &vor[0], &centre[0, 0])
+                                   &zero[0], &parent[0], &vid[0], link, &centre[0, 0])
     else:
         m = n_finite
 
@@ -380,7 +394,7 @@ cdef struct Walk:
     const int32_t* opp
     const int32_t* first_e
     int inf
-    int32_t* vor
+    int32_t* link
     const int32_t* vid
     int32_t* he_origin
     int32_t* he_twin
@@ -401,9 +415,15 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
     One half-edge per Delaunay edge a->b with b finite, from h on: its origin is the vertex of the
     triangle on the right of a->b (-1 if that is infinite), its twin the half-edge of b->a. Sites from
     done_from up to a have been walked: the twin made by an earlier one is looked up and linked; one
-    of a site before done_from (another thread's) is left as -1 - Delaunay half-edge, looked up later,
-    as is one whose site comes later. The triangle on the right of a->b is the one the walk left at the
-    step before.
+    of a site before done_from (another thread's) is left as -1 - Delaunay half-edge a->b, looked up
+    later, as is one whose site comes later.
+
+    The walk steps from a->b to the next edge out of a through the twin of the edge into a before it,
+    b->a (opp); once the half-edge of a->b is made, it writes its number in link at the place of b->a,
+    where b's walk looks it up (link[b->a], b's own edge). A place of link is thus written by one walk
+    only, the walk that reads it in opp to step, after it read it: link may be opp itself (a
+    triangulation given up). No walk reads opp at its own edges: the twin of the first edge, and the
+    triangle on its right, are those the walk crosses last, and its half-edge is finished then.
 
     The zero-length edges are marked in zero as the walk goes (n_marked counts them), each from the
     half-edge of the site that comes first (b > a). Equal exact centres round to equal doubles, so
@@ -419,16 +439,15 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
     # (locals, so that the stores below do not make the compiler read the struct again)
     cdef const int32_t* tv = w.tv
     cdef const int32_t* opp = w.opp
-    cdef int32_t* vor = w.vor
+    cdef int32_t* link = w.link
     cdef const int32_t* vid = w.vid
     cdef const double* centre = w.centre
     cdef int32_t* he_origin = w.he_origin
     cdef int32_t* he_twin = w.he_twin
     cdef int32_t* he_face = w.he_face
-    cdef int e0 = w.first_e[a], e, b, t, o, g, vr, vl, inf = w.inf
+    cdef int e0 = w.first_e[a], e, b, t = -1, o = -1, g, vr = -1, vl, inf = w.inf, h0 = h
     cdef double rx = 0.0, ry = 0.0, lx = 0.0, ly = 0.0, ax = 0.0, ay = 0.0
     cdef bint linked, check = w.check, rounded_ok = False
-    cdef int sign
     if e0 < 0:
         return h                # a repeated site, or none of the triangles (no cell)
     if check:
@@ -443,49 +462,83 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
             ax = ldexp(w.xs[a], w.exponent)
             ay = ldexp(w.ys[a], w.exponent)
             rounded_ok = ldexp(ax, -w.exponent) == w.xs[a] and ldexp(ay, -w.exponent) == w.ys[a]
-    t = opp[e0] // 3
-    vr = vid[t]
-    if vr >= 0:
-        rx = centre[2 * vr]; ry = centre[2 * vr + 1]
     e = e0
     while True:
-        # vr: the vertex on the right of a->b (triangle t), vl the one on its left (triangle e // 3)
+        # e = a->b, o its twin (the edge crossed last), vr the vertex on the right of a->b (triangle t,
+        # o's), vl the one on its left (triangle e // 3); for e0, o, t and vr are known at the end
         b = tv[nxt(e)]
         vl = vid[e // 3]
         if vl >= 0:
             lx = centre[2 * vl]; ly = centre[2 * vl + 1]
         if b != inf:
-            vor[e] = h
-            he_origin[h] = vr
-            o = opp[e]
             # the twin, when its site's walk made it (done_from <= b < a): linked both ways, with no
             # branch (an unlinked twin's store lands on h itself, then is overwritten)
             linked = (<unsigned> (b - done_from)) < <unsigned> (a - done_from)
-            g = vor[o]          # (read whether or not it was written: selected below)
+            g = link[e]         # (read whether or not b's walk wrote it: selected below)
             g = g if linked else h
             he_twin[g] = h
-            he_twin[h] = g if linked else -1 - o
+            he_twin[h] = g if linked else -1 - e
             he_face[h] = a
-            if check:
-                # each edge once, from its smaller site; hull edges (an infinite side) are the hull's
-                if vr >= 0 and vl >= 0 and b > a and (not rounded_ok or edge_order(rx, ry, lx, ly, ax, ay) <= 0):
-                    sign = far_site_inside(a, b, &tv[3 * t], &tv[3 * (e // 3)], w.xs, w.ys)
-                    if sign == 0:
-                        w.zero[h] = 1
-                        n_marked[0] += 1
-                    elif sign > 0:
-                        n_illegal[0] += 1
-            elif lx == rx and ly == ry and vr >= 0 and vl >= 0 and b > a:
-                if far_site_inside(a, b, &tv[3 * t], &tv[3 * (e // 3)], w.xs, w.ys) == 0:
-                    w.zero[h] = 1
-                    n_marked[0] += 1
+            if e != e0:
+                link[o] = h     # (o was read to come here, by this walk alone)
+                he_origin[h] = vr
+                if vr >= 0 and vl >= 0 and b > a and (check or (lx == rx and ly == ry)):
+                    edge_tests(w, a, b, t, e, h, rx, ry, lx, ly, ax, ay, rounded_ok, n_marked, n_illegal)
             h += 1
         t = e // 3
         vr = vl; rx = lx; ry = ly
-        e = opp[prv(e)]     # the twin of the edge into a: the next edge out
+        o = prv(e)
+        e = opp[o]     # the twin of the edge into a: the next edge out
         if e == e0:
             break
+    # the first edge's half-edge: its twin o and the triangle t on its right are the last crossed
+    if h > h0 and tv[nxt(e0)] != inf:
+        link[o] = h0
+        he_origin[h0] = vr
+        b = tv[nxt(e0)]
+        vl = vid[e0 // 3]
+        if vr >= 0 and vl >= 0 and b > a:
+            edge_tests(w, a, b, t, e0, h0, rx, ry, centre[2 * vl], centre[2 * vl + 1], ax, ay, rounded_ok,
+                       n_marked, n_illegal)
     return h
+
+
+cdef inline void edge_tests(Walk* w, int a, int b, int t, int e, int h, double rx, double ry, double lx, double ly,
+                            double ax, double ay, bint rounded_ok, int* n_marked, int* n_illegal) noexcept nogil:
+    # a Voronoi edge h (of Delaunay edge e = a->b, b > a, both its vertices finite: r on the right, in
+    # triangle t, and l): marked zero-length if its sites are cocircular, and, with w.check, counted as
+    # illegal if its Delaunay edge is not locally Delaunay (without it, called only where r == l)
+    cdef int sign
+    if w.check:
+        if not rounded_ok or edge_order(rx, ry, lx, ly, ax, ay) <= 0:
+            sign = far_site_inside(a, b, &w.tv[3 * t], &w.tv[3 * (e // 3)], w.xs, w.ys)
+            if sign == 0:
+                w.zero[h] = 1
+                n_marked[0] += 1
+            elif sign > 0:
+                n_illegal[0] += 1
+    elif lx == rx and ly == ry:
+        if far_site_inside(a, b, &w.tv[3 * t], &w.tv[3 * (e // 3)], w.xs, w.ys) == 0:
+            w.zero[h] = 1
+            n_marked[0] += 1
+
+
+cdef void restore_opp(const int32_t* tv, int32_t* opp, int n_he_d, int inf, const int32_t* he_twin,
+                      int32_t* edge_of) noexcept nogil:
+    # opp as it was before the walks wrote link in it (every twin linked): each Delaunay half-edge d
+    # between finite sites holds the Voronoi half-edge of its twin, whose twin is d's own (those to or
+    # from infinity were not written); edge_of: scratch, a place per Voronoi half-edge
+    cdef int d
+    for d in range(n_he_d):
+        if tv[d] != inf and tv[nxt(d)] != inf:
+            edge_of[he_twin[opp[d]]] = d
+    for d in range(n_he_d):
+        if tv[d] != inf and tv[nxt(d)] != inf:
+            opp[d] = edge_of[opp[d]]
+
+
+cdef bint writable(const int32_t[::1] a):
+    return isinstance(a.base, np.ndarray) and a.base.flags.writeable
 
 
 cdef int mark_twins(int h, const int32_t* he_twin, signed char* zero) noexcept nogil:
