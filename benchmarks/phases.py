@@ -82,7 +82,7 @@ def time_phases(pts: np.ndarray, engine: str, threads: int) -> dict:
             t1 = time.perf_counter()
             t = build.triangulate_and_lay_out(s, engine=engine, insertion="brio", threads=threads)
         t2 = time.perf_counter()
-        s, out = t.sites, t.voronoi(threads, clip_room=True)
+        s, out = build.dcel(t, threads)
         del t
         t3 = time.perf_counter()
         d = build.assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)

@@ -31,11 +31,16 @@ def build_diagram(
     engines.check_box_scale(box, e)
     with build_arrays():
         t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads, bounds=bounds)
-        pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
-        # (the triangulation is not needed to clip: its tv becomes the Diagram's triangles, in place)
-        s, out = t.sites, t.voronoi(threads, clip_room=True, give_triangulation=True)
-        del t
+        s, out = dcel(t, threads)
+        del t  # (its opp, written by the dual, is freed before the clipper's arrays are made)
         return assemble(pts, box, e, s.perm, s.xs, s.ys, out, engine=engine, threads=threads)
+
+
+def dcel(t: engines.Triangulation, threads: int) -> tuple[engines.Sites, dict]:
+    """A build's Voronoi DCEL (with room for the clipper's points) and its sites: the triangulation is
+    given up to it (not to be used again: the Diagram's triangles are its tv, in place)."""
+    pages.trim_heap()  # the triangulation's scratch, freed: the dual's peak need not stand on it
+    return t.sites, t.voronoi(threads, clip_room=True, give_triangulation=True)
 
 
 def triangulation(pts: np.ndarray, e: int, *, engine: str, insertion: str, seed: int, threads: int, bounds=None):
