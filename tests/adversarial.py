@@ -364,6 +364,52 @@ def mercator_graticule(step: float = 5.0, *, decimals: int = 2, seed: int = SEED
     return Case(_pts(np.column_stack([gx.ravel(), gy.ravel()])), note=f"Mercator graticule every {step} degrees")
 
 
+def tensor_grid(side: int = 45, *, spacing: str = "log", decimals: int = 4, seed: int = SEED) -> Case:
+    """The product of two irregular sets of coordinates, rounded: rows and columns spaced by a seeded
+    geometric progression ("log", ratios near 1.07 and 1.11) or at sorted random places ("random",
+    repeats dropped), so that every cell of the grid is a rectangle of its own shape, its four sites
+    exactly cocircular (the rounding keeps rows and columns straight), with neighbouring circumcentres
+    nearly equal where the spacing changes slowly."""
+    rng = np.random.default_rng(seed)
+    if spacing == "log":
+        ratios = rng.uniform(1.05, 1.09), rng.uniform(1.09, 1.13)
+        axes = [np.round(rng.uniform(0.1, 1.0) * q ** np.arange(side), decimals) for q in ratios]
+    else:
+        axes = [np.unique(np.round(rng.uniform(0.0, 10.0, side), decimals)) for _ in range(2)]
+    gx, gy = np.meshgrid(*axes)
+    return Case(_pts(np.column_stack([gx.ravel(), gy.ravel()])), note=f"{spacing} tensor grid, {decimals} decimals")
+
+
+def penrose_vertices(reach: int = 7, *, decimals: int = 6, seed: int = SEED) -> Case:
+    """Vertices of a Penrose rhombus tiling, from de Bruijn's pentagrid (five families of parallel lines
+    at multiples of 72 degrees, seeded offsets summing to 0), rounded: a quasi-periodic set whose exact
+    vertices make rings of ten cocircular sites and many cocircular quadruples, all of them broken or
+    kept by the rounding according to the digits."""
+    rng = np.random.default_rng(seed)
+    angle = 2.0 * np.pi * np.arange(5) / 5.0
+    e = np.column_stack([np.cos(angle), np.sin(angle)])
+    gamma = rng.uniform(0.0, 1.0, 5)
+    gamma += (0.5 - gamma.sum()) / 5.0  # (sum 0.5: a generic, non-singular pentagrid)
+    found = []
+    ks = np.arange(-reach, reach + 1)
+    for r in range(5):
+        for t in range(r + 1, 5):
+            # where line k_r of family r meets line k_t of family t: x . e_j + gamma_j = k_j for j = r, t
+            kr, kt = (a.ravel() for a in np.meshgrid(ks, ks))
+            m = np.array([e[r], e[t]])
+            x = np.linalg.solve(m, np.array([kr - gamma[r], kt - gamma[t]])).T
+            k = np.ceil(x @ e.T + gamma)  # the pentagrid cell each family puts the meeting in
+            # the rhombus of the meeting: its four corners, k_r and k_t each one below or at the lines
+            for dr, dt in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                kk = k.copy()
+                kk[:, r] = kr + dr
+                kk[:, t] = kt + dt
+                found.append(kk @ e)
+    pts = np.unique(np.round(np.concatenate(found), decimals), axis=0)
+    keep = np.hypot(pts[:, 0], pts[:, 1]) < 2.0 * reach  # (the patch, 2.5 reach wide, is ragged at its edge)
+    return Case(_pts(pts[keep]), note=f"Penrose tiling vertices, {decimals} decimals")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -749,6 +795,11 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "survey_rows_cm": survey_rows,
     "mercator_graticule_cm": mercator_graticule,
     "mercator_graticule_m": partial(mercator_graticule, 4.0, decimals=0),
+    # products and tilings
+    "tensor_grid_log_4dec": tensor_grid,
+    "tensor_grid_random_3dec": partial(tensor_grid, 60, spacing="random", decimals=3),
+    "penrose_6dec": penrose_vertices,
+    "penrose_2dec": partial(penrose_vertices, 9, decimals=2),
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
