@@ -1,7 +1,8 @@
 """Where a build's time goes: each phase of tvoronoi.voronoi() in ns per site, next to other tools.
 
 For each distribution and size, and each engine and thread count, the phases of a build to bounded
-cells are timed one after the other, in interleaved repeats (the median is reported):
+cells are timed one after the other, in interleaved repeats (each configuration once per round, their
+order rotated from round to round; the median is reported):
 
   order     the check of the points that tvoronoi.voronoi() makes (one pass, which also finds their
             bounds), exact scaling and the engine's insertion order (BRIO, or the sweep's sort)
@@ -199,11 +200,14 @@ def main(argv=None) -> None:
             for engine in ("incremental", "fortune"):  # warm-up, not timed: the process's memory, the caches
                 time_phases(pts, engine, 1)
             time_triangle(pts)
-            for _ in range(args.repeats):  # interleaved: every configuration once per round
-                for engine in ("incremental", "fortune"):
-                    for threads in thread_counts:
-                        gc.collect()
-                        runs.setdefault((engine, threads), []).append(time_phases(pts, engine, threads))
+            configs = [(engine, threads) for engine in ("incremental", "fortune") for threads in thread_counts]
+            for r in range(args.repeats):
+                # interleaved: every configuration once per round, their order rotated from round to round,
+                # so that none always comes first, after Triangle's call (a build that follows a pause
+                # or another tool's memory pays most for fresh memory on a virtual machine)
+                for engine, threads in configs[r % len(configs) :] + configs[: r % len(configs)]:
+                    gc.collect()
+                    runs.setdefault((engine, threads), []).append(time_phases(pts, engine, threads))
                 gc.collect()
                 seconds = time_triangle(pts)
                 if seconds is not None:
@@ -248,7 +252,8 @@ def report(rows: list[dict], info: dict) -> str:
         "",
         f"Machine: {describe_machine(info)}",
         "",
-        "Medians of interleaved repeats, each phase in **ns per site** (ms in brackets for the total). "
+        "Medians of interleaved repeats (each configuration once per round, in an order rotated from round "
+        "to round, Triangle last), each phase in **ns per site** (ms in brackets for the total). "
         "`tvoronoi.voronoi()` to bounded cells = order + tri + dual + cells (by halves, each half is "
         "ordered within tri: order reads -). The other tools are "
         "whole calls on the same points: Triangle's `triangle.voronoi` (no cells), Qhull's "
