@@ -136,9 +136,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         (the caller repairs the triangulation and builds again).
     give_triangulation : bool, the caller gives tv and opp up (not to be read again; each is written
         only if it is an array the dual can write): the finite triangles are moved to the start of tv in
-        place and ``triangles`` is a view of it, not a copy; opp holds, as the walks go, each Delaunay
-        half-edge's Voronoi half-edge, instead of an array of its own. A result of only {"illegal": count}
-        leaves both as they were (opp is restored from the half-edges).
+        place and ``triangles`` is a view of it, not a copy; opp holds, as the walks go, the links between
+        twins (walk_site: at each Delaunay half-edge, the Voronoi half-edge of its twin), instead of an
+        array of their own. A result of only {"illegal": count} leaves both as they were (opp is
+        restored from the half-edges).
 
     Returns
     -------
