@@ -7,6 +7,8 @@ of hard input, small as it is here, is cut in two and joined.
 
 import contextlib
 import math
+import threading
+import time
 from fractions import Fraction
 
 import numpy as np
@@ -327,29 +329,60 @@ def test_integer_sites_at_the_threshold_join_without_falling_back(seed):
 def test_an_interrupted_build_stops_its_other_half(monkeypatch):
     """Ctrl-C reaches the main thread's half; the other half's kernels then stop at their next poll
     (tvoronoi.kernels.STOPPING) instead of running to their end, and a build afterwards is whole."""
-    import time
-
     from tvoronoi.kernels import STOPPING
 
-    real, outcomes = halves.half, []
+    real, outcomes = halves.half_triangles, []
 
-    def half(engine, xs, ys, rows, other, c, out, first, **kw):
+    def half_triangles(engine, xs, ys, rows, out, first, **kw):
         if first == 0:  # the main thread's half: interrupted while the other half works
             time.sleep(0.02)
             raise KeyboardInterrupt
         try:
-            outcomes.append(real(engine, xs, ys, rows, other, c, out, first, **kw))
+            outcomes.append(real(engine, xs, ys, rows, out, first, **kw))
         except KeyboardInterrupt as exc:
             outcomes.append(exc)
             raise
 
-    monkeypatch.setattr(halves, "half", half)
+    monkeypatch.setattr(halves, "half_triangles", half_triangles)
     pts = generate("uniform", 800_000, seed=9)
     with pytest.raises(KeyboardInterrupt):
         halves.triangulate(pts[:, 0].copy(), pts[:, 1].copy(), 0, threads=2)
     assert len(outcomes) == 1 and isinstance(outcomes[0], KeyboardInterrupt), outcomes
     assert not STOPPING
-    monkeypatch.setattr(halves, "half", real)
+    monkeypatch.setattr(halves, "half_triangles", real)
     small = generate("uniform", 3000, seed=9)
     with split_from_3() as joins:
         check_by_halves(small, joins=joins)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize("late", ["left", "right"])
+def test_the_right_half_is_laid_out_by_whichever_thread_is_free(monkeypatch, engine, late):
+    """On two threads the right half's triangles are laid out by its own thread when the left half is not
+    done yet, else by the main thread on two (halves.on_two_halves): each way the same triangulation
+    as on one thread. Each way is forced here by holding one half's triangles back."""
+    pts = generate("uniform", 3 * halves.SPLIT_MIN_SITES, seed=5)
+    e = engines.scale_exponent(pts)
+    one = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, threads=1)
+    real_tri, real_lay = halves.half_triangles, halves.lay_out
+    laid: list[tuple[int, bool]] = []  # (first site, laid out on the main thread)
+
+    def half_triangles(engine, xs, ys, rows, out, first, **kw):
+        t = real_tri(engine, xs, ys, rows, out, first, **kw)
+        if (first == 0) == (late == "left"):
+            time.sleep(0.3)
+        return t
+
+    def lay_out(t, other_box, c, out, first, **kw):
+        laid.append((first, threading.current_thread() is threading.main_thread()))
+        return real_lay(t, other_box, c, out, first, **kw)
+
+    monkeypatch.setattr(halves, "half_triangles", half_triangles)
+    monkeypatch.setattr(halves, "lay_out", lay_out)
+    two = halves.triangulate(pts[:, 0], pts[:, 1], e, engine=engine, threads=2)
+    right = [on_main for first, on_main in laid if first != 0]
+    assert right == [late == "right"], laid
+    for name in ("tv", "opp", "dup"):
+        assert np.array_equal(getattr(one, name), getattr(two, name)), name
+    assert np.array_equal(one.sites.perm, two.sites.perm)
+    assert np.array_equal(one.sites.xs, two.sites.xs)
