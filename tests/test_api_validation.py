@@ -281,6 +281,33 @@ def test_point_bounds_is_numpys_reductions_in_one_pass(rows):
     assert smallest == (mags.min() if mags.size else math.inf)
 
 
+@pytest.mark.parametrize("threads", [2, 3, 7])
+@pytest.mark.parametrize("seed", range(4))
+def test_point_bounds_on_threads_is_the_one_thread_pass(threads, seed):
+    """On several threads (a run of rows each, from 2^16 rows on) the same figures as on one, bit for bit:
+    equal extremes of either sign (0.0 and -0.0) in different runs keep the first row's, the least
+    magnitude and the count of non-finite values merge across runs."""
+    from tvoronoi.kernels.bounds import point_bounds
+
+    rng = np.random.default_rng(seed)
+    n = 200_000
+    pts = rng.uniform(0.5, 1.0, (n, 2)) * rng.choice([-1.0, 1.0], (n, 2))
+    pts[rng.integers(0, n, 5)] = 0.0  # +0.0 and -0.0 at random rows: tied lows, highs and no magnitude
+    pts[rng.integers(0, n, 5)] = -0.0
+    pts[:, 0] = np.abs(pts[:, 0])  # x >= 0: its low is a zero, whose sign comes from its first row
+    pts[:, 1] = -np.abs(pts[:, 1])  # y <= 0: its high is a zero
+    pts[rng.integers(0, n), 0] = 1e-300  # the least magnitude, in a random run
+    one = point_bounds(pts)
+    assert np.array_equal(np.array(point_bounds(pts, threads)).view(np.int64), np.array(one).view(np.int64))
+    first_x_zero = pts[np.flatnonzero(pts[:, 0] == 0)[0], 0]
+    assert math.copysign(1, one[1]) == math.copysign(1, first_x_zero)
+    assert one[5] == 1e-300
+    bad = pts.copy()
+    bad[rng.integers(0, n, 3), 1] = np.nan
+    bad[rng.integers(0, n), 0] = np.inf
+    assert point_bounds(bad, threads)[0] == point_bounds(bad)[0] == int((~np.isfinite(bad)).sum())
+
+
 def test_checked_points_range_verdict_is_check_ranges():
     """checked_points reads the range rule off the one pass (the least nonzero magnitude against the
     scale): it refuses exactly what check_range, comparing every value, refuses, and names the same row;

