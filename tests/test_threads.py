@@ -59,6 +59,35 @@ def test_bad_thread_counts_are_refused(bad):
         tvoronoi.voronoi([[0, 0], [1, 0], [0, 1]], threads=bad)
 
 
+@pytest.mark.parametrize("order", ["shuffled", "reversed", "halves_swapped"])
+@pytest.mark.parametrize("n", [3_000, 40_000])
+def test_dual_first_pass_on_threads_with_triangles_in_any_order(order, n):
+    """The dual's first pass on several threads: each thread writes the sites of its run of triangles
+    and lists the others, merged after (the least half-edge wins); a run that meets too many of them
+    falls back to one thread. Triangles in an order far from their sites' (shuffled: 40,000 sites
+    overflow the lists; reversed; the two halves swapped) give the same DCEL on 1, 2, 3 and 5 threads."""
+    rng = np.random.default_rng(n)
+    pts = rng.random((n, 2))
+    e = engines.scale_exponent(pts)
+    t = engines.run(pts[:, 0], pts[:, 1], engine="incremental", exponent=e)
+    s, n_tri = t.sites, len(t.tv) // 3
+    if order == "shuffled":
+        new_of_old = rng.permutation(n_tri)
+    elif order == "reversed":
+        new_of_old = np.arange(n_tri)[::-1].copy()
+    else:
+        new_of_old = np.roll(np.arange(n_tri), n_tri // 2)
+    old_of_new = np.argsort(new_of_old)
+    tv = t.tv.reshape(-1, 3)[old_of_new].ravel()
+    twin = t.opp.reshape(-1, 3)[old_of_new].ravel()
+    opp = (3 * new_of_old[twin // 3] + twin % 3).astype(np.int32)
+    outs = [dual.voronoi_from_delaunay(s.xs, s.ys, tv, opp, e, k, parallel_min=1) for k in (1, 2, 3, 5)]
+    assert len(outs[0]["he_origin"]) > 0
+    for out in outs[1:]:
+        for key in outs[0]:
+            assert np.array_equal(outs[0][key], out[key]), key
+
+
 @pytest.mark.parametrize("name", sorted(adversarial.FAMILIES))
 def test_kernels_split_on_every_family(name):
     case = adversarial.make(name)

@@ -3,7 +3,7 @@
 import numpy as np
 
 from cython.parallel cimport prange
-from libc.stdint cimport int32_t, uint64_t
+from libc.stdint cimport int32_t, int64_t, uint64_t
 from libc.math cimport fabs, ldexp
 from libc.string cimport memmove
 
@@ -21,6 +21,8 @@ cdef enum:
     WALK_CHUNK = 1 << 12    # sites walked by one thread in a row (neighbouring cells share cache lines)
     TRI_BLOCK = 1 << 12     # triangles given their vertices by one thread in a row
     POLL_BLOCKS = 64        # blocks of triangles between two polls for signals
+    MAX_THREADS = 64        # threads the first pass runs on (more are given that many)
+    SIDE_MIN = 1 << 12      # room in each thread's side list of the first pass, at least
 
 # Layout of the Voronoi DCEL (struct of arrays, -1 for "at infinity"):
 #   he_origin[h]  Voronoi vertex h starts from, -1 if h comes from infinity
@@ -180,9 +182,30 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         link_own = np.empty(max(n_he_d, 1), np.int32)
         link = &link_own[0]
 
+    cdef FirstPass parts[MAX_THREADS]
+    cdef int T = min(threads, MAX_THREADS), side_cap
+    cdef int32_t[::1] side_buf
+    cdef bint overflow
+    if T > 1:
+        # each thread's run of triangles (whole blocks) and the sites it counts itself (the rest go to its
+        # side list): from the least site of its first triangle on, as the triangles come in the order
+        # of their least sites
+        side_cap = max(SIDE_MIN, n_tri // (4 * T))
+        side_buf = np.empty(2 * T * side_cap, np.int32)
+        for k in range(T):
+            parts[k].t_lo = min(n_blocks * k // T * TRI_BLOCK, n_tri)
+            parts[k].t_hi = min(n_blocks * (k + 1) // T * TRI_BLOCK, n_tri)
+            parts[k].s_lo = 0 if k == 0 else max(parts[k - 1].s_lo, least_site(&tv[0], parts[k].t_lo, n_tri, inf))
+            parts[k].cap_side = side_cap
+            parts[k].side_site = &side_buf[2 * k * side_cap]
+            parts[k].side_e = parts[k].side_site + side_cap
+        for k in range(T):
+            parts[k].s_hi = parts[k + 1].s_lo if k + 1 < T else n
     with nogil:
-        fill_int32(&first_e[0], n, -1)      # (written whole: faulted in by runs of pages)
-        fill_int32(&face_edge[0], n, -1)
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            fill_int32(&first_e[<int64_t> n * k // T], <int> (<int64_t> n * (k + 1) // T - <int64_t> n * k // T), -1)
+            fill_int32(&face_edge[<int64_t> n * k // T], <int> (<int64_t> n * (k + 1) // T - <int64_t> n * k // T),
+                       -1)
         # which triangles are finite (counted by blocks of triangles, for their vertices' numbers), and
         # where each site's walk starts: any half-edge out of it, or for a hull site the one whose dual
         # comes from infinity (the twin of a hull edge p->q of an infinite triangle starts at q). On
@@ -191,27 +214,49 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         # (the triangles last to first, so that each site keeps its first half-edge in triangle order
         # by plain stores, no test of what is there; then the hull's, which take precedence)
         n_hull = 0
-        for t in range(n_tri - 1, -1, -1):
-            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            if a == inf or b == inf or c == inf:
-                vid[n_hull] = t         # (vid is free until the vertices are numbered: the hull's triangles)
-                n_hull += 1
-                if threads > 1:
-                    for e in range(3 * t, 3 * t + 3):
-                        if tv[e] != inf and tv[nxt(e)] != inf:
-                            h_first[tv[e]] += 1
-            else:
-                v_block[t // TRI_BLOCK + 1] += 1
-                first_e[c] = 3 * t + 2
-                first_e[b] = 3 * t + 1
-                first_e[a] = 3 * t
-                if threads > 1:
-                    h_first[a] += 1; h_first[b] += 1; h_first[c] += 1
-        for k in range(n_hull):
-            t = vid[k]
-            for e in range(3 * t, 3 * t + 3):
-                if tv[e] != inf and tv[nxt(e)] != inf:
-                    first_e[tv[nxt(e)]] = opp[e]
+        if T == 1:
+            for t in range(n_tri - 1, -1, -1):
+                a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+                if a == inf or b == inf or c == inf:
+                    vid[n_hull] = t         # (vid is free until the vertices are numbered: the hull's triangles)
+                    n_hull += 1
+                else:
+                    v_block[t // TRI_BLOCK + 1] += 1
+                    first_e[c] = 3 * t + 2
+                    first_e[b] = 3 * t + 1
+                    first_e[a] = 3 * t
+            for k in range(n_hull):
+                hull_starts(&tv[0], &opp[0], vid[k], inf, &first_e[0])
+        else:
+            # a run of triangles on each thread (the same counts and the same first half-edges: each run
+            # keeps the least of its own, the side lists' are merged by the least), its hull triangles
+            # listed in vid from the run's start
+            for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+                first_pass_part(&parts[k], &tv[0], inf, &first_e[0], &h_first[0], &v_block[0], &vid[0])
+            overflow = False
+            for k in range(T):
+                overflow = overflow or parts[k].overflow
+            if overflow:
+                # (a side list ran out of room: triangles far from the order of their sites) the whole
+                # pass again on this thread
+                for k in range(n + 1):
+                    h_first[k] = 0
+                for k in range(n_blocks + 1):
+                    v_block[k] = 0
+                for k in range(n):
+                    first_e[k] = -1
+                parts[0].t_lo = 0
+                parts[0].t_hi = n_tri
+                parts[0].s_lo = 0
+                parts[0].s_hi = n
+                parts[0].cap_side = 0
+                first_pass_part(&parts[0], &tv[0], inf, &first_e[0], &h_first[0], &v_block[0], &vid[0])
+                T = 1
+            for k in range(T):
+                merge_side(&parts[k], &first_e[0], &h_first[0])
+            for k in range(T):
+                for g in range(parts[k].n_hull):
+                    hull_starts(&tv[0], &opp[0], vid[parts[k].t_lo + g], inf, &first_e[0])
         for bk in range(n_blocks):
             v_block[bk + 1] += v_block[bk]
         n_finite = v_block[n_blocks]
@@ -370,6 +415,87 @@ cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int
             k += 1
             t += 1
         circumcentres_block(k, gx[0], gy[0], gx[1], gy[1], gx[2], gy[2], e, &centre[2 * m0], 2)
+
+
+cdef struct FirstPass:
+    # one thread's run of the dual's first pass (voronoi_from_delaunay)
+    int t_lo, t_hi          # its triangles
+    int s_lo, s_hi          # the sites whose first half-edge and count it writes itself
+    int n_hull              # its hull triangles, listed in vid from t_lo on
+    int n_side, cap_side    # the other sites it met: side_site[j], met at half-edge side_e[j] (-1: a count
+    int32_t* side_site      # only, from a hull triangle)
+    int32_t* side_e
+    bint overflow           # more than cap_side of them
+
+
+cdef inline void meet(FirstPass* P, int x, int e, int32_t* first_e, int32_t* h_first) noexcept nogil:
+    # site x met at half-edge e out of it (-1: counted only)
+    if P.s_lo <= x < P.s_hi:
+        if e >= 0:
+            first_e[x] = e
+        h_first[x] += 1
+    elif P.n_side < P.cap_side:
+        P.side_site[P.n_side] = x
+        P.side_e[P.n_side] = e
+        P.n_side += 1
+    else:
+        P.overflow = True
+
+
+cdef void first_pass_part(FirstPass* P, const int32_t* tv, int inf, int32_t* first_e, int32_t* h_first,
+                          int32_t* v_block, int32_t* vid) noexcept nogil:
+    # the first pass over triangles t_lo..t_hi-1, last to first (each site it writes keeps its least
+    # half-edge of the run); counts one half-edge a Delaunay edge out of each site
+    cdef int t, e, a, b, c
+    P.n_hull = 0
+    P.n_side = 0
+    P.overflow = False
+    for t in range(P.t_hi - 1, P.t_lo - 1, -1):
+        a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+        if a == inf or b == inf or c == inf:
+            vid[P.t_lo + P.n_hull] = t
+            P.n_hull += 1
+            for e in range(3 * t, 3 * t + 3):
+                if tv[e] != inf and tv[nxt(e)] != inf:
+                    meet(P, tv[e], -1, first_e, h_first)
+        else:
+            v_block[t // TRI_BLOCK + 1] += 1
+            meet(P, c, 3 * t + 2, first_e, h_first)
+            meet(P, b, 3 * t + 1, first_e, h_first)
+            meet(P, a, 3 * t, first_e, h_first)
+
+
+cdef void merge_side(FirstPass* P, int32_t* first_e, int32_t* h_first) noexcept nogil:
+    # a run's side list into the counts and the first half-edges (the least half-edge wins)
+    cdef int j, x, e
+    for j in range(P.n_side):
+        x = P.side_site[j]
+        e = P.side_e[j]
+        h_first[x] += 1
+        if e >= 0 and (first_e[x] < 0 or e < first_e[x]):
+            first_e[x] = e
+
+
+cdef inline void hull_starts(const int32_t* tv, const int32_t* opp, int t, int inf, int32_t* first_e) noexcept nogil:
+    # hull triangle t: each hull site's walk starts at the twin of the hull edge into it
+    cdef int e
+    for e in range(3 * t, 3 * t + 3):
+        if tv[e] != inf and tv[nxt(e)] != inf:
+            first_e[tv[nxt(e)]] = opp[e]
+
+
+cdef int least_site(const int32_t* tv, int t, int n_tri, int inf) noexcept nogil:
+    # the least finite site of triangle t (of the first finite one from t on; inf if none)
+    cdef int k, v, least = inf
+    while t < n_tri:
+        for k in range(3):
+            v = tv[3 * t + k]
+            if v < least:
+                least = v
+        if least < inf:
+            return least
+        t += 1
+    return inf
 
 
 cdef void finite_to_front(int32_t* tv, int n_tri, int inf) noexcept nogil:
