@@ -410,6 +410,73 @@ def penrose_vertices(reach: int = 7, *, decimals: int = 6, seed: int = SEED) -> 
     return Case(_pts(pts[keep]), note=f"Penrose tiling vertices, {decimals} decimals")
 
 
+def lloyd_relaxed(
+    n: int = 1500, *, iterations: int = 10, samples: int = 30, decimals: int = 4, seed: int = SEED
+) -> Case:
+    """Sites after Lloyd's relaxation in the unit square (each moved to the centroid of its cell, the
+    centroids estimated from ``samples`` random points a site, assigned by a k-d tree), rounded: a centroidal
+    tessellation, nearly hexagonal inside, its sites nearly evenly spaced, so that many Voronoi vertices
+    of neighbouring triples lie within the rounding of one another. Made apart from the code under test."""
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(seed)
+    sites = rng.uniform(0.0, 1.0, (n, 2))
+    for _ in range(iterations):
+        drawn = rng.uniform(0.0, 1.0, (samples * n, 2))
+        owner = cKDTree(sites).query(drawn)[1]
+        counts = np.bincount(owner, minlength=n)
+        sums = np.column_stack([np.bincount(owner, drawn[:, k], minlength=n) for k in range(2)])
+        moved = counts > 0
+        sites[moved] = sums[moved] / counts[moved, None]
+    return Case(_pts(np.round(sites, decimals)), note=f"Lloyd-relaxed, {decimals} decimals")
+
+
+def street_network(streets: int = 14, *, spacing_m: float = 8.0, decimals: int = 7, seed: int = SEED) -> Case:
+    """A street network as a map stores it: two families of straight streets (a grid turned by a seeded
+    angle, blocks of about 80 m) and two avenues across, with a node every few metres along each and a
+    node at every crossing, in degrees near lon 13.4 / lat 52.5 rounded to 7 decimals (an integer of
+    1e-7 degrees): long runs of nodes that are collinear before the rounding, a crossing's node repeated
+    by each street through it, streets far closer along than across."""
+    rng = np.random.default_rng(seed)
+    metre = np.array([1.0 / (111320.0 * math.cos(math.radians(52.5))), 1.0 / 110540.0])  # degrees a metre
+    theta = rng.uniform(0.0, math.pi / 2.0)
+    u = np.array([math.cos(theta), math.sin(theta)])
+    v = np.array([-u[1], u[0]])
+    half = 40.0 * streets
+    lines = [(k * 80.0 * v, u) for k in range(-streets // 2, streets // 2 + 1)]
+    lines += [(k * 80.0 * u, v) for k in range(-streets // 2, streets // 2 + 1)]
+    for _ in range(2):
+        a = rng.uniform(0.0, math.pi)
+        lines.append((rng.uniform(-half / 3, half / 3, 2), np.array([math.cos(a), math.sin(a)])))
+    out = []
+    for k, (p, d) in enumerate(lines):
+        t = np.arange(-half, half, spacing_m * rng.uniform(0.8, 1.2))
+        out.append(p + t[:, None] * d)
+        for q, e in lines[k + 1 :]:
+            det = d[0] * e[1] - d[1] * e[0]
+            if abs(det) > 1e-9:  # the crossing, a node of both streets
+                s_ = ((q[0] - p[0]) * e[1] - (q[1] - p[1]) * e[0]) / det
+                if abs(s_) < half:
+                    out.append(np.repeat((p + s_ * d)[None, :], 2, axis=0))  # (listed by both streets)
+    metres = np.concatenate(out)
+    degrees = np.array([13.4, 52.5]) + metres * metre
+    pts = np.round(degrees, decimals)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"street network, {decimals} decimals")
+
+
+def time_series(n: int = 1000, *, series: int = 3, decimals: int = 2, seed: int = SEED) -> Case:
+    """A scatter of time series: x a Unix time in seconds near 1.7e9 (steps of 1 to 60 s, some repeated
+    stamps), y each series' random walk rounded to a few decimals, the series sampled at the same
+    stamps: columns of sites on one x, a scale of 1 across the columns against 0.01 up them, and the
+    large offset leaving x some 22 bits below its unit."""
+    rng = np.random.default_rng(seed)
+    steps = rng.integers(0, 61, n)  # (0: a repeated stamp)
+    t = 1.7e9 + np.cumsum(steps).astype(np.float64)
+    walks = np.cumsum(rng.normal(0.0, 0.3, (series, n)), axis=1) + rng.uniform(-5.0, 5.0, (series, 1))
+    pts = np.column_stack([np.tile(t, series), np.round(walks.ravel(), decimals)])
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"time series, {decimals} decimals")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -800,6 +867,13 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "tensor_grid_random_3dec": partial(tensor_grid, 60, spacing="random", decimals=3),
     "penrose_6dec": penrose_vertices,
     "penrose_2dec": partial(penrose_vertices, 9, decimals=2),
+    # relaxed sites, networks and series
+    "lloyd_relaxed_4dec": lloyd_relaxed,
+    "lloyd_relaxed_2dec": partial(lloyd_relaxed, 800, iterations=12, decimals=2),
+    "street_network_7dec": street_network,
+    "street_network_5dec": partial(street_network, 10, spacing_m=3.0, decimals=5),
+    "time_series_epoch_2dec": time_series,
+    "time_series_epoch_1dec": partial(time_series, 1500, series=4, decimals=1),
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
