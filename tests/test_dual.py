@@ -12,7 +12,7 @@ import pytest
 from tests import adversarial
 from tvoronoi import engines
 from tvoronoi.generators import generate
-from tvoronoi.kernels import dual
+from tvoronoi.kernels import dual, predicates
 
 
 def triangulated(pts: np.ndarray, engine: str):
@@ -155,3 +155,58 @@ def test_a_read_only_triangulation_is_not_written_when_given_up(read_only):
         assert np.array_equal(tv, t.tv) and not np.shares_memory(out["triangles"], tv)
     if read_only != "tv":
         assert np.array_equal(opp, t.opp)
+
+
+def zero_length_edges(t) -> int:
+    """Delaunay edges between two finite triangles whose four sites are cocircular (exact): each is an
+    edge of length zero between two triangles with one circumcentre."""
+    n = len(t.sites.xs)
+    rows = t.tv.reshape(-1, 3)
+    count = 0
+    for d in range(len(t.tv)):
+        e = int(t.opp[d])
+        if e < d or (rows[d // 3] >= n).any() or (rows[e // 3] >= n).any():
+            continue
+        p, q = int(t.tv[d]), int(t.tv[3 * (d // 3) + (d + 1) % 3])
+        r = int(t.tv[3 * (d // 3) + (d + 2) % 3])
+        s = int(t.tv[3 * (e // 3) + (e + 2) % 3])
+        xs, ys = t.sites.xs, t.sites.ys
+        count += predicates.incircle_sign(xs[p], ys[p], xs[q], ys[q], xs[r], ys[r], xs[s], ys[s]) == 0
+    return count
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "grid10_noise1e-17",
+        "pythagorean_grid",
+        "overlaid_grids_3_5",
+        "refined_cells",
+        "grid_with_holes",
+        "offset_grid_1e15",
+    ],
+)
+def test_cocircular_merges_are_the_same_on_any_count_of_threads(name, engine):
+    """Cocircular sites: the walks mark both half-edges of each zero-length edge (the second where it
+    links the twin, or the pass after the walks across runs of sites), and the merges, renumbering and
+    moves run a part on each thread. Every count of threads and every run length of the walks gives
+    the arrays of one thread, whose vertices number the finite triangles less the zero-length edges
+    (exact in-circle tests: they form a forest)."""
+    got = triangulated(adversarial.make(name).points, engine)
+    assert got is not None
+    t, e = got
+    s = t.sites
+    want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e)
+    zero = zero_length_edges(t)
+    assert zero > 0
+    assert len(want["vertices"]) == len(finite_rows(t)) - zero
+    for threads in (2, 3, 5, 8):
+        for walk_chunk in (1, 7, 4096):
+            for given in (False, True):
+                tv, opp = (t.tv.copy(), t.opp.copy()) if given else (t.tv, t.opp)
+                out = dual.voronoi_from_delaunay(
+                    s.xs, s.ys, tv, opp, e, threads, parallel_min=1, walk_chunk=walk_chunk, give_triangulation=given
+                )
+                for key in want:
+                    assert np.array_equal(out[key], want[key]), (threads, walk_chunk, given, key)

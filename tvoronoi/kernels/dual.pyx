@@ -354,9 +354,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         he_twin[g] = link[-1 - he_twin[g]]
                 lo = hi
 
-        # the twins of the zero-length edges the walks marked (a twin comes after its edge)
-        if n_marked > 0 and n_illegal == 0:
-            n_zero = mark_twins(h, &he_twin[0], &zero[0])
+        # (the walks marked one half-edge of each zero-length edge; drop_zero_edges marks the other)
+        if n_illegal == 0:
+            n_zero = 2 * n_marked
     if n_illegal > 0:
         if give_opp:
             edge_of = np.empty(max(h, 1), np.int32)
@@ -369,10 +369,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     else:
         triangles = np.asarray(tri)
     if n_zero > 0:
-        parent = np.arange(max(n_finite, 1), dtype=np.int32)
+        parent = np.empty(max(n_finite, 1), dtype=np.int32)
         with nogil:
             m, h = drop_zero_edges(h, n_finite, n, &he_origin[0], &he_twin[0], &he_face[0], &face_edge[0],
-                                   &zero[0], &parent[0], &vid[0], link, &centre[0, 0])
+                                   &zero[0], &parent[0], &vid[0], link, &centre[0, 0], threads)
     else:
         m = n_finite
 
@@ -668,29 +668,6 @@ cdef bint writable(const int32_t[::1] a):
     return isinstance(a.base, np.ndarray) and a.base.flags.writeable
 
 
-cdef int mark_twins(int h, const int32_t* he_twin, signed char* zero) noexcept nogil:
-    # after the walks, with every twin known: both half-edges of every zero-length edge marked 1 (the
-    # walks marked one); returns the count of half-edges marked. Words with no flag set are skipped
-    # whole: `zero`'s pages are read only where a walk wrote to them
-    cdef int g, k, count = 0
-    cdef const uint64_t* words = <const uint64_t*> zero
-    for k in range(h // 8):
-        if words[k] == 0:
-            continue
-        for g in range(8 * k, 8 * k + 8):
-            count += mark_twin(g, he_twin, zero)
-    for g in range(h - h % 8, h):
-        count += mark_twin(g, he_twin, zero)
-    return count
-
-
-cdef inline int mark_twin(int g, const int32_t* he_twin, signed char* zero) noexcept nogil:
-    if zero[g] == 1 and he_twin[g] > g:
-        zero[he_twin[g]] = 1
-        return 2
-    return 0
-
-
 cdef inline int far_site_inside(int a, int b, const int32_t* t_right, const int32_t* t_left, const double* xs,
                                 const double* ys) noexcept nogil:
     # Delaunay edge a->b between triangle (b, a, c) on its right and (a, b, d) on its left (both
@@ -716,62 +693,204 @@ cdef inline int third(const int32_t* t, int a, int b) noexcept nogil:
     return t[2]
 
 
-cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t* he_twin, int32_t* he_face,
-                                int32_t* face_edge, const signed char* zero, int32_t* parent, int32_t* vmap,
-                                int32_t* newh, double* centre) noexcept nogil:
-    """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
-    group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
-    each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts."""
-    cdef int g, k, u, w, r, a, q, c, last_face = -1, h_kept
-    # each kept half-edge's new number (how many before it are kept), and the zero-length edges listed,
-    # each from its half-edge of smaller index (its twin joins the same two vertices), in vmap (free
-    # until the vertices are renumbered; they form a forest: fewer than m). No branch: where zero-length
-    # edges lie follows no pattern the processor could learn (sites numbered along a BRIO curve)
-    k = 0
-    c = 0
-    for g in range(h):
+cdef struct DropPart:
+    # one thread's run of half-edges [g_lo, g_hi) and of vertices [v_lo, v_hi) in drop_zero_edges
+    int g_lo, g_hi, v_lo, v_hi
+    int n_zero          # its zero-length half-edges
+    int n_listed        # those listed for the merges: the walks marked them (the half-edge of smaller index)
+    int first_listed    # the first of them (-1: none)
+    int landed[MAX_THREADS]     # the twins this run marked, by the run they lie in
+    int k_lo            # the new number of its first kept half-edge
+    int q_lo            # where its listed half-edges start in the list
+    int n_roots         # its vertices that stay (each group's smallest)
+    int r_lo            # the new number of the first of them
+    int face_before     # the face of the half-edge before the run (-1 for the first)
+
+
+cdef inline void mark_range(int lo, int hi, const int32_t* he_twin, signed char* zero, int* listed, int* first,
+                            int* landed, const int* bound) noexcept nogil:
+    # each half-edge g in lo..hi - 1 that its walk marked (the half-edge of the site that comes first: its
+    # twin comes after it) listed, its twin marked and counted in landed by the run it lies in
+    cdef int g, tw, j
+    for g in range(lo, hi):
+        tw = he_twin[g]
+        if zero[g] == 1 and tw > g:
+            zero[tw] = 1
+            j = 0
+            while tw >= bound[j]:
+                j += 1
+            landed[j] += 1
+            if listed[0] == 0:
+                first[0] = g
+            listed[0] += 1
+
+
+cdef void mark_twins(DropPart* P, const int32_t* he_twin, signed char* zero, const DropPart* parts, int T) noexcept nogil:
+    # the twins of the half-edges of P that the walks marked, marked too (mark_range). Words with no
+    # mark are skipped whole: `zero`'s pages are read only where a walk wrote to them. (On threads, the
+    # twin marked may lie in another run, whose thread reads that mark only to find that its twin comes
+    # before it: what it reads there changes nothing)
+    cdef int k, lo = P.g_lo, hi = P.g_hi, w_lo = (lo + 7) >> 3, w_hi = hi >> 3, listed = 0, first = -1
+    cdef int head_end = min(hi, 8 * w_lo)
+    cdef int landed[MAX_THREADS]
+    cdef int bound[MAX_THREADS]
+    cdef const uint64_t* words = <const uint64_t*> zero
+    for k in range(T):
+        landed[k] = 0
+        bound[k] = parts[k].g_hi
+    mark_range(lo, head_end, he_twin, zero, &listed, &first, landed, bound)
+    for k in range(w_lo, w_hi):
+        if words[k] != 0:
+            mark_range(8 * k, 8 * k + 8, he_twin, zero, &listed, &first, landed, bound)
+    mark_range(max(head_end, 8 * w_hi), hi, he_twin, zero, &listed, &first, landed, bound)
+    P.n_listed = listed
+    P.first_listed = first
+    for k in range(T):
+        P.landed[k] = landed[k]
+
+
+cdef inline void number_kept(DropPart* P, const signed char* zero, const int32_t* he_twin, int32_t* newh,
+                             int32_t* listed) noexcept nogil:
+    # each half-edge's new number (the kept ones before it), and the listed half-edges from q_lo on. No
+    # branch: where zero-length edges lie follows no pattern the processor could learn (sites numbered
+    # along a BRIO curve); a half-edge not listed is written at the next free place, which the next
+    # listed one overwrites (those after the run's last one land on the next run's first place: put
+    # back once every run is done)
+    cdef int g, k = P.k_lo, q = P.q_lo
+    for g in range(P.g_lo, P.g_hi):
         newh[g] = k
         k += 1 - zero[g]
-        vmap[c] = g
-        c += zero[g] & (he_twin[g] > g)
-    h_kept = k
+        listed[q] = g
+        q += zero[g] & (he_twin[g] > g)
+
+
+cdef inline int count_roots(const DropPart* P, const int32_t* parent) noexcept nogil:
+    cdef int v, roots = 0
+    for v in range(P.v_lo, P.v_hi):
+        roots += parent[v] == v
+    return roots
+
+
+cdef inline void number_groups(DropPart* P, int32_t* parent, int32_t* vmap, double* centre) noexcept nogil:
+    # each vertex of P pointed at its group's root (walks up that read only: only a vertex's own place is
+    # written, by its own run), the roots numbered from r_lo on and their centres moved down to the start
+    # of P's run in place (each to no later place than its own: every place is written after it was read)
+    cdef int v, r, i = P.v_lo
+    for v in range(P.v_lo, P.v_hi):
+        r = v
+        while parent[r] != r:
+            r = parent[r]
+        parent[v] = r
+        if r == v:
+            vmap[v] = P.r_lo + (i - P.v_lo)
+            centre[2 * i] = centre[2 * v]
+            centre[2 * i + 1] = centre[2 * v + 1]
+            i += 1
+    P.n_roots = i - P.v_lo
+
+
+cdef inline void move_kept(const DropPart* P, int32_t* he_origin, int32_t* he_twin, int32_t* he_face,
+                           int32_t* face_edge, const int32_t* parent, const int32_t* vmap,
+                           const int32_t* newh) noexcept nogil:
+    # the kept half-edges of P moved down to the start of its run in place, with their new numbers (their
+    # twins', their origins' groups'), each cell's first where its face begins
+    # (a zero-length half-edge is written too, with no branch, at the place of the next kept one, which
+    # then overwrites it: every place is written after it was read; those after the run's last kept
+    # half-edge land beyond its kept ones, inside the run. Its face's first is the next kept one's
+    # number: every cell keeps some edges, those from and to infinity or three at least)
+    cdef int g, k, a, o, last_face = P.face_before, shift = P.g_lo - P.k_lo
+    for g in range(P.g_lo, P.g_hi):
+        k = newh[g]
+        o = he_origin[g]
+        he_origin[k + shift] = vmap[parent[o]] if o >= 0 else -1
+        he_twin[k + shift] = newh[he_twin[g]]
+        a = he_face[g]
+        he_face[k + shift] = a
+        if a != last_face:
+            face_edge[a] = k
+            last_face = a
+
+
+cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t* he_twin, int32_t* he_face,
+                                int32_t* face_edge, signed char* zero, int32_t* parent, int32_t* vmap,
+                                int32_t* newh, double* centre, int threads) noexcept nogil:
+    """Cocircular sites: merge the vertices at both ends of each zero-length half-edge into one (the
+    group's smallest number), renumber the vertices in order, and remove those half-edges, keeping
+    each cell's in order and the cells contiguous. Returns the new vertex and half-edge counts.
+
+    The walks marked one half-edge of each zero-length edge, that of the site that comes first; the
+    other is marked here. On more than one thread, each takes a run of the half-edges and of the
+    vertices: they are counted, then each run numbered from the counts of the runs before it and moved
+    down to its own start, then the runs moved together in order (the same arrays for any count). The
+    merges run on this thread."""
+    cdef DropPart parts[MAX_THREADS]
+    cdef int T = max(1, min(threads, MAX_THREADS)), k, q, g, u, w, v
+    cdef int h_kept = 0, n_listed = 0, n_roots = 0
+    for k in range(T):
+        parts[k].g_lo = <int> (<int64_t> h * k // T)
+        parts[k].g_hi = <int> (<int64_t> h * (k + 1) // T)
+        parts[k].v_lo = <int> (<int64_t> m * k // T)
+        parts[k].v_hi = <int> (<int64_t> m * (k + 1) // T)
+        parts[k].k_lo = 0
+        parts[k].q_lo = 0
+        parts[k].r_lo = 0
+        parts[k].face_before = he_face[parts[k].g_lo - 1] if parts[k].g_lo > 0 else -1
+    # the twins of the zero-length half-edges the walks marked, marked too and counted by runs; each
+    # vertex its own group
+    for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+        mark_twins(&parts[k], he_twin, zero, parts, T)
+        for v in range(parts[k].v_lo, parts[k].v_hi):
+            parent[v] = v
+    for k in range(T):
+        parts[k].n_zero = parts[k].n_listed
+        for q in range(T):
+            parts[k].n_zero += parts[q].landed[k]
+        parts[k].k_lo = h_kept
+        parts[k].q_lo = n_listed
+        h_kept += (parts[k].g_hi - parts[k].g_lo) - parts[k].n_zero
+        n_listed += parts[k].n_listed
+    # each kept half-edge's new number, and the zero-length edges listed, each from its half-edge of
+    # smaller index (its twin joins the same two vertices), in vmap (free until the vertices are
+    # renumbered; they form a forest: fewer than m)
+    for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+        number_kept(&parts[k], zero, he_twin, newh, vmap)
+    for k in range(1, T):
+        if parts[k].n_listed > 0:
+            vmap[parts[k].q_lo] = parts[k].first_listed
     # the merges: both ends of each zero-length edge in one group, named by its smallest vertex
-    for q in range(c):
+    for q in range(n_listed):
         g = vmap[q]
         u = find(parent, he_origin[g])
         w = find(parent, he_origin[next_in_cell(g, h, he_face, face_edge)])
         parent[max(u, w)] = min(u, w)
     # the vertices renumbered in order: a root takes the next number, any other vertex its root's (a
-    # merge keeps the smaller root, so that root is numbered already)
-    k = 0
-    for g in range(m):
-        r = find(parent, g)
-        if r == g:
-            vmap[g] = k
-            centre[2 * k] = centre[2 * g]
-            centre[2 * k + 1] = centre[2 * g + 1]
-            k += 1
-        else:
-            vmap[g] = vmap[r]
-    m = k
-    # the kept half-edges moved down in place (to no later place than their own), and each cell's first
-    # where its face begins: the cells stay contiguous and in order (every cell keeps some edges: those
-    # from and to infinity, or three at least)
-    for g in range(n):
-        face_edge[g] = -1
-    # (a zero-length half-edge is written too, with no branch, at the place of the next kept one, which
-    # then overwrites it: every place is written after it was read, k = newh[g] <= g; those after the
-    # last kept half-edge land beyond the kept ones. Its face's first is the next kept one's place)
-    for g in range(h):
-        k = newh[g]
-        he_origin[k] = vmap[he_origin[g]] if he_origin[g] >= 0 else -1
-        he_twin[k] = newh[he_twin[g]]
-        a = he_face[g]
-        he_face[k] = a
-        if a != last_face:
-            face_edge[a] = k
-            last_face = a
-    return m, h_kept
+    # merge keeps the smaller root); every cell's first half-edge unknown
+    if T > 1:
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            parts[k].n_roots = count_roots(&parts[k], parent)
+            fill_int32(&face_edge[<int64_t> n * k // T], <int> (<int64_t> n * (k + 1) // T - <int64_t> n * k // T), -1)
+        for k in range(T):
+            parts[k].r_lo = n_roots
+            n_roots += parts[k].n_roots
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            number_groups(&parts[k], parent, vmap, centre)
+        # (every root numbered before any half-edge reads its number)
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            move_kept(&parts[k], he_origin, he_twin, he_face, face_edge, parent, vmap, newh)
+    else:
+        fill_int32(face_edge, n, -1)
+        number_groups(&parts[0], parent, vmap, centre)
+        n_roots = parts[0].n_roots
+        move_kept(&parts[0], he_origin, he_twin, he_face, face_edge, parent, vmap, newh)
+    # each run's vertices and kept half-edges moved to their places, in order (a run's new place is
+    # before its own, and after the places of the runs before it)
+    for k in range(1, T):
+        memmove(&centre[2 * parts[k].r_lo], &centre[2 * parts[k].v_lo], 2 * parts[k].n_roots * sizeof(double))
+        u = (parts[k].g_hi - parts[k].g_lo) - parts[k].n_zero
+        memmove(&he_origin[parts[k].k_lo], &he_origin[parts[k].g_lo], u * sizeof(int32_t))
+        memmove(&he_twin[parts[k].k_lo], &he_twin[parts[k].g_lo], u * sizeof(int32_t))
+        memmove(&he_face[parts[k].k_lo], &he_face[parts[k].g_lo], u * sizeof(int32_t))
+    return n_roots, h_kept
 
 
 def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0,
