@@ -477,6 +477,38 @@ def time_series(n: int = 1000, *, series: int = 3, decimals: int = 2, seed: int 
     return Case(_pts(pts[rng.permutation(len(pts))]), note=f"time series, {decimals} decimals")
 
 
+def building_footprints(blocks: int = 80, *, decimals: int = 2, turned: bool = True, seed: int = SEED) -> Case:
+    """The corners of building footprints in projected metres (UTM near 389,000 / 5,819,000), rounded as
+    a survey stores them: blocks of rectangles along streets of a few orientations, terraces of houses
+    sharing their side walls (a shared corner listed by both houses), a courtyard cut into some. Every
+    rectangle's four corners are cocircular before the rounding (exactly, for those not turned), and
+    neighbouring houses' corners lie on common lines and circles."""
+    rng = np.random.default_rng(seed)
+    angles = [0.0] if not turned else list(rng.uniform(0.0, math.pi / 2.0, 3))
+    out = []
+    for _ in range(blocks):
+        a = angles[rng.integers(len(angles))]
+        u = np.array([math.cos(a), math.sin(a)])
+        v = np.array([-u[1], u[0]])
+        origin = rng.uniform(0.0, 1500.0, 2)
+        x = 0.0
+        depth = float(rng.integers(8, 16))
+        for _ in range(int(rng.integers(1, 9))):  # a terrace: houses wall to wall
+            width = float(rng.integers(5, 13)) + (0.5 if rng.random() < 0.3 else 0.0)
+            corners = [(x, 0.0), (x + width, 0.0), (x + width, depth), (x, depth)]
+            if rng.random() < 0.15:  # a courtyard: an inner rectangle
+                corners += [
+                    (x + 2.0, 2.0),
+                    (x + width - 2.0, 2.0),
+                    (x + width - 2.0, depth - 2.0),
+                    (x + 2.0, depth - 2.0),
+                ]
+            out += [origin + cx * u + cy * v for cx, cy in corners]
+            x += width
+    pts = np.round(np.array([389000.0, 5819000.0]) + np.array(out), decimals)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"building footprints, {decimals} decimals")
+
+
 # ---------------------------------------------------------------------------------------------
 # rounded random points
 
@@ -874,6 +906,8 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "street_network_5dec": partial(street_network, 10, spacing_m=3.0, decimals=5),
     "time_series_epoch_2dec": time_series,
     "time_series_epoch_1dec": partial(time_series, 1500, series=4, decimals=1),
+    "buildings_turned_2dec": building_footprints,
+    "buildings_axis_1dec": partial(building_footprints, 100, decimals=1, turned=False),
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
