@@ -188,11 +188,11 @@ def zero_length_edges(t) -> int:
     ],
 )
 def test_cocircular_merges_are_the_same_on_any_count_of_threads(name, engine):
-    """Cocircular sites: the walks mark both half-edges of each zero-length edge (the second where it
-    links the twin, or the pass after the walks across runs of sites), and the merges, renumbering and
-    moves run a part on each thread. Every count of threads and every run length of the walks gives
-    the arrays of one thread, whose vertices number the finite triangles less the zero-length edges
-    (exact in-circle tests: they form a forest)."""
+    """Cocircular sites: the walks mark one half-edge of each zero-length edge (that of the site that
+    comes first), and drop_zero_edges marks its twin, then merges, renumbers and moves a run on each
+    thread. Every count of threads and every run length of the walks gives the arrays of one thread,
+    whose vertices number the finite triangles less the zero-length edges (exact in-circle tests: they
+    form a forest)."""
     got = triangulated(adversarial.make(name).points, engine)
     assert got is not None
     t, e = got
@@ -210,3 +210,20 @@ def test_cocircular_merges_are_the_same_on_any_count_of_threads(name, engine):
                 )
                 for key in want:
                     assert np.array_equal(out[key], want[key]), (threads, walk_chunk, given, key)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize("side", [2, 3, 5])
+def test_cocircular_merges_on_more_threads_than_half_edges(side, engine):
+    """A side x side grid (from four cocircular sites on): up to 64 threads and more, most of their runs
+    of half-edges and of vertices empty or shorter than a word of marks, give the arrays of one thread."""
+    g = np.array([(i, j) for i in range(side) for j in range(side)], np.float64)
+    t, e = triangulated(g[np.random.default_rng(side).permutation(len(g))], engine)
+    s = t.sites
+    want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e)
+    assert len(want["vertices"]) == (side - 1) ** 2
+    for threads in (2, 7, 16, 31, 64, 100):
+        for walk_chunk in (1, 3):
+            out = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, walk_chunk=walk_chunk)
+            for key in want:
+                assert np.array_equal(out[key], want[key]), (threads, walk_chunk, key)
