@@ -140,6 +140,27 @@ def test_sweep_order_sorts_y_a_few_units_apart_among_far_values(ulps, far, xs):
     assert np.array_equal(got, want)
 
 
+@settings(max_examples=100, deadline=None)
+@given(
+    cols=st.integers(1, 70),
+    rows=st.integers(1, 70),
+    spacing=st.sampled_from([1.0, 0.1, 2.0**-30, 3e5]),
+    turn=st.sampled_from([0.0, 0.3, np.pi / 2]),
+    seed=st.integers(0, 2**32 - 1),
+    repeats=st.integers(0, 50),
+)
+def test_sweep_order_sorts_long_runs_of_equal_y_in_any_order(cols, rows, spacing, turn, seed, repeats):
+    # grids (turned or not, in shuffled order, some sites listed twice): runs of equal or nearly equal
+    # y far longer than the runs sorted by insertion, merged; against a stable sort by y, x and row
+    rng = np.random.default_rng(seed)
+    gx, gy = np.meshgrid(np.arange(cols) * spacing, np.arange(rows) * spacing)
+    pts = np.c_[gx.ravel(), gy.ravel()] @ np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
+    pts = np.round(pts, 9) if spacing >= 0.1 else pts
+    pts = np.concatenate([pts, pts[rng.integers(0, len(pts), repeats)]])[rng.permutation(len(pts) + repeats)]
+    want = np.lexsort((np.arange(len(pts)), pts[:, 0], pts[:, 1]))
+    assert np.array_equal(sweep_order(pts[:, 0], pts[:, 1]), want)
+
+
 # ---------------------------------------------------------------------------------------------------------
 # locating sites from hints (beach_line.locate_hinted): the same arcs as the tree's search
 

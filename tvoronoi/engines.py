@@ -13,6 +13,7 @@ import numpy as np
 
 from tvoronoi.errors import TvoronoiError
 from tvoronoi.kernels import dual, fortune, incremental, order, renumber
+from tvoronoi.kernels import sweep_order as event_order
 
 # Box sides in the sites' scaled unit. From above, the exact products split a box coordinate into
 # halves by multiplying it with 2^27 + 1 (Dekker), which must not overflow: about 2^997, a little
@@ -106,34 +107,20 @@ def sweep_order(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     """Event order of Fortune's sweep: by y, then x, then input row (int32).
 
     One sort of 64-bit integers, each a site's y as an unsigned integer of the same order (-0.0 read
-    as +0.0), less the smallest, shifted right just enough that the row fits below it, and the row.
-    Sites whose shifted keys are equal (equal y, or y a few units apart when the span of y needs the
-    shift) are then sorted again, by y, x and row, run by run."""
+    as +0.0), less the smallest, shifted right just enough that the row fits below it, and the row
+    (sweep_order.sweep_keys); the rows read off after it, and each run of equal keys (equal y, or y a
+    few units apart when the span of y needs the shift) sorted again by y, x and row
+    (sweep_order.sweep_rows)."""
     n = len(ys)
     if n < 2:
         return np.arange(n, dtype=np.int32)
-    row_bits = (n - 1).bit_length()
-    key = np.add(ys, 0.0).view(np.uint64)  # (a copy)
-    # negative y: every bit flipped; the others: the sign bit set
-    key ^= (np.uint64(0) - (key >> np.uint64(63))) | np.uint64(1 << 63)
-    low = key.min()
-    shift = max(0, int(key.max() - low).bit_length() - (64 - row_bits))
-    key -= low
-    key >>= np.uint64(shift)
-    key <<= np.uint64(row_bits)
-    key |= np.arange(n, dtype=np.uint64)
+    xs = np.ascontiguousarray(xs, dtype=np.float64)
+    ys = np.ascontiguousarray(ys, dtype=np.float64)
+    key = np.empty(n, np.uint64)
+    row_bits = event_order.sweep_keys(ys, key)
     key.sort()
-    perm = (key & np.uint64((1 << row_bits) - 1)).astype(np.int32)
-    key >>= np.uint64(row_bits)
-    tie = key[1:] == key[:-1]
-    if tie.any():
-        tied = np.zeros(n, bool)
-        tied[1:] = tie
-        tied[:-1] |= tie
-        at = np.flatnonzero(tied)
-        run = np.cumsum(np.r_[True, ~tie])[at]  # the run of equal keys each tied position is in
-        rows = perm[at]
-        perm[at] = rows[np.lexsort((rows, xs[rows], ys[rows], run))]
+    perm = np.empty(n, np.int32)
+    event_order.sweep_rows(key, row_bits, xs, ys, perm)
     return perm
 
 
