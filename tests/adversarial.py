@@ -314,6 +314,22 @@ def survey_rows(rows: int = 40, per_row: int = 40, *, seed: int = SEED) -> Case:
     return Case(_pts(np.column_stack([x, y])), note="survey rows, centimetres")
 
 
+def raster_scan(rows: int = 50, per_row: int = 90, *, decimals: int = 3, seed: int = SEED) -> Case:
+    """A raster scanner's samples near (500 m, 1000 m): rows of equal y at a fixed pitch (a tenth of
+    them one unit in the last place off, line jitter below the instrument's resolution), x along each
+    row at a fixed pitch with jitter rounded to the resolution, one reading in twenty repeated, the rows
+    and readings listed in no order: long runs of equal and nearly equal y for the sweep's order, with
+    repeated points inside them."""
+    rng = np.random.default_rng(seed)
+    y = np.repeat(np.round(1000.0 + np.arange(rows) * 0.25, decimals), per_row)
+    off = rng.random(len(y)) < 0.1
+    y[off] = np.nextafter(y[off], np.where(rng.random(int(off.sum())) < 0.5, -np.inf, np.inf))
+    x = np.round(500.0 + np.tile(np.arange(per_row) * 0.1, rows) + rng.normal(0.0, 0.01, rows * per_row), decimals)
+    pts = np.column_stack([x, y])
+    pts = np.concatenate([pts, pts[rng.integers(0, len(pts), len(pts) // 20)]])
+    return Case(_pts(pts[rng.permutation(len(pts))]), note=f"raster scan, {decimals} decimals, ulp line jitter")
+
+
 def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
     """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
     lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
@@ -908,6 +924,8 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "time_series_epoch_1dec": partial(time_series, 1500, series=4, decimals=1),
     "buildings_turned_2dec": building_footprints,
     "buildings_axis_1dec": partial(building_footprints, 100, decimals=1, turned=False),
+    "raster_scan_3dec": raster_scan,
+    "raster_scan_1dec": partial(raster_scan, 80, 120, decimals=1),
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
