@@ -21,7 +21,7 @@ import pytest
 import tvoronoi
 from tvoronoi import engines
 from tvoronoi.api import default_bbox
-from tvoronoi.kernels import clip, fortune, incremental, order
+from tvoronoi.kernels import clip, fortune, incremental, order, sweep_order
 
 N = 1_000_000
 pytestmark = pytest.mark.skipif(not hasattr(signal, "setitimer"), reason="needs signal.setitimer")
@@ -80,6 +80,20 @@ def stopped_in_kernel(arm, run) -> str:
 def test_order_answers_signals(points, alarm):
     xs, ys = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
     assert stopped_in_kernel(alarm, lambda: order.brio_order(xs, ys, 0)).endswith("order.pyx")
+
+
+def test_sweep_order_answers_signals(alarm):
+    # a shuffled 1,500 x 1,500 grid: 1,500 runs of equal y, each sorted again by x (sweep_rows alone)
+    g = np.arange(1500.0)
+    gx, gy = np.meshgrid(g, g)
+    pts = np.c_[gx.ravel(), gy.ravel()][np.random.default_rng(7).permutation(g.size**2)]
+    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
+    key = np.empty(len(xs), np.uint64)
+    row_bits = sweep_order.sweep_keys(ys, key)
+    key.sort()
+    perm = np.empty(len(xs), np.int32)
+    run = lambda: sweep_order.sweep_rows(key, row_bits, xs, ys, perm)  # noqa: E731
+    assert stopped_in_kernel(alarm, run).endswith("sweep_order.pyx")
 
 
 def test_incremental_answers_signals(points, alarm):

@@ -78,7 +78,7 @@ def sweep_rows(const uint64_t[::1] key, int row_bits, const double[::1] xs, cons
                int32_t[::1] perm):
     """The sweep order in ``perm`` from the sorted keys of sweep_keys: each key's row, each run of equal
     shifted keys sorted again by the exact y, x and row of its sites. Returns the sites in such runs."""
-    cdef Py_ssize_t n = key.shape[0], i, j, tied = 0, longest = 0
+    cdef Py_ssize_t n = key.shape[0], i, j, tied = 0, longest = 0, since_poll = 0
     cdef uint64_t mask = (<uint64_t> 1 << row_bits) - 1 if row_bits < 64 else <uint64_t> -1
     cdef Tied* buf = NULL
     if perm.shape[0] != n or xs.shape[0] != n or ys.shape[0] != n:
@@ -106,13 +106,16 @@ def sweep_rows(const uint64_t[::1] key, int row_bits, const double[::1] xs, cons
         with nogil:
             i = 0
             while i < n:
-                if (i & POLL_MASK) == 0:
-                    poll_signals()
                 j = i + 1
                 while j < n and (key[j] >> row_bits) == (key[i] >> row_bits):
                     j += 1
                 if j - i > 1:
                     sort_run(&perm[i], j - i, xs, ys, buf)
+                    # (signals looked at after every POLL_MASK sites sorted or so)
+                    since_poll += j - i
+                    if since_poll > POLL_MASK:
+                        poll_signals()
+                        since_poll = 0
                 i = j
     finally:
         free(buf)
