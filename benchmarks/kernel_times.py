@@ -77,8 +77,10 @@ def totals(calls: list) -> list[tuple[str, float, int]]:
 
 
 def report(start: float, end: float, calls: list, *, timeline: bool, least_ms: float = 0.5) -> str:
+    """The table of every kernel called (ms, calls) and, with timeline, the calls of least_ms or more in
+    time order, a column per thread."""
     lines = [f"build: {(end - start) * 1e3:.1f} ms", "", "| kernel | ms | calls |", "|---|---:|---:|"]
-    lines += [f"| {name} | {ms:.1f} | {n} |" for name, ms, n in totals(calls) if ms >= least_ms]
+    lines += [f"| {name} | {ms:.1f} | {n} |" for name, ms, n in totals(calls)]
     if timeline:
         lines += ["", "timeline (ms from the build's start; one column per thread):"]
         column: dict[int, int] = {}
