@@ -57,10 +57,11 @@ def stopped_in_kernel(arm, run) -> str:
     """Run the call with the timer armed; the handler must run from the kernels' poll (interrupt.pxd).
 
     Returns the file of the kernel frame that polled. The timer may land in the Python set-up around the
-    kernel on a slow machine, so a few delays are tried; a kernel that never polls fails them all.
+    kernel on a slow machine, so a few delays are tried (from 5 ms: on a fast host a kernel on a million
+    sites may finish within 20 ms); a kernel that never polls fails them all.
     """
     seen = []
-    for delay in (0.02, 0.05, 0.1, 0.2, 0.4):
+    for delay in (0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.4):
         arm(delay)
         try:
             run()
