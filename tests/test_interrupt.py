@@ -9,6 +9,8 @@ signals would give. The batch CLI is then checked end to end with a real SIGINT 
 from __future__ import annotations
 
 import os
+import pty
+import select
 import signal
 import subprocess
 import sys
@@ -142,32 +144,72 @@ def test_a_build_after_an_interrupted_one_is_whole(points, alarm):
     assert np.array_equal(got.cell_offsets, want.cell_offsets)
 
 
-@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, None)])
+def _wait_for(fd: int, text: bytes, proc: subprocess.Popen, limit: float) -> bytes:
+    """Read the terminal's output until ``text`` shows (the bytes read so far), the child ends or time is up."""
+    seen = b""
+    deadline = time.monotonic() + limit
+    while text not in seen and proc.poll() is None and time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], 0.05)
+        if ready:
+            try:
+                seen += os.read(fd, 65536)
+            except OSError:  # the child closed the terminal
+                break
+    return seen
+
+
+def _drain(fd: int, proc: subprocess.Popen, limit: float) -> bytes:
+    """Keep reading the terminal (so that the child never blocks on it) until the child ends."""
+    seen = b""
+    deadline = time.monotonic() + limit
+    while proc.poll() is None and time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], 0.05)
+        if ready:
+            try:
+                seen += os.read(fd, 65536)
+            except OSError:
+                break
+    return seen
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_batch_stops_on_signal_and_leaves_no_file(tmp_path, sig, code):
-    """`tvoronoi batch` on 2,000,000 points, signalled while its kernels run: it ends at once, writes nothing."""
+    """`tvoronoi batch` on 2,000,000 points, signalled while its engine runs: it ends at once, writes nothing.
+
+    Its standard error is a terminal, so that the batch shows its phases; the signal goes out once the
+    build phase is on the screen (a fixed delay raced the whole run on a fast host, where the batch could
+    be done before the signal came).
+    """
     src = tmp_path / "points.npy"
     np.save(src, np.random.default_rng(3).random((2_000_000, 2)))
     out = tmp_path / "cells.geojson"
+    master, slave = pty.openpty()
     # a child of a background job inherits SIGINT ignored, and Python then leaves it ignored: give the
     # child the default disposition, as a terminal would
     proc = subprocess.Popen(
         [sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
         stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+        stderr=slave,
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
-    time.sleep(2.5)  # start-up and reading done; the engine is running
-    proc.send_signal(sig)
+    os.close(slave)
     try:
-        _, err = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:  # a kernel that ignores signals would not end: fail, don't hang
-        proc.kill()
-        proc.communicate()
-        pytest.fail("the batch did not stop on the signal")
-    assert proc.returncode != 0, err
-    if code is not None:
-        assert proc.returncode == code, err
+        shown = _wait_for(master, b"build", proc, 60)
+        assert b"build" in shown, f"the build phase never showed: {shown[-2000:]!r}"
+        assert proc.poll() is None, "the batch ended before it was signalled"
+        proc.send_signal(sig)
+        shown += _drain(master, proc, 60)
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:  # a kernel that ignores signals would not end: fail, don't hang
+            proc.kill()
+            proc.wait()
+            pytest.fail("the batch did not stop on the signal")
+        proc.stdout.close()
+    finally:
+        os.close(master)
+    err = shown.decode(errors="replace")
+    assert proc.returncode == code, err
     assert not out.exists()
     assert not [p for p in os.listdir(tmp_path) if p not in ("points.npy",)], os.listdir(tmp_path)
     assert "Traceback" not in err, err
