@@ -3,6 +3,7 @@
 
 from tvoronoi.kernels.predicates cimport orient2d
 from tvoronoi.kernels.mesh cimport Mesh, is_infinite, nxt, prv
+from tvoronoi.kernels.prefetch cimport prefetch
 
 cdef inline int jump_cell(Mesh* m, double px, double py) noexcept nogil:
     # the cell of the jump grid holding p (points outside it: the nearest border cell)
@@ -53,6 +54,7 @@ cdef inline int locate(Mesh* m, int t, double px, double py) noexcept nogil:
     cdef double x0, y0, x1, y1, x2, y2
     while True:
         steps += 1
+        prefetch(&m.opp[3 * t])
         a0 = m.tv[3 * t]; a1 = m.tv[3 * t + 1]; a2 = m.tv[3 * t + 2]
         if a0 == m.inf or a1 == m.inf or a2 == m.inf:
             m.walk_steps = steps
