@@ -264,3 +264,87 @@ def test_hints_outlast_outliers_and_give_way_to_the_tree():
     assert hinted["tree_built"]
     assert walks + descents + hinted["long_walks"] == len(far) - 1
     assert descents > 0.8 * len(far)
+
+
+# the event queue (event_queue.pxd): the events far above the sweep line wait in buckets by strips of y,
+# the heap holding a window of them; the same sweep as with every event in the heap
+
+
+def _sweep_with_and_without_buckets(pts, **kw):
+    order = sweep_order(pts[:, 0], pts[:, 1])
+    xs, ys = np.ascontiguousarray(pts[order, 0]), np.ascontiguousarray(pts[order, 1])
+    return fortune.sweep(xs, ys, **kw), fortune.sweep(xs, ys, buckets=False, **kw)
+
+
+def _assert_same_events(bucketed, heap):
+    assert bucketed["status"] == heap["status"] == fortune.STATUS_OK
+    for key in ("steps", "flips"):
+        assert bucketed[key] == heap[key], key
+    for key in ("tv", "opp", "dup"):
+        assert np.array_equal(bucketed.get(key), heap.get(key)), key
+    assert heap["queue"][0] == 1
+
+
+@pytest.mark.parametrize("family", sorted(adversarial.FAMILIES))
+def test_bucketed_queue_is_the_heaps_on_every_hard_family(family):
+    """Every adversarial family, two seeds: the same triangles, twins and steps, bit for bit, with the
+    far events in buckets as with all of them in the heap. Lattices and cocircular rings give events
+    with equal tops by the hundred, whose order the sweep fixes by their centres and sites (a strict
+    order, whatever holds the events)."""
+    for seed in (adversarial.SEED, 2):
+        bucketed, heap = _sweep_with_and_without_buckets(adversarial.make(family, seed).points)
+        _assert_same_events(bucketed, heap)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(64, 600),
+    span=st.sampled_from([3, 8, 40, 1000]),
+    turn=st.sampled_from([0.0, 0.3, 1.0]),
+    seed=st.integers(0, 2**16),
+)
+def test_bucketed_queue_is_the_heaps_on_small_integer_sets(n, span, turn, seed):
+    """Small integer coordinates, turned and rounded: rows of equal y, many cocircular quadruples, equal
+    tops in every bucket."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, span, (n, 2)).astype(float)
+    c, s = np.cos(turn), np.sin(turn)
+    pts = np.round(pts @ np.array([[c, s], [-s, c]]), 3)
+    _assert_same_events(*_sweep_with_and_without_buckets(pts))
+
+
+@pytest.mark.parametrize("dist", ["uniform", "gaussian", "clustered"])
+def test_buckets_hold_the_events_far_above_the_sweep_line(dist):
+    """The buckets are used: halfway through a sweep of 20,000 sites most pending events wait in
+    buckets, the heap holds a few, and the pending events are those of the sweep without buckets."""
+    from tvoronoi.generators import generate
+
+    pts = generate(dist, 20_000, seed=3)
+    whole, _ = _sweep_with_and_without_buckets(pts)
+    half = whole["steps"] // 2
+    bucketed, heap = _sweep_with_and_without_buckets(pts, stop_after=half)
+    n_buckets, now, waiting, in_heap = bucketed["queue"]
+    assert n_buckets == 20_000 // 2 and 0 < now < n_buckets - 1
+    assert waiting > 4 * in_heap > 0, bucketed["queue"]
+    assert heap["queue"][2] == 0
+    for key in ("beach", "beach_edges", "triangles"):
+        assert np.array_equal(bucketed[key], heap[key]), key
+    a, b = bucketed["events"], heap["events"]
+    assert len(a) == waiting + in_heap == len(b)
+    assert np.array_equal(a[np.lexsort(a.T[::-1])], b[np.lexsort(b.T[::-1])])
+
+
+def test_buckets_give_way_to_the_heap_where_strips_cannot_measure_y():
+    """One bucket (every event in the heap) for fewer than 64 sites, sites on one row, or a span of y
+    whose strips would not be finite; a far outlier leaves nearly every site in the first strip: the
+    heap then holds nearly every event, and the sweep is the same."""
+    rng = np.random.default_rng(4)
+    few = rng.random((63, 2))
+    row = np.c_[rng.random(500), np.zeros(500)]
+    tiny = rng.random((300, 2)) * 1e-310
+    for pts in (few, row, tiny):
+        bucketed, heap = _sweep_with_and_without_buckets(pts)
+        assert bucketed["queue"][0] == 1
+        _assert_same_events(bucketed, heap)
+    outlier = np.r_[rng.random((5000, 2)), [[0.5, 1e12]]]
+    _assert_same_events(*_sweep_with_and_without_buckets(outlier))

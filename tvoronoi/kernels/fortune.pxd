@@ -8,3 +8,6 @@ cdef int sweep_triangles(const double* x, const double* y, int n, int32_t* tv_ou
 from tvoronoi.kernels.sweep_state cimport Sweep
 cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil
 cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil
+
+# the event queue's window grown until it decides what comes next (event_queue.queue_next), out of line
+cdef int queue_grow(Sweep* s, int i) noexcept nogil

@@ -29,7 +29,8 @@ from tvoronoi.kernels.beach_line cimport (
     new_arc, insert_after, remove_arc, locate_hinted, set_hint, LONG_WALK_STEPS_PER_SITE, LONG_WALK_STEPS_BASE,
 )
 from tvoronoi.kernels.event_queue cimport (
-    event_sites, heap_push, heap_fix, heap_remove, cancel_event, take_event, site_first,
+    event_sites, heap_push, heap_remove, site_first, cancel_event, take_event, queue_add, queue_update, queue_next,
+    bucket_high, SITE_NEXT,
 )
 
 # The sweep line y = L moves upwards; sites are numbered in event order
@@ -50,11 +51,11 @@ from tvoronoi.kernels.event_queue cimport (
 # proven error bound; near ties by the rise above the highest site, then in
 # double-double precision, then in exact integers, event_order_exact.pxd). At an
 # exact tie a site comes before a circle event, and circle events with equal
-# tops go by their rounded centre x: events at one height with different
-# centres share no arc and commute, events at one centre are cocircular sites,
-# any order of which gives a triangulation of their group (the dual merges
-# it). A final pass of exact Lawson flips stays as a guard; it finds nothing
-# to flip when the order is exact.
+# tops go by their rounded centre x, then by their sites (a strict order): events
+# at one height with different centres share no arc and commute, events at one
+# centre are cocircular sites, any order of which gives a triangulation of their
+# group (the dual merges it). A final pass of exact Lawson flips stays as a
+# guard; it finds nothing to flip when the order is exact.
 #
 # The kernel never trusts its own state blindly: every array has its bound
 # checked before a write, and an inconsistent state (which exact decisions
@@ -143,8 +144,18 @@ cdef int top_order_exact(Sweep* s, int i, int j) noexcept nogil:
     return c
 
 
+cdef inline bint sites_less(const int32_t* p, const int32_t* q) noexcept nogil:
+    # the triples (a, b, c) of two events, by b, then a, then c
+    if p[1] != q[1]:
+        return p[1] < q[1]
+    if p[0] != q[0]:
+        return p[0] < q[0]
+    return p[2] < q[2]
+
+
 cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil:
-    """ev_less when the two events' intervals overlap: the exact sign, then the centre's rounded x."""
+    """ev_less when the two events' intervals overlap: the exact sign, then the centre's rounded x, then
+    the sites."""
     cdef int c = 0
     if s.ev_class[i] != s.ev_class[j]:
         c = top_order_exact(s, i, j)
@@ -158,7 +169,12 @@ cdef bint ev_less_near(Sweep* s, int i, int j) noexcept nogil:
         else:
             s.ev_class[i] = s.ev_class[j]
     # equal tops: different centres share no arc (the events commute), one centre is a cocircular group
-    return s.ev_x[i] < s.ev_x[j]
+    # (any order of its events triangulates it); the centres' rounded x, then the sites make the order
+    # strict, so that the sweep is the same whatever structure holds the events (event_queue.pxd): two
+    # pending events never have the same three sites (a beach line never holds a..b..a..b)
+    if s.ev_x[i] != s.ev_x[j]:
+        return s.ev_x[i] < s.ev_x[j]
+    return sites_less(&s.ev_sites[3 * i], &s.ev_sites[3 * j])
 
 
 cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
@@ -185,6 +201,46 @@ cdef bint site_first_near(Sweep* s, int i, int ev) noexcept nogil:
         s.status = NO_MEMORY
         return True
     return r == 1
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the event queue's window (event_queue.pxd), grown where queue_next cannot decide
+
+cdef inline void pull_bucket(Sweep* s) noexcept nogil:
+    """The window grows by one strip: its bucket's events go to the heap, in the order they came to the
+    bucket (the list's last first). Events at one height often come in order along the line (a row of a
+    lattice, scheduled left to right): pushed in that order, each stays where it lands after a comparison
+    or two; pushed the other way, each would rise through the heap past events it ties with."""
+    cdef int ev, before
+    s.bucket_now += 1
+    ev = s.bucket_head[s.bucket_now]
+    s.bucket_head[s.bucket_now] = NONE
+    if ev == NONE:
+        return
+    while s.ev_link[2 * ev] != NONE:
+        ev = s.ev_link[2 * ev]
+    while ev != NONE:
+        before = s.ev_link[2 * ev + 1]
+        s.n_bucketed -= 1
+        heap_push(s, ev)
+        ev = before
+
+
+cdef int queue_grow(Sweep* s, int i) noexcept nogil:
+    """queue_next, once neither the next site nor the heap's first event lies in the window: its strips'
+    buckets go to the heap one by one until one of them does, or every event is in the heap."""
+    while True:
+        if s.bucket_now >= s.n_buckets - 1:     # (every event is in the heap)
+            if i < s.n and (s.n_heap == 0 or site_first(s, i, s.heap[0])):
+                return SITE_NEXT
+            return s.heap[0] if s.n_heap > 0 else NONE
+        pull_bucket(s)
+        if i < s.n and bucket_high(s, s.y[i]) <= s.bucket_now:
+            if s.n_heap == 0 or site_first(s, i, s.heap[0]):
+                return SITE_NEXT
+            return s.heap[0]
+        if s.n_heap > 0 and bucket_high(s, s.ev_span[2 * s.heap[0] + 1]) <= s.bucket_now:
+            return s.heap[0]
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -235,9 +291,9 @@ cdef void check_circle(Sweep* s, int arc, int old) noexcept nogil:
     s.n_classes += 1
     s.arc_event[arc] = ev
     if old != NONE:
-        heap_fix(s, s.ev_pos[ev])
+        queue_update(s, ev)
     else:
-        heap_push(s, ev)
+        queue_add(s, ev)
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -366,7 +422,8 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
     i = next_site[0]
     if s.status != OK:
         return 0
-    if i < s.n and (s.n_heap == 0 or site_first(s, i, s.heap[0])):
+    ev = queue_next(s, i)
+    if ev == SITE_NEXT:
         # sites come before circle events at the same position
         next_site[0] = i + 1
         if i > 0 and s.x[i] == s.x[i - 1] and s.y[i] == s.y[i - 1]:
@@ -377,9 +434,9 @@ cdef int step(Sweep* s, int* next_site) noexcept nogil:
             return 1
         site_event(s, i)
         return 1
-    if s.n_heap == 0:
+    if ev == NONE:
         return 0
-    circle_event(s, s.heap[0])
+    circle_event(s, ev)
     return 1
 
 
@@ -510,6 +567,9 @@ cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap
     s.n_hint = 0; s.hint = NULL; s.hint_site = NULL; s.hint_x0 = 0.0; s.hint_scale = 0.0
     s.n_walks = 0; s.n_descents = 0; s.tree_on = True; s.long_budget = 0; s.n_long_walks = 0
     s.n_classes = 0; s.n_heap = 0; s.n_events = 0; s.n_free_ev = 0
+    # one bucket, always in the window (every event in the heap), until the caller sets buckets
+    s.bucket_head = NULL; s.ev_link = NULL; s.n_buckets = 1; s.bucket_now = 0; s.n_bucketed = 0
+    s.bucket_y0 = 0.0; s.bucket_scale = 0.0
     s.n_recs = 0; s.n_tri = 0
     s.row_mode = False; s.row_last = NONE
     s.last_kind = NONE; s.last_site = NONE; s.last_tri = NONE; s.sweep_y = -INFINITY
@@ -517,7 +577,38 @@ cdef void start_state(Sweep* s, const double* x, const double* y, int n, int cap
     s.status = OK; s.n_exact_site = 0; s.n_exact_circle = 0; s.n_fine_tops = 0; s.n_fine_tests = 0; s.n_near = 0
 
 
-def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True, bint guard=True):
+cdef enum:
+    BUCKET_MIN_SITES = 64       # fewer sites: every event in the heap (one bucket)
+    SITES_PER_BUCKET = 2        # the strips' height: about this many sites each, over uniform y
+
+
+cdef object set_buckets(Sweep* s, int32_t[::1] ev_link):
+    """Buckets for the events beyond the heap's window (event_queue.pxd): strips of equal height from the
+    first site's y to the last's, about SITES_PER_BUCKET sites a strip. Returns the array of bucket
+    heads, for the caller to keep; None (one bucket, every event in the heap) for few sites or a span
+    of y the strips cannot measure."""
+    cdef int n = s.n, nb
+    cdef double span, scale
+    if n < BUCKET_MIN_SITES:
+        return None
+    span = s.y[n - 1] - s.y[0]
+    nb = n // SITES_PER_BUCKET
+    scale = nb / span if span > 0.0 else 0.0
+    if not (0.0 < scale < INFINITY):
+        return None
+    heads_arr = np.full(nb, NONE, np.int32)
+    cdef int32_t[::1] heads = heads_arr
+    s.bucket_head = &heads[0]
+    s.ev_link = &ev_link[0]
+    s.n_buckets = nb
+    s.bucket_now = 0
+    s.bucket_y0 = s.y[0]
+    s.bucket_scale = scale
+    return heads_arr
+
+
+def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint hints=True, bint guard=True,
+          bint buckets=True):
     """Fortune's sweep over sites sorted by (y, x).
 
     Parameters
@@ -531,6 +622,10 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         Locate each site by a walk along the beach line from an arc met
         lately near its x (beach_line.locate_hinted); False: always down the
         tree. The same arcs either way (tests compare them).
+    buckets : bool
+        Keep the events far above the sweep line in buckets by strips of y,
+        the heap holding only a window of them (event_queue.pxd); False: every
+        event in the heap. The same order of events either way.
     guard : bool
         Close with the exact repair, a guard that finds nothing to flip (``flips`` counts what it
         flipped). False leaves the guard to the caller: the dual checks every edge as it walks
@@ -546,7 +641,8 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     left to the rises, those left to the double-double filter, events whose fine top
     was computed), ``exact_tests`` (site and circle comparisons left to exact
     integers), ``located`` (sites located by a walk from a hint, by the
-    tree), and with ``stop_after`` the state: ``beach`` (arc sites left to
+    tree), ``queue`` (buckets, the last bucket in the heap's window, events waiting in
+    buckets, events in the heap, when the sweep stopped), and with ``stop_after`` the state: ``beach`` (arc sites left to
     right), ``beach_edges`` (record of each breakpoint), ``events`` (pending
     circle events: arc index in ``beach``, centre x, centre y, top y),
     ``records`` (sites a, b; half-edges e0, e1; start x, y), ``triangles``
@@ -570,6 +666,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         "ev_sites": np.empty(3 * cap_ev, np.int32),
         "ev_class": np.empty(cap_ev, np.int64),
         "ev_pos": np.empty(cap_ev, np.int32), "heap": np.empty(cap_ev, np.int32),
+        "ev_link": np.empty(2 * cap_ev, np.int32),
         "free_events": np.empty(cap_ev, np.int32), "free_arcs": np.empty(cap_arcs, np.int32),
         "rec_a": np.empty(cap_shown, np.int32), "rec_b": np.empty(cap_shown, np.int32),
         "rec_e0": np.empty(cap_rec, np.int32), "rec_e1": np.empty(cap_rec, np.int32),
@@ -607,6 +704,7 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
         raise MemoryError("Fortune's sweep: event buffers")
     s.ev_pos = &ev_pos[0]; s.heap = &heap[0]
     s.free_events = &free_events[0]
+    bucket_heads = set_buckets(&s, arrays["ev_link"]) if buckets else None    # (kept until the sweep's end)
     s.free_arcs = &free_arcs[0]
     s.rec_e0 = &rec_e0[0]; s.rec_e1 = &rec_e1[0]
     s.rec_a = s.rec_b = NULL
@@ -659,10 +757,11 @@ def sweep(const double[::1] xs, const double[::1] ys, long stop_after=-1, bint h
     out = {"status": s.status, "dup": arrays["dup"], "steps": steps, "flips": 0, "sweep_y": s.sweep_y,
            "last": (s.last_kind, s.last_site, s.last_tri),
            "near_ties": (s.n_near, s.n_fine_tests, s.n_fine_tops), "exact_tests": (s.n_exact_site, s.n_exact_circle), "located": (s.n_walks, s.n_descents),
-           "long_walks": s.n_long_walks, "tree_built": s.tree_on}
+           "long_walks": s.n_long_walks, "tree_built": s.tree_on,
+           "queue": (s.n_buckets, s.bucket_now, s.n_bucketed, s.n_heap)}
     if s.status != OK:
         return out
-    cdef bint finished = next_site == n and s.n_heap == 0
+    cdef bint finished = next_site == n and s.n_heap == 0 and s.n_bucketed == 0
     if not finished or stop_after >= 0:
         out.update(_state(&s, arrays))
     if not finished:
@@ -711,6 +810,11 @@ cdef dict _state(Sweep* s, dict arrays):
     for k in range(s.n_heap):
         ev = s.heap[k]
         events.append((index[s.ev_arc[ev]], s.ev_x[ev], s.ev_cy[ev], s.ev_y[ev]))
+    for k in range(s.bucket_now + 1, s.n_buckets):
+        ev = s.bucket_head[k]
+        while ev != NONE:
+            events.append((index[s.ev_arc[ev]], s.ev_x[ev], s.ev_cy[ev], s.ev_y[ev]))
+            ev = s.ev_link[2 * ev]
     events.sort(key=lambda row: (row[3], row[1]))
     r = s.n_recs if s.rec_a != NULL else 0
     return {

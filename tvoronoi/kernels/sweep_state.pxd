@@ -71,8 +71,17 @@ cdef struct Sweep:
     int64_t* ev_class       # events proven to have equal tops share a class (numbers never reused)
     int64_t n_classes
     int32_t* heap
-    int32_t* ev_pos        # where each pending event sits in the heap
+    int32_t* ev_pos        # where each pending event sits: its heap slot (>= 0), or -2 - its bucket
     int n_heap
+    # the events beyond the heap's window (event_queue.pxd): in n_buckets strips of y by the low end of
+    # their interval, each a doubly linked list; buckets 0 .. bucket_now are in the heap
+    int32_t* bucket_head
+    int32_t* ev_link        # next, prev of each event in its bucket (2 per event)
+    int n_buckets
+    int bucket_now
+    int n_bucketed
+    double bucket_y0
+    double bucket_scale
     int n_events
     int32_t* free_events
     int n_free_ev
