@@ -330,6 +330,29 @@ def raster_scan(rows: int = 50, per_row: int = 90, *, decimals: int = 3, seed: i
     return Case(_pts(pts[rng.permutation(len(pts))]), note=f"raster scan, {decimals} decimals, ulp line jitter")
 
 
+def diamond_lattice(side: int = 40, *, seed: int = SEED) -> Case:
+    """An integer lattice turned by 45 degrees exactly, (i + j, i - j): every cell a diamond whose circle's
+    top is the site above it, so that every circle event ties a site exactly (a site comes first), the
+    events of a row at one height; listed in no order."""
+    rng = np.random.default_rng(seed)
+    i, j = np.meshgrid(np.arange(side), np.arange(side))
+    g = np.column_stack([(i + j).ravel(), (i - j).ravel()]).astype(float)
+    return Case(_pts(g[rng.permutation(len(g))]), note="lattice turned 45 deg exactly")
+
+
+def geometric_rows(
+    rows: int = 60, per_row: int = 50, *, ratio: float = 1.25, decimals: int = 3, seed: int = SEED
+) -> Case:
+    """Rows of sites at heights growing geometrically (1, 1.25, 1.56, ... to about 6e5), x uniform over
+    the row's own height, rounded: the strips of equal height over the sites' y hold nearly every site in
+    the first few, and the circles of the high rows reach across thousands of strips."""
+    rng = np.random.default_rng(seed)
+    h = np.round(ratio ** np.arange(rows), decimals)
+    y = np.repeat(h, per_row)
+    x = np.round(rng.random(rows * per_row) * y, decimals)
+    return Case(_pts(np.column_stack([x, y])[rng.permutation(rows * per_row)]), note=f"geometric rows x{ratio}")
+
+
 def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
     """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
     lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
@@ -926,6 +949,9 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "buildings_axis_1dec": partial(building_footprints, 100, decimals=1, turned=False),
     "raster_scan_3dec": raster_scan,
     "raster_scan_1dec": partial(raster_scan, 80, 120, decimals=1),
+    # sites tied with circle tops; heights spread over many magnitudes (the event queue's strips)
+    "diamond_lattice": diamond_lattice,
+    "geometric_rows_3dec": geometric_rows,
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
