@@ -186,10 +186,12 @@ def test_batch_stops_on_signal_and_leaves_no_file(tmp_path, sig, code):
     master, slave = pty.openpty()
     # a child of a background job inherits SIGINT ignored, and Python then leaves it ignored: give the
     # child the default disposition, as a terminal would
+    # (a terminal that draws: under TERM=dumb the progress display is drawn only once it stops)
     proc = subprocess.Popen(
         [sys.executable, "-m", "tvoronoi", "batch", str(src), "-o", str(out)],
         stdout=subprocess.PIPE,
         stderr=slave,
+        env=dict(os.environ, TERM="xterm-256color"),
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     os.close(slave)
