@@ -353,6 +353,20 @@ def geometric_rows(
     return Case(_pts(np.column_stack([x, y])[rng.permutation(rows * per_row)]), note=f"geometric rows x{ratio}")
 
 
+def rows_on_strip_edges(rows: int = 400, *, decimals: int = 2, seed: int = SEED) -> Case:
+    """Two sites a row on rows y = 0, 1, ..., rows - 1, less the last row's second site and the first
+    row's: 2 rows - 2 sites, so that Fortune's event queue cuts y into exactly rows - 1 strips of height 1
+    and every row lies on a strip's edge; x rounded, with some sites straight above others (circles
+    whose tops lie on the rows too)."""
+    rng = np.random.default_rng(seed)
+    x = np.round(rng.random((rows, 2)) * rows, decimals)
+    above = np.flatnonzero(rng.random(rows - 1) < 0.3) + 1
+    x[above, 0] = x[above - 1, 0]  # (a site straight above one of the row below)
+    y = np.repeat(np.arange(rows, dtype=float), 2).reshape(rows, 2)
+    pts = np.column_stack([x.ravel(), y.ravel()])[1:-1]
+    return Case(_pts(pts[rng.permutation(len(pts))]), note="rows on the event queue's strip edges")
+
+
 def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
     """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
     lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
@@ -952,6 +966,7 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     # sites tied with circle tops; heights spread over many magnitudes (the event queue's strips)
     "diamond_lattice": diamond_lattice,
     "geometric_rows_3dec": geometric_rows,
+    "rows_on_strip_edges": rows_on_strip_edges,
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
