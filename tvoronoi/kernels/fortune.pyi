@@ -14,9 +14,11 @@ STATUS_NO_MEMORY: int
 STATUS_NO_REPAIR: int
 STATUS_MESSAGES: dict[int, str]
 
-# The result dict: status, tv, opp, dup, steps, flips, near_ties, exact_tests, located; with stop_after
+# The result dict: status, tv, opp, dup, steps, flips, near_ties, exact_tests, located, queue; with stop_after
 # the sweep's state (beach, beach_edges, events, records, triangles, sweep_y, last): see sweep's docstring.
-def sweep(xs: F64, ys: F64, stop_after: int = -1, hints: bool = True, guard: bool = True) -> dict[str, Any]: ...
+def sweep(
+    xs: F64, ys: F64, stop_after: int = -1, hints: bool = True, guard: bool = True, buckets: bool = True
+) -> dict[str, Any]: ...
 def legalize(xs: F64, ys: F64, tv: I32, opp: I32, bounded: bool = False) -> int: ...
 def circle_event_top(ax: float, ay: float, bx: float, by: float, cx: float, cy: float) -> tuple[Any, ...]: ...
 def circle_event_top_fine(
