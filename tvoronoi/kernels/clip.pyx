@@ -13,7 +13,7 @@ from tvoronoi.kernels.clipper cimport (
     Box, EdgePart, Points, AT_ORIGIN, AT_POINT, make_box, axis_code, code_in, code_side, clip_edge, walk_cell,
     finish_ring, first_right_turn, turn, convex_ring, bent, TURN_BAND_LOW, TURN_BAND_HIGH,
 )
-from tvoronoi.kernels.prefetch cimport prefetch
+from tvoronoi.kernels.prefetch cimport AHEAD_BYTES, prefetch, prefetch_write
 from tvoronoi.kernels.populate cimport populate_part, fill_int32
 
 
@@ -531,7 +531,20 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
                 cell_offsets[r + 1] = 0
         # each row: the row holding its cell, and for a row holding one its first half-edge and its
         # ring's length; then the lengths summed into offsets in row order
+        # (the rows written to, asked for GATHER_AHEAD sites ahead; the arrays read in order, AHEAD_BYTES ahead)
         for k in prange(n, num_threads=T, schedule="static"):
+            if (k & 7) == 0:
+                prefetch(<const char*> &offsets[k] + AHEAD_BYTES)
+                if (k & 15) == 0:
+                    prefetch(<const char*> &perm[k] + AHEAD_BYTES)
+                    prefetch(<const char*> &owner[k] + AHEAD_BYTES)
+                    prefetch(<const char*> &dup[k] + AHEAD_BYTES)
+                    prefetch(<const char*> &face_edge[k] + AHEAD_BYTES)
+            if k + GATHER_AHEAD < n:
+                prefetch_write(&site_of[perm[k + GATHER_AHEAD]])
+                if first[k + GATHER_AHEAD]:
+                    prefetch_write(&row_face_edge[owner[k + GATHER_AHEAD]])
+                    prefetch_write(&cell_offsets[owner[k + GATHER_AHEAD] + 1])
             r = dup[k] if dup[k] >= 0 else k
             site_of[perm[k]] = owner[r]
             if first[k]:
@@ -552,8 +565,15 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
         # the rings, read in engine order, each written at its row's place (that place's offset is
         # loaded GATHER_AHEAD sites ahead, so that the store seldom waits for it)
         for k in prange(n, num_threads=T, schedule="static"):
+            if (k & 7) == 0:
+                prefetch(<const char*> &offsets[k] + AHEAD_BYTES)
+                if (k & 15) == 0:
+                    prefetch(<const char*> &owner[k] + AHEAD_BYTES)
+            if k + 2 * GATHER_AHEAD < n and first[k + 2 * GATHER_AHEAD]:
+                prefetch(&cell_offsets[owner[k + 2 * GATHER_AHEAD]])
             if k + GATHER_AHEAD < n and first[k + GATHER_AHEAD]:
-                prefetch(&cell_offsets[owner[k + GATHER_AHEAD]])
+                prefetch_write(&out_p[cell_offsets[owner[k + GATHER_AHEAD]]])
+                prefetch(&ring_p[offsets[k + GATHER_AHEAD]])
             if first[k]:
                 lo = offsets[k]
                 hi = offsets[k + 1]
@@ -576,6 +596,8 @@ def relabel(const int32_t[::1] label, int32_t[::1] ids, int threads=1):
     cdef int T = threads if count >= (1 << 18) and threads > 1 else 1
     with nogil:
         for k in prange(count, num_threads=T, schedule="static"):
+            if (k & 15) == 0:
+                prefetch_write(<char*> &ids[k] + AHEAD_BYTES)
             if 0 <= ids[k] < n_label:
                 ids[k] = label[ids[k]]
             else:

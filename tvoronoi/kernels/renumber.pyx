@@ -20,12 +20,13 @@ from libc.stdlib cimport calloc, free, malloc
 from libc.math cimport INFINITY, ldexp
 from libc.string cimport memcpy
 from tvoronoi.kernels.populate cimport populate, populate_part
-from tvoronoi.kernels.prefetch cimport prefetch, prefetch_write
+from tvoronoi.kernels.prefetch cimport AHEAD_BYTES, prefetch, prefetch_write
 
 cdef enum:
     MAX_GRID_BITS = 11      # at most 2^11 x 2^11 grid cells (a 16 MiB count array); more sites share cells
     PARALLEL_MIN_TRIANGLES = 1 << 16    # fewer triangles are rewritten on one thread
     REWRITE_AHEAD = 32      # triangle_order_into: the places a triangle is written to, asked for this many ahead
+    TAKE_AHEAD = 64         # take_sites: the sites read, asked for this many ahead
     CROWDED = 32            # a grid cell with more sites is ordered again, on a grid over its own sites
     MAX_DEPTH = 6           # levels of such grids (each up to 2^11 finer): the work stays linear
 
@@ -293,6 +294,9 @@ def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx, i
             if i < 0 or i >= n:
                 bad = True
                 break
+            if (k & 3) == 0 and k + TAKE_AHEAD < m:
+                prefetch(&xs[idx[k + TAKE_AHEAD]])
+                prefetch(&ys[idx[k + TAKE_AHEAD]])
             if exponent == 0:
                 out_x[k] = xs[i]
                 out_y[k] = ys[i]
@@ -333,6 +337,9 @@ def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
         # select, each box's bounds by min and max over every site, the other side's moved to +-inf by
         # adding up[side] or down[side] (-0.0 leaves any coordinate as it is, a signed zero too)
         for k in range(n):
+            if (k & 3) == 0:
+                prefetch(<const char*> &xs[k] + AHEAD_BYTES)
+                prefetch(<const char*> &ys[k] + AHEAD_BYTES)
             x = xs[k]
             y = ys[k]
             below = (x if axis == 0 else y) < split
