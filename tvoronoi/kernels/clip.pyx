@@ -281,6 +281,8 @@ cdef int vertex_codes(int lo, int hi, const double* vertices, const Box* box, si
     cdef int v, n_ties = 0, off = 0
     cdef double x, y
     for v in range(lo, hi):
+        if (v & 3) == 0:
+            prefetch(<const char*> &vertices[2 * v] + AHEAD_BYTES)
         x = vertices[2 * v]
         y = vertices[2 * v + 1]
         off |= ((fabs(x) >= TURN_BAND_HIGH) | (fabs(y) >= TURN_BAND_HIGH)
@@ -308,6 +310,10 @@ cdef int whole_edges(int lo, int hi, int n_he, const int32_t* he_origin, const i
     # listed in increasing order from cross[lo] on; returns their count
     cdef int h, k, n_cross = 0
     for h in range(lo, hi):
+        if (h & 15) == 0:
+            prefetch(<const char*> &he_origin[h] + AHEAD_BYTES)
+            prefetch(<const char*> &he_face[h] + AHEAD_BYTES)
+            prefetch(<const char*> &he_twin[h] + AHEAD_BYTES)
         k = v_in[he_origin[h]] & v_in[he_origin[next_in_cell(h, n_he, he_face, face_edge)]]
         flags[h] = k * (HAS | WHOLE)
         if k == 0 and he_twin[h] > h:
@@ -396,8 +402,13 @@ cdef int64_t clip_cells_of(CellPass* S, int lo, int hi, int32_t* ring, int64_t* 
         offsets[i] = n_ring
         if not S.active[i]:
             continue
-        # an interior cell: its vertices, already in order
+        # an interior cell: its vertices, already in order (the half-edges' arrays and the ring, read
+        # and written in order, requested AHEAD_BYTES ahead)
         h = S.face_edge[i]
+        prefetch(<const char*> &S.he_origin[h] + AHEAD_BYTES)
+        prefetch(<const char*> &S.he_face[h] + AHEAD_BYTES)
+        prefetch(&S.flags[h + AHEAD_BYTES])
+        prefetch_write(<char*> &ring[n_ring] + AHEAD_BYTES)
         cnt = 0
         while h >= 0 and ((S.flags[h] & WHOLE) or (S.flags[h] == HAS and S.seg_start[h] == S.he_origin[h])):
             ring[n_ring + cnt] = S.he_origin[h]
