@@ -30,6 +30,7 @@ from libc.stdint cimport int32_t
 
 from tvoronoi.kernels.predicates cimport incircle, orient2d
 from tvoronoi.kernels.mesh cimport nxt, prv
+from tvoronoi.kernels.prefetch cimport AHEAD_BYTES, prefetch
 
 cdef enum:
     OK = 0
@@ -86,6 +87,8 @@ cdef void disks_clear(const double* xs, const double* ys, const int32_t* tv, Py_
     cdef const double* other = ys if axis == 0 else xs
     cdef int j, a, b, c
     for j in range(count):
+        if (j & 3) == 0:
+            prefetch(<const char*> &tv[3 * (t0 + j)] + AHEAD_BYTES)   # (the triangles, read in order)
         a = tv[3 * (t0 + j)]; b = tv[3 * (t0 + j) + 1]; c = tv[3 * (t0 + j) + 2]
         a = a if a != inf else 0
         b = b if b != inf else 0
