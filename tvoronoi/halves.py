@@ -23,6 +23,11 @@ from tvoronoi.kernels import STOPPING, incremental, order, renumber, seam
 SPLIT_MIN_SITES = 1 << 16
 # a half with fewer than this share of the sites (many sites on the median line): no split on that axis
 LEAST_SHARE = 0.25
+# more than twice as many sites: the cut is at the median of this many of them, spread over the rows by
+# a multiplicative hash (row k * SAMPLE_STEP mod n), not of all (at 10^6 sites in a build: 5 ms -> 0.7;
+# the halves then differ by about n / (2 sqrt(SAMPLE_SITES)) sites, 0.2%)
+SAMPLE_SITES = 1 << 16
+SAMPLE_STEP = 2654435761
 
 
 @dataclass(frozen=True)
@@ -38,10 +43,20 @@ class Cut:
     box_right: tuple[float, float, float, float]
 
 
+def median(c: np.ndarray) -> float:
+    """The median of c, or from 2 SAMPLE_SITES values on the median of SAMPLE_SITES of them (a function of
+    the values and their order alone): a value of c either way."""
+    n = len(c)
+    if n <= 2 * SAMPLE_SITES:
+        return float(np.partition(c, n // 2)[n // 2])
+    sample = c[np.arange(SAMPLE_SITES, dtype=np.int64) * SAMPLE_STEP % n]
+    return float(np.partition(sample, SAMPLE_SITES // 2)[SAMPLE_SITES // 2])
+
+
 def cut(xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False) -> Cut | None:
-    """The cut at the median of the longer side of the sites' box (else of the other side), or None when
-    neither gives two halves of at least LEAST_SHARE of the sites each (xs, ys may be strided; bounds:
-    the sites' box (xmin, ymin, xmax, ymax) when known).
+    """The cut at the median of the longer side of the sites' box (else of the other side; halves.median:
+    of a sample of many sites), or None when neither gives two halves of at least LEAST_SHARE of the
+    sites each (xs, ys may be strided; bounds: the sites' box (xmin, ymin, xmax, ymax) when known).
 
     sweep: for Fortune's sweep, which goes up in y and whose beach line grows with the width of what
     it sweeps (its arcs about sqrt(k w / h) for k sites in a box w by h): the x median first unless the
@@ -57,7 +72,7 @@ def cut(xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False) -> 
     x_first = spans[0] >= (spans[1] / 2 if sweep else spans[1])
     for axis in (0, 1) if x_first else (1, 0):
         c = xs if axis == 0 else ys
-        split = float(np.partition(c, n // 2)[n // 2])
+        split = median(c)
         rows, n_left, box_left, box_right = renumber.split_rows(xs, ys, axis, split)
         if min(n_left, n - n_left) >= LEAST_SHARE * n:
             return Cut(axis, split, rows[:n_left], rows[n_left:], box_left, box_right)
