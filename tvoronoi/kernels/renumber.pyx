@@ -208,13 +208,20 @@ def triangle_order_into(const int32_t[::1] tv, const int32_t[::1] opp, const int
             populate_part(&tv2[0], n_he * sizeof(int32_t), <int> k, T_threads)
             populate_part(&opp2[0], n_he * sizeof(int32_t), <int> k, T_threads)
         # a counting sort by the smallest new site (every triangle has a finite one)
+        # (the triangles and keys, read in order, requested AHEAD_BYTES ahead)
         for t in prange(n_tri, num_threads=T_threads, schedule="static"):
+            if (t & 3) == 0:
+                prefetch(<const char*> &tv[3 * t] + AHEAD_BYTES)
             keys[t] = first_site(&tv[3 * t], renumbered, inf)
         for t in range(n_tri):
+            if (t & 15) == 0:
+                prefetch(<const char*> &keys[t] + AHEAD_BYTES)
             start[keys[t] + 1] += 1
         for k in range(n):
             start[k + 1] += start[k]
         for t in range(n_tri):
+            if (t & 15) == 0:
+                prefetch(<const char*> &keys[t] + AHEAD_BYTES)
             tri_new[t] = start[keys[t]]
             start[keys[t]] += 1
 
