@@ -278,7 +278,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 and not give_tv else NULL
     cdef double* centres = &centre[0, 0] if n_finite > 0 else NULL
     cdef Walk w
-    w.tv = &tv[0]; w.opp = &opp[0]; w.first_e = &first_e[0]; w.inf = inf
+    w.tv = &tv[0]; w.first_e = &first_e[0]; w.inf = inf
     w.link = link; w.vid = &vid[0]
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
     w.xs = &xs[0]; w.ys = &ys[0]; w.centre = centres; w.zero = &zero[0]
@@ -310,8 +310,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             poll_signals()
             hi = lo + POLL_BLOCKS if lo + POLL_BLOCKS < n_blocks else n_blocks
             for bk in prange(lo, hi, num_threads=threads, schedule="dynamic", chunksize=1):
-                number_vertices(&tv[0], bk * TRI_BLOCK, min((bk + 1) * TRI_BLOCK, n_tri), v_block[bk], inf,
-                                &vid[0], tri_rows, &xs[0], &ys[0], exponent, centres)
+                number_vertices(&tv[0], &opp[0], bk * TRI_BLOCK, min((bk + 1) * TRI_BLOCK, n_tri), v_block[bk],
+                                inf, &vid[0], tri_rows, link, &xs[0], &ys[0], exponent, centres)
             lo = hi
         # the walks: one per site, in the sites' order, each making its cell's half-edges,
         # marking its zero-length edges as it goes; on one thread, one after the other
@@ -322,7 +322,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     poll_signals()
                 if a + AHEAD < n and first_e[a + AHEAD] >= 0:
                     prefetch(&tv[first_e[a + AHEAD]])
-                    prefetch(&opp[first_e[a + AHEAD]])
+                    prefetch(&link[first_e[a + AHEAD]])
                 h_first[a] = h
                 h0 = h
                 h = walk_site(&w, a, h, 0, &n_marked, &n_illegal)
@@ -340,7 +340,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                 for a in prange(lo, hi, num_threads=threads, schedule="static", chunksize=walk_chunk):
                     if a + AHEAD < n and first_e[a + AHEAD] >= 0:
                         prefetch(&tv[first_e[a + AHEAD]])
-                        prefetch(&opp[first_e[a + AHEAD]])
+                        prefetch(&link[first_e[a + AHEAD]])
                     marked = 0
                     illegal = 0
                     walk_site(&w, a, h_first[a], a - (a - lo) % walk_chunk, &marked, &illegal)
@@ -393,17 +393,23 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     return out
 
 
-cdef void number_vertices(const int32_t* tv, int t0, int t1, int m, int inf, int32_t* vid, int32_t* tri,
-                          const double* xs, const double* ys, int e, double* centre) noexcept nogil:
+cdef void number_vertices(const int32_t* tv, const int32_t* opp, int t0, int t1, int m, int inf, int32_t* vid,
+                          int32_t* tri, int32_t* link, const double* xs, const double* ys, int e,
+                          double* centre) noexcept nogil:
     # the finite triangles t0..t1 - 1 numbered from m on (vid), their sites copied to tri (unless NULL)
-    # and their circumcentres computed (by blocks: construct.circumcentres_block); an infinite triangle's vid is -1
+    # and their circumcentres computed (by blocks: construct.circumcentres_block); an infinite triangle's
+    # vid is -1. And every triangle's twins turned in link for the walks (walk_site): at each half-edge,
+    # the twin of the one before it (link may be opp itself: a triangle's three are read, then written)
     cdef double gx[3][CENTRE_BLOCK]
     cdef double gy[3][CENTRE_BLOCK]
     cdef int t = t0, a, b, c, k, m0
+    cdef int32_t o0, o1, o2
     while t < t1:
         k = 0
         m0 = m
         while t < t1 and k < CENTRE_BLOCK:
+            o0 = opp[3 * t]; o1 = opp[3 * t + 1]; o2 = opp[3 * t + 2]
+            link[3 * t] = o2; link[3 * t + 1] = o0; link[3 * t + 2] = o1
             a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
             if a == inf or b == inf or c == inf:
                 vid[t] = -1
@@ -522,7 +528,6 @@ cdef void finite_to_front(int32_t* tv, int n_tri, int inf) noexcept nogil:
 cdef struct Walk:
     # what the walks read (the triangulation, where each starts, the vertices) and write (the DCEL)
     const int32_t* tv
-    const int32_t* opp
     const int32_t* first_e
     int inf
     int32_t* link
@@ -546,15 +551,18 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
     One half-edge per Delaunay edge a->b with b finite, from h on: its origin is the vertex of the
     triangle on the right of a->b (-1 if that is infinite), its twin the half-edge of b->a. Sites from
     done_from up to a have been walked: the twin made by an earlier one is looked up and linked; one
-    of a site before done_from (another thread's) is left as -1 - Delaunay half-edge a->b, looked up
-    later, as is one whose site comes later.
+    of a site before done_from (another thread's) is left as -1 - its place in link, looked up later,
+    as is one whose site comes later.
 
-    The walk steps from a->b to the next edge out of a through the twin of the edge into a before it,
-    b->a (opp); once the half-edge of a->b is made, it writes its number in link at the place of b->a,
-    where b's walk looks it up (link[b->a], b's own edge). A place of link is thus written by one walk
-    only, the walk that reads it in opp to step, after it read it: link may be opp itself (a
-    triangulation given up). No walk reads opp at its own edges: the twin of the first edge, and the
-    triangle on its right, are those the walk crosses last, and its half-edge is finished then.
+    link holds at each Delaunay half-edge s, until a walk writes over it, the twin of prv(s), the edge
+    into s's origin before it (number_vertices turns opp so): at an edge e out of a, link[e] is the
+    next edge out of a, one load a step (opp[prv(e)] would cost the step prv's arithmetic on its chain
+    of loads too). Once the walk has stepped from e to e' = a->b and made e''s half-edge, it writes
+    that number at the place e it stepped from: the place of b->a = prv(e) in link, where b's walk
+    looks it up (at nxt(b->a), from its own edge b->a). A place of link is thus written by one walk
+    only, the walk that reads it to step, after it read it: link may be opp itself (a triangulation
+    given up). No walk writes the place of its first edge before it leaves it: the edge it steps to
+    the first from is the last it reaches, and the first edge's half-edge is finished then.
 
     The zero-length edges are marked in zero as the walk goes (n_marked counts them), each from the
     half-edge of the site that comes first (b > a). Equal exact centres round to equal doubles, so
@@ -569,7 +577,6 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
     """
     # (locals, so that the stores below do not make the compiler read the struct again)
     cdef const int32_t* tv = w.tv
-    cdef const int32_t* opp = w.opp
     cdef int32_t* link = w.link
     cdef const int32_t* vid = w.vid
     cdef const double* centre = w.centre
@@ -605,10 +612,10 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
             # the twin, when its site's walk made it (done_from <= b < a): linked both ways, with no
             # branch (an unlinked twin's store lands on h itself, then is overwritten)
             linked = (<unsigned> (b - done_from)) < <unsigned> (a - done_from)
-            g = link[e]         # (read whether or not b's walk wrote it: selected below)
+            g = link[nxt(e)]    # (read whether or not b's walk wrote it: selected below)
             g = g if linked else h
             he_twin[g] = h
-            he_twin[h] = g if linked else -1 - e
+            he_twin[h] = g if linked else -1 - nxt(e)
             he_face[h] = a
             if e != e0:
                 link[o] = h     # (o was read to come here, by this walk alone)
@@ -618,8 +625,8 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
             h += 1
         t = e // 3
         vr = vl; rx = lx; ry = ly
-        o = prv(e)
-        e = opp[o]     # the twin of the edge into a: the next edge out
+        o = e
+        e = link[e]    # the next edge out (the twin of the edge into a before e), not yet written over
         if e == e0:
             break
     # the first edge's half-edge: its twin o and the triangle t on its right are the last crossed
@@ -656,16 +663,20 @@ cdef inline void edge_tests(Walk* w, int a, int b, int t, int e, int h, double r
 
 cdef void restore_opp(const int32_t* tv, int32_t* opp, int n_he_d, int inf, const int32_t* he_twin,
                       int32_t* edge_of) noexcept nogil:
-    # opp as it was before the walks wrote link in it (every twin linked): each Delaunay half-edge d
-    # between finite sites holds the Voronoi half-edge of its twin, whose twin is d's own (those to or
-    # from infinity were not written); edge_of: scratch, a place per Voronoi half-edge
-    cdef int d
+    # opp as it was before the dual (every twin linked): the walks left at each half-edge s the twin of
+    # the one before it, d = prv(s) (number_vertices), written over where d is between finite sites by
+    # the Voronoi half-edge of d's twin, whose twin is d's own; edge_of: scratch, a place per Voronoi
+    # half-edge
+    cdef int d, t, k
+    cdef int32_t v[3]
     for d in range(n_he_d):
         if tv[d] != inf and tv[nxt(d)] != inf:
-            edge_of[he_twin[opp[d]]] = d
-    for d in range(n_he_d):
-        if tv[d] != inf and tv[nxt(d)] != inf:
-            opp[d] = edge_of[opp[d]]
+            edge_of[he_twin[opp[nxt(d)]]] = d
+    for t in range(n_he_d // 3):
+        v[0] = opp[3 * t]; v[1] = opp[3 * t + 1]; v[2] = opp[3 * t + 2]
+        for k in range(3):
+            d = 3 * t + k
+            opp[d] = edge_of[v[(k + 1) % 3]] if tv[d] != inf and tv[nxt(d)] != inf else v[(k + 1) % 3]
 
 
 cdef bint writable(const int32_t[::1] a):
