@@ -11,7 +11,7 @@ from tvoronoi.kernels.construct cimport circumcentre, circumcentres_block, CENTR
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
 from tvoronoi.kernels.predicates cimport incircle
 from tvoronoi.kernels.mesh cimport nxt, prv
-from tvoronoi.kernels.prefetch cimport prefetch
+from tvoronoi.kernels.prefetch cimport AHEAD_BYTES, prefetch
 from tvoronoi.kernels.populate cimport populate_part, fill_int32
 
 cdef enum:
@@ -216,6 +216,8 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         n_hull = 0
         if T == 1:
             for t in range(n_tri - 1, -1, -1):
+                if (t & 3) == 0:
+                    prefetch(<const char*> &tv[3 * t] - AHEAD_BYTES)     # (the triangles, read last to first)
                 a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
                 if a == inf or b == inf or c == inf:
                     vid[n_hull] = t         # (vid is free until the vertices are numbered: the hull's triangles)
@@ -461,6 +463,8 @@ cdef void first_pass_part(FirstPass* P, const int32_t* tv, int inf, int32_t* fir
     P.n_side = 0
     P.overflow = False
     for t in range(P.t_hi - 1, P.t_lo - 1, -1):
+        if (t & 3) == 0:
+            prefetch(<const char*> &tv[3 * t] - AHEAD_BYTES)     # (the triangles, read last to first)
         a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
         if a == inf or b == inf or c == inf:
             vid[P.t_lo + P.n_hull] = t
