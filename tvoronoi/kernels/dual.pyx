@@ -280,6 +280,10 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t* tri_rows = &tri[0, 0] if n_finite > 0 and not give_tv else NULL
     cdef double* centres = &centre[0, 0] if n_finite > 0 else NULL
     cdef Walk w
+    # (the sites whose cells have a twin to look up after the walks: walks on more than one thread)
+    cdef signed char[::1] loose_arr = np.zeros(n if threads > 1 else 1, np.int8)
+    cdef signed char* loose = &loose_arr[0]
+    w.loose = loose if threads > 1 else NULL
     w.tv = &tv[0]; w.first_e = &first_e[0]; w.inf = inf
     w.link = link; w.vid = &vid[0]
     w.he_origin = &he_origin[0]; w.he_twin = &he_twin[0]; w.he_face = &he_face[0]
@@ -327,14 +331,15 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                     prefetch(&link[first_e[a + AHEAD]])
                 h_first[a] = h
                 h0 = h
-                h = walk_site(&w, a, h, 0, &n_marked, &n_illegal)
+                h = walk_site(&w, a, h, 0, n, &n_marked, &n_illegal)
                 if h > h0:
                     face_edge[a] = h0
             h_first[n] = h
         else:
             # in runs of WALK_CHUNK sites on the threads, each walk from the offsets counted above; a
-            # twin that another run may not have made yet is left as its own Delaunay half-edge, looked up
-            # in link once every walk is done (the arrays are the same for any count)
+            # twin that another run may not have made yet is left as its place in link, looked up once
+            # every walk is done, in the cells of the sites marked loose (the arrays are the same for
+            # any count)
             lo = 0
             while lo < n:
                 poll_signals()
@@ -345,20 +350,18 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                         prefetch(&link[first_e[a + AHEAD]])
                     marked = 0
                     illegal = 0
-                    walk_site(&w, a, h_first[a], a - (a - lo) % walk_chunk, &marked, &illegal)
+                    g = a - (a - lo) % walk_chunk
+                    walk_site(&w, a, h_first[a], g, min(g + walk_chunk, hi), &marked, &illegal)
                     if h_first[a + 1] > h_first[a]:
                         face_edge[a] = h_first[a]
                     n_marked += marked
                     n_illegal += illegal
                 lo = hi
-            lo = 0
-            while lo < h:
-                poll_signals()
-                hi = lo + BLOCK if lo + BLOCK < h else h
-                for g in prange(lo, hi, num_threads=threads, schedule="static"):
-                    if he_twin[g] < 0:
-                        he_twin[g] = link[-1 - he_twin[g]]
-                lo = hi
+            for a in prange(n, num_threads=threads, schedule="static"):
+                if loose[a]:
+                    for g in range(h_first[a], h_first[a + 1]):
+                        if he_twin[g] < 0:
+                            he_twin[g] = link[-1 - he_twin[g]]
 
         # (the walks marked one half-edge of each zero-length edge; drop_zero_edges marks the other)
         if n_illegal == 0:
@@ -533,6 +536,7 @@ cdef struct Walk:
     # what the walks read (the triangulation, where each starts, the vertices) and write (the DCEL)
     const int32_t* tv
     const int32_t* first_e
+    signed char* loose              # 1 at a site whose cell has a twin left to look up (NULL: none can)
     int inf
     int32_t* link
     const int32_t* vid
@@ -549,14 +553,16 @@ cdef struct Walk:
     double down
 
 
-cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, int* n_illegal) noexcept nogil:
+cdef inline int walk_site(Walk* w, int a, int h, int done_from, int done_to, int* n_marked,
+                          int* n_illegal) noexcept nogil:
     """The cell of site a, counter-clockwise from first_e[a]; returns the next free half-edge.
 
     One half-edge per Delaunay edge a->b with b finite, from h on: its origin is the vertex of the
     triangle on the right of a->b (-1 if that is infinite), its twin the half-edge of b->a. Sites from
     done_from up to a have been walked: the twin made by an earlier one is looked up and linked; one
     of a site before done_from (another thread's) is left as -1 - its place in link, looked up later,
-    as is one whose site comes later.
+    as is one whose site comes later; one whose site lies outside done_from..done_to - 1 (another
+    run's, which will not link it either) marks a loose (w.loose, if not NULL).
 
     link holds at each Delaunay half-edge s, until a walk writes over it, the twin of prv(s), the edge
     into s's origin before it (number_vertices turns opp so): at an edge e out of a, link[e] is the
@@ -590,6 +596,8 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
     cdef int e0 = w.first_e[a], e, b, t = -1, o = -1, g, vr = -1, vl, inf = w.inf, h0 = h
     cdef double rx = 0.0, ry = 0.0, lx = 0.0, ly = 0.0, ax = 0.0, ay = 0.0
     cdef bint linked, check = w.check, rounded_ok = False
+    cdef bint outside = False
+    cdef unsigned run = <unsigned> (done_to - done_from)
     if e0 < 0:
         return h                # a repeated site, or none of the triangles (no cell)
     if check:
@@ -616,6 +624,7 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
             # the twin, when its site's walk made it (done_from <= b < a): linked both ways, with no
             # branch (an unlinked twin's store lands on h itself, then is overwritten)
             linked = (<unsigned> (b - done_from)) < <unsigned> (a - done_from)
+            outside |= (<unsigned> (b - done_from)) >= run
             g = link[nxt(e)]    # (read whether or not b's walk wrote it: selected below)
             g = g if linked else h
             he_twin[g] = h
@@ -642,6 +651,8 @@ cdef inline int walk_site(Walk* w, int a, int h, int done_from, int* n_marked, i
         if vr >= 0 and vl >= 0 and b > a:
             edge_tests(w, a, b, t, e0, h0, rx, ry, centre[2 * vl], centre[2 * vl + 1], ax, ay, rounded_ok,
                        n_marked, n_illegal)
+    if w.loose != NULL:
+        w.loose[a] = outside
     return h
 
 
