@@ -140,6 +140,29 @@ def test_a_triangulation_given_up_gives_the_same_dcel_with_its_triangles_in_plac
             assert not np.array_equal(opp, t.opp)  # (written: no array of its own)
 
 
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize(("on_circle", "inside"), [(0, 20_000), (600, 12_000), (3_000, 12_000), (5_000, 2_000)])
+def test_triangles_given_up_move_to_the_front_alike_on_threads(engine, on_circle, inside):
+    """The finite triangles are moved to the front of tv by runs of blocks on two threads (those that
+    land where the run before still reads wait in a buffer), or on one when that buffer would be large:
+    the same rows as finite_rows either way, with infinite triangles spread through tv (a hull of up to
+    5,000 sites around up to 20,000, every triangle count above a few blocks)."""
+    rng = np.random.default_rng(on_circle + inside)
+    angle = rng.uniform(0, 2 * np.pi, on_circle)
+    pts = np.r_[np.c_[np.cos(angle), np.sin(angle)], 0.7 * (rng.random((inside, 2)) - 0.5)]
+    t, e = triangulated(pts, engine)
+    s = t.sites
+    rows = finite_rows(t)
+    assert len(t.tv) // 3 > 3 * dual.TRI_BLOCK_SIZE and len(rows) < len(t.tv) // 3
+    for threads in (1, 2):
+        tv = t.tv.copy()
+        out = dual.voronoi_from_delaunay(
+            s.xs, s.ys, tv, t.opp.copy(), e, threads, parallel_min=1, give_triangulation=True
+        )
+        assert np.shares_memory(out["triangles"], tv)
+        assert np.array_equal(out["triangles"], rows), threads
+
+
 @pytest.mark.parametrize("read_only", ["tv", "opp", "both"])
 def test_a_read_only_triangulation_is_not_written_when_given_up(read_only):
     t, e = triangulated(generate("uniform", 500, seed=3), "incremental")

@@ -5,7 +5,7 @@ import numpy as np
 from cython.parallel cimport prange
 from libc.stdint cimport int32_t, int64_t, uint64_t
 from libc.math cimport fabs, ldexp
-from libc.string cimport memmove
+from libc.string cimport memcpy, memmove
 
 from tvoronoi.kernels.construct cimport circumcentre, circumcentres_block, CENTRE_BLOCK
 from tvoronoi.kernels.interrupt cimport poll_signals, POLL_MASK
@@ -372,8 +372,7 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
             restore_opp(&tv[0], link, n_he_d, inf, &he_twin[0], &edge_of[0])
         return {"illegal": n_illegal}      # (not a Delaunay triangulation: no diagram)
     if give_tv:
-        with nogil:
-            finite_to_front(<int32_t*> &tv[0] if n_tri > 0 else NULL, n_tri, inf)
+        finite_to_front_on(<int32_t*> &tv[0] if n_tri > 0 else NULL, n_tri, inf, &v_block[0], n_blocks, threads)
         triangles = np.asarray(tv.base).reshape(-1)[: 3 * n_finite].reshape(n_finite, 3)
     else:
         triangles = np.asarray(tri)
@@ -513,6 +512,60 @@ cdef int least_site(const int32_t* tv, int t, int n_tri, int inf) noexcept nogil
             return least
         t += 1
     return inf
+
+
+cdef finite_to_front_on(int32_t* tv, int n_tri, int inf, const int32_t* v_block, int n_blocks, int threads):
+    """finite_to_front on ``threads`` threads, each a run of whole blocks of triangles (TRI_BLOCK; the
+    finite ones before block bk: v_block[bk]). A run's finite triangles move to v_block[its first
+    block] on, at most as far as it starts: those that land before its start, where the run before
+    still reads, wait in a buffer until every run has moved the others, then go in place. One thread
+    when that buffer would be large (most triangles infinite, as on a circle of sites)."""
+    cdef int T = min(threads, MAX_THREADS, n_blocks), k, b0, lo, dst, t, j
+    cdef int waiting[MAX_THREADS]
+    cdef int64_t held[MAX_THREADS + 1]
+    held[0] = 0
+    for k in range(T):
+        b0 = n_blocks * k // T
+        lo = b0 * TRI_BLOCK
+        waiting[k] = min(lo - v_block[b0], v_block[n_blocks * (k + 1) // T] - v_block[b0])
+        held[k + 1] = held[k] + waiting[k]
+    if T < 2 or held[T] > n_tri // 8:
+        with nogil:
+            finite_to_front(tv, n_tri, inf)
+        return
+    buffer_arr = np.empty(max(3 * held[T], 1), np.int32)
+    cdef int32_t[::1] buffer = buffer_arr
+    cdef int32_t* buf = &buffer[0]
+    with nogil:
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            finite_part(tv, n_blocks * k // T * TRI_BLOCK, min(n_blocks * (k + 1) // T * TRI_BLOCK, n_tri), inf,
+                        v_block[n_blocks * k // T], waiting[k], &buf[3 * held[k]])
+        for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+            if waiting[k] > 0:
+                memcpy(&tv[3 * v_block[n_blocks * k // T]], &buf[3 * held[k]], 3 * waiting[k] * sizeof(int32_t))
+
+
+cdef void finite_part(int32_t* tv, int lo, int hi, int inf, int dst, int waiting, int32_t* held) noexcept nogil:
+    # the finite triangles of lo..hi-1 in order: the first ``waiting`` of them copied to held, the others
+    # moved to their places from dst + waiting on (at or after lo, at or before where they are), each
+    # run of them between infinite ones by one move
+    cdef int t = lo, run, m = 0, k
+    while t < hi:
+        if tv[3 * t] == inf or tv[3 * t + 1] == inf or tv[3 * t + 2] == inf:
+            t += 1
+            continue
+        run = t
+        while run < hi and tv[3 * run] != inf and tv[3 * run + 1] != inf and tv[3 * run + 2] != inf:
+            run += 1
+        if m < waiting:
+            k = min(waiting - m, run - t)
+            memcpy(&held[3 * m], &tv[3 * t], 3 * k * sizeof(int32_t))
+            m += k
+            t += k
+        if t < run and dst + m != t:
+            memmove(&tv[3 * (dst + m)], &tv[3 * t], 3 * (run - t) * sizeof(int32_t))
+        m += run - t
+        t = run
 
 
 cdef void finite_to_front(int32_t* tv, int n_tri, int inf) noexcept nogil:
@@ -921,6 +974,9 @@ cdef (int, int) drop_zero_edges(int h, int m, int n, int32_t* he_origin, int32_t
         memmove(&he_twin[parts[k].k_lo], &he_twin[parts[k].g_lo], u * sizeof(int32_t))
         memmove(&he_face[parts[k].k_lo], &he_face[parts[k].g_lo], u * sizeof(int32_t))
     return n_roots, h_kept
+
+
+TRI_BLOCK_SIZE = TRI_BLOCK    # (for tests: the triangles a thread takes at a time)
 
 
 def circumcentres(const double[::1] xs, const double[::1] ys, const int32_t[:, ::1] tri, int e=0,
