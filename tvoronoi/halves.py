@@ -184,8 +184,8 @@ def lay_out(
     t: HalfTriangles, other_box: tuple[float, float, float, float], c: Cut, out: Joined, first: int, *, threads: int
 ) -> tuple[int, int]:
     """The second step of half(): a half's triangles sorted into their part of ``out``, its repeated sites
-    and the triangles it keeps marked; the slots its triangles take (lo, hi). threads: for the sort
-    (the same result for any count)."""
+    and the triangles it keeps marked; the slots its triangles take (lo, hi). threads: for the sort and
+    the judging of the triangles (the same result for any count)."""
     n = len(out.xs)
     n_tri = len(t.tv) // 3
     lo = 0 if first == 0 else len(out.keep) - n_tri
@@ -197,7 +197,9 @@ def lay_out(
     renumber.triangle_order_into(t.tv, t.opp, None, tv, opp, first, lo, n, threads, n_sites=t.k)
     out.dup[first : first + t.k] = np.where(t.dup >= 0, t.dup + first, -1)
     keep = out.keep[lo : lo + n_tri]
-    seam.kept_triangles(out.xs, out.ys, tv, opp, lo, n, c.split, c.axis, first == 0, *other_box, keep, out.seam)
+    seam.kept_triangles(
+        out.xs, out.ys, tv, opp, lo, n, c.split, c.axis, first == 0, *other_box, keep, out.seam, threads
+    )
     return lo, lo + n_tri
 
 

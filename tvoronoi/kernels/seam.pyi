@@ -20,6 +20,7 @@ def kept_triangles(
     oy1: float,
     keep: np.ndarray,
     seam: np.ndarray,
+    threads: int = 1,
 ) -> None: ...
 def join(
     tv: np.ndarray,

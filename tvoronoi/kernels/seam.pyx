@@ -25,6 +25,7 @@ No decision reads the thread count: the same triangulation on one thread or two.
 
 import numpy as np
 
+from cython.parallel cimport prange
 from libc.math cimport fabs
 from libc.stdint cimport int32_t
 
@@ -54,6 +55,8 @@ cdef double TINY = 2.0 ** -900
 
 cdef enum:
     DISK_BLOCK = 64     # kept_triangles: triangles whose disks are tested in one vectorized loop
+    PARALLEL_MIN_TRIANGLES = 1 << 16    # kept_triangles: fewer are judged on one thread
+    MAX_PARTS = 64
 
 
 cdef void disks_clear(const double* xs, const double* ys, const int32_t* tv, Py_ssize_t t0, int count, int inf,
@@ -114,9 +117,41 @@ cdef void disks_clear(const double* xs, const double* ys, const int32_t* tv, Py_
         clear[j] = verdict if big * (nb + nc) > tiny else 0.0
 
 
+cdef Py_ssize_t judge_part(const double* xs, const double* ys, const int32_t* tv, Py_ssize_t lo, Py_ssize_t hi,
+                           int inf, double split, int axis, bint below, const double* qx, const double* qy,
+                           signed char* keep, int32_t* judged) noexcept nogil:
+    # triangles lo..hi-1 (lo a multiple of DISK_BLOCK) judged into keep; those not kept listed in
+    # judged[0..], in order; returns their count
+    cdef Py_ssize_t t, count = 0
+    cdef int a, b, c, u, w
+    cdef double clear[DISK_BLOCK]
+    for t in range(lo, hi):
+        if t % DISK_BLOCK == 0:
+            disks_clear(xs, ys, tv, t, <int> min(DISK_BLOCK, hi - t), inf, split, axis, below, clear)
+        a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+        if a != inf and b != inf and c != inf:
+            keep[t] = clear[t % DISK_BLOCK] != 0.0
+        else:
+            # an infinite triangle (u, w, inf): its region is the open half-plane left of u->w
+            if a == inf:
+                u = b; w = c
+            elif b == inf:
+                u = c; w = a
+            else:
+                u = a; w = b
+            keep[t] = (orient2d(xs[u], ys[u], xs[w], ys[w], qx[0], qy[0]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[1], qy[1]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[2], qy[2]) < 0
+                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[3], qy[3]) < 0)
+        if not keep[t]:
+            judged[count] = <int32_t> t
+            count += 1
+    return count
+
+
 def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1] tv, const int32_t[::1] opp,
                    int first, int inf, double split, int axis, bint below, double ox0, double oy0, double ox1,
-                   double oy1, signed char[::1] keep, signed char[::1] seam):
+                   double oy1, signed char[::1] keep, signed char[::1] seam, int threads=1):
     """Which triangles of one half are triangles of the whole triangulation (1) or left to the seam (0).
 
     Parameters
@@ -129,42 +164,45 @@ def kept_triangles(const double[::1] xs, const double[::1] ys, const int32_t[::1
     keep : (k,) int8, written.
     seam : (n,) int8, set to 1 at the sites of the triangles not kept (the seam sites; the halves' sites
         are apart, so both halves can mark at once).
+    threads : the triangles are judged in a run of whole blocks on each (the same result for any count).
     """
-    cdef Py_ssize_t n_tri = tv.shape[0] // 3, t, nt, head = 0, tail = 0
-    cdef int a, b, c, u, w, k, o, d
+    cdef Py_ssize_t n_tri = tv.shape[0] // 3, t, nt, head = 0, tail = 0, j
+    cdef int a, b, c, u, w, k, o, d, part
     cdef double qx[4]
     cdef double qy[4]
-    cdef double clear[DISK_BLOCK]
     if keep.shape[0] != n_tri or opp.shape[0] != tv.shape[0] or seam.shape[0] < inf:
         raise ValueError("kept_triangles: keep must hold one entry a triangle, opp one a half-edge, seam one a site")
-    cdef int32_t[::1] queue = np.empty(max(n_tri, 1), np.int32)
+    if n_tri == 0:
+        return
+    cdef int32_t[::1] queue = np.empty(n_tri, np.int32)
+    cdef Py_ssize_t n_blocks = (n_tri + DISK_BLOCK - 1) // DISK_BLOCK
+    cdef int T = max(1, min(threads, MAX_PARTS)) if n_tri >= PARALLEL_MIN_TRIANGLES else 1
+    cdef Py_ssize_t starts[MAX_PARTS + 1]
+    cdef Py_ssize_t counts[MAX_PARTS]
     qx[0] = ox0; qy[0] = oy0; qx[1] = ox1; qy[1] = oy0; qx[2] = ox1; qy[2] = oy1; qx[3] = ox0; qy[3] = oy1
+    for part in range(T + 1):
+        starts[part] = min(n_blocks * part // T * DISK_BLOCK, n_tri)
     with nogil:
-        for t in range(n_tri):
-            if t % DISK_BLOCK == 0:
-                disks_clear(&xs[0], &ys[0], &tv[0], t, <int> min(DISK_BLOCK, n_tri - t), inf, split, axis, below,
-                            clear)
-            a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
-            if a != inf and b != inf and c != inf:
-                keep[t] = clear[t % DISK_BLOCK] != 0.0
-                if not keep[t]:
+        # each part's triangles judged, those not kept listed from its start in queue; then, in order,
+        # their sites marked and the finite ones queued for the pass below
+        for part in prange(T, num_threads=T, schedule="static", chunksize=1):
+            counts[part] = judge_part(&xs[0], &ys[0], &tv[0], starts[part], starts[part + 1], inf, split, axis,
+                                      below, qx, qy, &keep[0], &queue[starts[part]])
+        for part in range(T):
+            for j in range(counts[part]):
+                t = queue[starts[part] + j]
+                a = tv[3 * t]; b = tv[3 * t + 1]; c = tv[3 * t + 2]
+                if a != inf and b != inf and c != inf:
                     seam[a] = 1; seam[b] = 1; seam[c] = 1
-                    queue[tail] = <int32_t> t       # (for the pass on cocircular sites below)
+                    queue[tail] = <int32_t> t       # (tail <= starts[part] + j: the list moves down)
                     tail += 1
-                continue
-            # an infinite triangle (u, w, inf): its region is the open half-plane left of u->w
-            if a == inf:
-                u = b; w = c
-            elif b == inf:
-                u = c; w = a
-            else:
-                u = a; w = b
-            keep[t] = (orient2d(xs[u], ys[u], xs[w], ys[w], qx[0], qy[0]) < 0
-                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[1], qy[1]) < 0
-                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[2], qy[2]) < 0
-                       and orient2d(xs[u], ys[u], xs[w], ys[w], qx[3], qy[3]) < 0)
-            if not keep[t]:
-                seam[u] = 1; seam[w] = 1
+                else:
+                    if a != inf:
+                        seam[a] = 1
+                    if b != inf:
+                        seam[b] = 1
+                    if c != inf:
+                        seam[c] = 1
 
         # degenerate case: cocircular sites. The doubles' verdict differs from one triangle of a circle to
         # the next (the bound reads the circle from the triangle's first corner), so a kept triangle whose
