@@ -534,8 +534,11 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
         return site_of_arr, face_edge_arr, cell_offsets_arr, np.empty(0, np.int32)
     with nogil:
         # (written whole: faulted in by runs of pages, a part on each thread)
+        # (site_of first the identity: a row holds its own cell unless its site repeats another or is
+        # repeated by an earlier row, the few rows written in the pass below)
         for k in prange(T, num_threads=T, schedule="static", chunksize=1):
-            populate_part(&site_of[0], n * sizeof(int32_t), <int> k, T)
+            for r in range(k * n // T, (k + 1) * n // T):
+                site_of[r] = <int32_t> r
             fill_int32(&row_face_edge[k * n // T], (k + 1) * n // T - k * n // T, -1)
             populate_part(&cell_offsets[1], n * sizeof(int64_t), <int> k, T)
             for r in range(k * n // T, (k + 1) * n // T):
@@ -551,13 +554,12 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
                     prefetch(<const char*> &owner[k] + AHEAD_BYTES)
                     prefetch(<const char*> &dup[k] + AHEAD_BYTES)
                     prefetch(<const char*> &face_edge[k] + AHEAD_BYTES)
-            if k + GATHER_AHEAD < n:
-                prefetch_write(&site_of[perm[k + GATHER_AHEAD]])
-                if first[k + GATHER_AHEAD]:
-                    prefetch_write(&row_face_edge[owner[k + GATHER_AHEAD]])
-                    prefetch_write(&cell_offsets[owner[k + GATHER_AHEAD] + 1])
+            if k + GATHER_AHEAD < n and first[k + GATHER_AHEAD]:
+                prefetch_write(&row_face_edge[owner[k + GATHER_AHEAD]])
+                prefetch_write(&cell_offsets[owner[k + GATHER_AHEAD] + 1])
             r = dup[k] if dup[k] >= 0 else k
-            site_of[perm[k]] = owner[r]
+            if owner[r] != perm[k]:
+                site_of[perm[k]] = owner[r]
             if first[k]:
                 row = owner[k]
                 row_face_edge[row] = face_edge[k]
