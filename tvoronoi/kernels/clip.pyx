@@ -539,12 +539,14 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
         for k in prange(T, num_threads=T, schedule="static", chunksize=1):
             for r in range(k * n // T, (k + 1) * n // T):
                 site_of[r] = <int32_t> r
-            fill_int32(&row_face_edge[k * n // T], (k + 1) * n // T - k * n // T, -1)
+            populate_part(&row_face_edge[0], n * sizeof(int32_t), <int> k, T)
             populate_part(&cell_offsets[1], n * sizeof(int64_t), <int> k, T)
             for r in range(k * n // T, (k + 1) * n // T):
                 cell_offsets[r + 1] = 0
         # each row: the row holding its cell, and for a row holding one its first half-edge and its
-        # ring's length; then the lengths summed into offsets in row order
+        # ring's length, both in its entry of cell_offsets (one store a site: the half-edge plus one in
+        # the high 32 bits); then, in row order, the half-edges moved out (-1 where none) and the
+        # lengths summed into offsets
         # (the rows written to, asked for GATHER_AHEAD sites ahead; the arrays read in order, AHEAD_BYTES ahead)
         for k in prange(n, num_threads=T, schedule="static"):
             if (k & 7) == 0:
@@ -555,17 +557,16 @@ def rows_of_cells(const int32_t[::1] owner, const int32_t[::1] perm, const int32
                     prefetch(<const char*> &dup[k] + AHEAD_BYTES)
                     prefetch(<const char*> &face_edge[k] + AHEAD_BYTES)
             if k + GATHER_AHEAD < n and first[k + GATHER_AHEAD]:
-                prefetch_write(&row_face_edge[owner[k + GATHER_AHEAD]])
                 prefetch_write(&cell_offsets[owner[k + GATHER_AHEAD] + 1])
             r = dup[k] if dup[k] >= 0 else k
             if owner[r] != perm[k]:
                 site_of[perm[k]] = owner[r]
             if first[k]:
-                row = owner[k]
-                row_face_edge[row] = face_edge[k]
-                cell_offsets[row + 1] = offsets[k + 1] - offsets[k]
+                cell_offsets[owner[k] + 1] = ((<int64_t> face_edge[k] + 1) << 32) | (offsets[k + 1] - offsets[k])
         for r in range(n):
             length = cell_offsets[r + 1]
+            row_face_edge[r] = <int32_t> ((length >> 32) - 1)
+            length = length & <int64_t> 0xFFFFFFFF
             total += length
             cell_offsets[r + 1] = total
     vertices_arr = np.empty(total, np.int32)
