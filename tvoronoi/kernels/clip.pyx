@@ -14,7 +14,7 @@ from tvoronoi.kernels.clipper cimport (
     finish_ring, first_right_turn, turn, convex_ring, bent, TURN_BAND_LOW, TURN_BAND_HIGH,
 )
 from tvoronoi.kernels.prefetch cimport AHEAD_BYTES, prefetch, prefetch_write
-from tvoronoi.kernels.populate cimport populate_part, fill_int32
+from tvoronoi.kernels.populate cimport populate_part
 
 
 cdef enum:
