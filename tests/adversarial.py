@@ -367,6 +367,21 @@ def rows_on_strip_edges(rows: int = 400, *, decimals: int = 2, seed: int = SEED)
     return Case(_pts(pts[rng.permutation(len(pts))]), note="rows on the event queue's strip edges")
 
 
+def ring_around_cloud(on_ring: int = 3000, inside: int = 6000, *, decimals: int = 3, seed: int = SEED) -> Case:
+    """Sites on a circle of radius 1000 around a cloud inside it (radius 700), to the mm: a hull of
+    thousands of sites (some rounded just inside it), so that infinite triangles lie all through a
+    triangulation in either engine's order, and the dual moves the finite ones to the front by runs of
+    blocks on two threads (its buffer of triangles that land before their run's start holding hundreds)."""
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, 2 * np.pi, on_ring)
+    ring = 1000 * np.column_stack([np.cos(angle), np.sin(angle)])
+    r = 700 * np.sqrt(rng.random(inside))
+    t = rng.uniform(0, 2 * np.pi, inside)
+    cloud = np.column_stack([r * np.cos(t), r * np.sin(t)])
+    pts = np.round(np.vstack([ring, cloud]), decimals)
+    return Case(_pts(pts[rng.permutation(len(pts))]), note="a hull of thousands around a cloud")
+
+
 def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
     """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
     lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
@@ -967,6 +982,7 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "diamond_lattice": diamond_lattice,
     "geometric_rows_3dec": geometric_rows,
     "rows_on_strip_edges": rows_on_strip_edges,
+    "ring_around_cloud_mm": ring_around_cloud,
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
