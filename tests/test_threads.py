@@ -214,3 +214,24 @@ def distinct_circles(xs, ys, tv) -> int:
         uy = ((ax * ax + ay * ay) * (cx - bx) + (bx * bx + by * by) * (ax - cx) + (cx * cx + cy * cy) * (bx - ax)) / d
         circles.add((ux, uy))
     return len(circles)
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
+def test_repeated_rows_past_the_sampled_cut_on_threads(engine):
+    """150,000 rows, 45,000 of them repeating earlier places (some several times), past the size from
+    which the halves are cut at a sampled median: the same Diagram on 1 and 2 threads, each row's cell
+    held by the first row at its place (site_of is built as the identity and only those rows written),
+    every cell valid."""
+    from tests.invariants import validate
+    from tvoronoi import halves
+
+    rng = np.random.default_rng(5)
+    base = np.round(rng.random((105_000, 2)) * 1000, 2)
+    pts = np.vstack([base, base[rng.integers(0, len(base), 45_000)]])
+    pts = pts[rng.permutation(len(pts))]
+    assert len(pts) > 2 * halves.SAMPLE_SITES
+    _, first_row, inverse = np.unique(pts, axis=0, return_index=True, return_inverse=True)
+    one, two = (tvoronoi.voronoi(pts, engine=engine, threads=t) for t in (1, 2))
+    assert_same(one, two)
+    assert np.array_equal(one.site_of, first_row[inverse.ravel()])
+    validate(one)
