@@ -252,18 +252,44 @@ def test_take_sites_scales_as_numpy_ldexp_does(n, exponent, mantissa_bits, magni
     assert np.array_equal(y.view(np.int64), want_y.view(np.int64))
 
 
+def expected_split(pts, axis, split, exponent):
+    """split_sites by numpy: each side's rows, its sites scaled by ldexp, and its box by a loop of strict
+    comparisons (the first site's value among equal extremes, bit for bit: a zero keeps its sign)."""
+    below = pts[:, axis] < split
+    sides = []
+    for part in (below, ~below):
+        rows = np.flatnonzero(part)
+        want = [math.inf, math.inf, -math.inf, -math.inf]
+        for x, y in pts[part].tolist():
+            want = [x if x < want[0] else want[0], y if y < want[1] else want[1],
+                    x if x > want[2] else want[2], y if y > want[3] else want[3]]  # fmt: skip
+        sides.append((rows, np.ldexp(pts[rows, 0], -exponent), np.ldexp(pts[rows, 1], -exponent), want))
+    return sides
+
+
+def assert_split_is(got, sides):
+    (rows_l, xl, yl), (rows_r, xr, yr), box_l, box_r = got
+    for (rows, xs, ys), box, (w_rows, w_xs, w_ys, w_box) in zip(
+        ((rows_l, xl, yl), (rows_r, xr, yr)), (box_l, box_r), sides, strict=True
+    ):
+        assert rows.dtype == np.int32 and np.array_equal(rows, w_rows)
+        assert np.array_equal(xs.view(np.int64), w_xs.view(np.int64))
+        assert np.array_equal(ys.view(np.int64), w_ys.view(np.int64))
+        assert np.array_equal(np.array(box).view(np.int64), np.array(w_box).view(np.int64))
+
+
 @settings(max_examples=80, deadline=None)
 @given(
     n=st.integers(1, 300),
     axis=st.sampled_from([0, 1]),
     kind=st.sampled_from(["normal", "grid", "signed zeros"]),
+    exponent=st.sampled_from([0, 3, -7, 1030, -1040]),
     seed=st.integers(0, 2**16),
 )
-def test_split_rows_is_the_two_masks_and_their_boxes(n, axis, kind, seed):
-    """split_rows gives the rows below the split and the others, each in row order, and each part's
-    box, from strided columns; ties with the split go right. A box's bounds are the first site's value
-    among equal extremes, bit for bit (so a zero keeps its sign), as a loop of strict comparisons
-    gives them."""
+def test_split_sites_is_the_two_masks_their_sites_and_boxes(n, axis, kind, exponent, seed):
+    """split_sites gives the rows below the split and the others, each in row order with its sites
+    scaled as np.ldexp scales them, and each part's box (unscaled), from strided columns; ties with the
+    split go right. A box's bounds are the first site's value among equal extremes, bit for bit."""
     rng = np.random.default_rng(seed)
     if kind == "normal":
         pts = rng.normal(size=(n, 2))
@@ -272,17 +298,33 @@ def test_split_rows_is_the_two_masks_and_their_boxes(n, axis, kind, seed):
     else:
         pts = rng.choice(np.array([-0.0, 0.0, -1.0, 1.0, 5e-324, -1e300]), size=(n, 2))
     split = float(pts[rng.integers(0, n), axis]) if rng.random() < 0.8 else float(rng.normal() * 3)
-    rows, n_left, box_l, box_r = renumber.split_rows(pts[:, 0], pts[:, 1], axis, split)
-    below = pts[:, axis] < split
-    assert rows.dtype == np.int32 and n_left == int(below.sum())
-    assert np.array_equal(rows[:n_left], np.flatnonzero(below))
-    assert np.array_equal(rows[n_left:], np.flatnonzero(~below))
-    for part, box in ((below, box_l), (~below, box_r)):
-        want = [math.inf, math.inf, -math.inf, -math.inf]
-        for x, y in pts[part].tolist():
-            want = [x if x < want[0] else want[0], y if y < want[1] else want[1],
-                    x if x > want[2] else want[2], y if y > want[3] else want[3]]  # fmt: skip
-        assert np.array_equal(np.array(box).view(np.int64), np.array(want).view(np.int64))
+    with np.errstate(over="ignore"):
+        sides = expected_split(pts, axis, split, exponent)
+        assert_split_is(renumber.split_sites(pts[:, 0], pts[:, 1], axis, split, exponent), sides)
+    n_left = len(sides[0][0])
+    least = min(n_left, n - n_left)
+    assert renumber.split_sites(pts[:, 0], pts[:, 1], axis, split, exponent, least) is not None
+    assert renumber.split_sites(pts[:, 0], pts[:, 1], axis, split, exponent, least + 1) is None
+
+
+@pytest.mark.parametrize("kind", ["uniform", "sorted", "all left", "runs of ties"])
+def test_split_sites_gives_the_same_arrays_on_any_thread_count(kind):
+    """Above the size split on threads, each thread counts and writes a run of rows: the arrays are those
+    of one pass for any count, the boxes too (a later run's bound only where strictly beyond: a tie
+    keeps the earlier site's signed zero)."""
+    n = 70_001
+    rng = np.random.default_rng(len(kind))
+    pts = rng.random((n, 2))
+    split = 0.5
+    if kind == "sorted":
+        pts = pts[np.argsort(pts[:, 0])]
+    elif kind == "all left":
+        split = 2.0
+    elif kind == "runs of ties":
+        pts = np.repeat(np.array([[-0.0, 0.0], [0.0, -0.0], [0.5, 1.0], [1.0, 0.5]]), n // 4 + 1, axis=0)[:n]
+    sides = expected_split(pts, 0, split, 2)
+    for threads in (1, 2, 3, 7):
+        assert_split_is(renumber.split_sites(pts[:, 0], pts[:, 1], 0, split, 2, 0, threads), sides)
 
 
 @pytest.mark.parametrize("bad", [-1, 5, 2**31 - 1])

@@ -33,7 +33,9 @@ SAMPLE_STEP = 2654435761
 @dataclass(frozen=True)
 class Cut:
     """The line the sites are cut by: coordinate ``axis`` (0: x, 1: y) below ``split`` on the left; the
-    rows of each side (int32, in row order) and each side's bounding box, in the coordinates' own unit."""
+    rows of each side (int32, in row order) and each side's bounding box, in the coordinates' own unit;
+    ``sites``: each side's sites (xs, ys), in row order and in the unit the cut was asked for, until its
+    half takes them (take_sites: each then None, so that they are freed as soon as they are used)."""
 
     axis: int
     split: float
@@ -41,6 +43,14 @@ class Cut:
     right: np.ndarray
     box_left: tuple[float, float, float, float]
     box_right: tuple[float, float, float, float]
+    sites: list
+
+    def take_sites(self, side: int) -> tuple[np.ndarray, np.ndarray]:
+        """Side ``side``'s sites (0: left), handed over once."""
+        xy, self.sites[side] = self.sites[side], None
+        if xy is None:
+            raise RuntimeError("a half's sites are taken once")
+        return xy
 
 
 def median(c: np.ndarray) -> float:
@@ -53,10 +63,14 @@ def median(c: np.ndarray) -> float:
     return float(np.partition(sample, SAMPLE_SITES // 2)[SAMPLE_SITES // 2])
 
 
-def cut(xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False) -> Cut | None:
+def cut(
+    xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False, exponent: int = 0, threads: int = 1
+) -> Cut | None:
     """The cut at the median of the longer side of the sites' box (else of the other side; halves.median:
     of a sample of many sites), or None when neither gives two halves of at least LEAST_SHARE of the
     sites each (xs, ys may be strided; bounds: the sites' box (xmin, ymin, xmax, ymax) when known).
+    Each side's sites come with it, scaled by 2^-exponent (renumber.split_sites, on ``threads``
+    threads: the same cut for any count).
 
     sweep: for Fortune's sweep, which goes up in y and whose beach line grows with the width of what
     it sweeps (its arcs about sqrt(k w / h) for k sites in a box w by h): the x median first unless the
@@ -70,17 +84,20 @@ def cut(xs: np.ndarray, ys: np.ndarray, bounds=None, *, sweep: bool = False) -> 
     # (half spans: a span of the unscaled coordinates may overflow, as from -1e308 to 1e308)
     spans = (bounds[2] / 2 - bounds[0] / 2, bounds[3] / 2 - bounds[1] / 2)
     x_first = spans[0] >= (spans[1] / 2 if sweep else spans[1])
+    least = math.ceil(LEAST_SHARE * n)
     for axis in (0, 1) if x_first else (1, 0):
         c = xs if axis == 0 else ys
         split = median(c)
-        rows, n_left, box_left, box_right = renumber.split_rows(xs, ys, axis, split)
-        if min(n_left, n - n_left) >= LEAST_SHARE * n:
-            return Cut(axis, split, rows[:n_left], rows[n_left:], box_left, box_right)
+        parts = renumber.split_sites(xs, ys, axis, split, exponent, least, threads)
+        if parts is not None:
+            (rows_l, xl, yl), (rows_r, xr, yr), box_left, box_right = parts
+            return Cut(axis, split, rows_l, rows_r, box_left, box_right, [(xl, yl), (xr, yr)])
     return None
 
 
 def scaled(c: Cut, exponent: int) -> Cut:
-    """The cut in the unit 2^exponent (exact: the range rule keeps scaled coordinates normal doubles)."""
+    """The cut's line and boxes in the unit 2^exponent (exact: the range rule keeps scaled coordinates
+    normal doubles); its sites are in that unit already (cut's exponent)."""
     return Cut(
         c.axis,
         math.ldexp(c.split, -exponent),
@@ -88,6 +105,7 @@ def scaled(c: Cut, exponent: int) -> Cut:
         c.right,
         tuple(math.ldexp(v, -exponent) for v in c.box_left),  # type: ignore[arg-type]
         tuple(math.ldexp(v, -exponent) for v in c.box_right),  # type: ignore[arg-type]
+        c.sites,
     )
 
 
@@ -121,24 +139,22 @@ class Joined:
 
 def half(
     engine: str,
-    xs,
-    ys,
+    side: int,
     rows,
     other_box: tuple[float, float, float, float],
     c: Cut,
     out: Joined,
     first: int,
     *,
-    exponent: int,
     seed: int,
     threads: int,
 ):
-    """Order, triangulate and renumber the sites ``rows`` of xs, ys (input order, scaled here by
-    2^-exponent), as sites first.. of ``out``, their triangles at its start (first == 0, the left half)
+    """Order, triangulate and renumber the sites of side ``side`` of the cut c (input rows ``rows``, taken
+    scaled from c), as sites first.. of ``out``, their triangles at its start (first == 0, the left half)
     or at its end; mark the triangles it keeps (c and other_box, the other half's bounding box: scaled).
     Returns the slots its triangles take (lo, hi), or None when its sites are collinear: half_triangles,
     then lay_out."""
-    t = half_triangles(engine, xs, ys, rows, out, first, exponent=exponent, seed=seed)
+    t = half_triangles(engine, c, side, rows, out, first, seed=seed)
     return None if t is None else lay_out(t, other_box, c, out, first, threads=threads)
 
 
@@ -152,10 +168,10 @@ class HalfTriangles:
     k: int
 
 
-def half_triangles(engine: str, xs, ys, rows, out: Joined, first: int, *, exponent: int, seed: int):
-    """The first step of half(): the sites ``rows`` ordered into their part of ``out`` and triangulated;
-    a HalfTriangles, or None when they are collinear."""
-    hx, hy = renumber.take_sites(xs, ys, rows, exponent)
+def half_triangles(engine: str, c: Cut, side: int, rows, out: Joined, first: int, *, seed: int):
+    """The first step of half(): the sites of side ``side`` of c (input rows ``rows``) ordered into their
+    part of ``out`` and triangulated; a HalfTriangles, or None when they are collinear."""
+    hx, hy = c.take_sites(side)
     k = len(rows)
     mine = slice(first, first + k)
     if engine == "fortune":
@@ -203,7 +219,7 @@ def lay_out(
     return lo, lo + n_tri
 
 
-def on_two_halves(engine: str, xs, ys, c: Cut, out: Joined, *, exponent: int, seed: int, threads: int):
+def on_two_halves(engine: str, c: Cut, out: Joined, *, seed: int, threads: int):
     """The slots of both halves (half() of each), made on two threads: the left half on this one, the
     right half's triangles on a second. That thread lays them out too if the left half is not done by
     then; else this one does, on ``threads`` threads (the second's first touches of fresh pages can cost
@@ -214,13 +230,13 @@ def on_two_halves(engine: str, xs, ys, c: Cut, out: Joined, *, exponent: int, se
 
     def left():
         try:
-            return half(engine, xs, ys, c.left, c.box_right, c, out, 0, exponent=exponent, seed=seed, threads=each)
+            return half(engine, 0, c.left, c.box_right, c, out, 0, seed=seed, threads=each)
         finally:
             with lock:
                 left_done[0] = True
 
     def right():
-        t = half_triangles(engine, xs, ys, c.right, out, len(c.left), exponent=exponent, seed=seed)
+        t = half_triangles(engine, c, 1, c.right, out, len(c.left), seed=seed)
         with lock:
             mine = not left_done[0]
         if t is None or not mine:
@@ -249,20 +265,20 @@ def triangulate(
     Returns an engines.Triangulation whose ``sites.perm`` maps its sites to input rows, or None when the
     sites do not split (too many on the median lines, a half's sites collinear): the caller then
     triangulates them whole. Two threads work when ``threads`` is 2 or more, each half then ordered on
-    half of them. Each half's sites are scaled as they are gathered: no scaled copy of all of them.
+    half of them. Each half's sites are scaled as the cut gathers them: no scaled copy of all of them.
     bounds: the sites' box (xmin, ymin, xmax, ymax), unscaled, when known (api.checked_points).
     """
-    c = cut(xs, ys, bounds, sweep=engine == "fortune")
+    c = cut(xs, ys, bounds, sweep=engine == "fortune", exponent=exponent, threads=threads)
     if c is None:
         return None
     c = scaled(c, exponent)
     out = Joined.empty(len(xs))
     if threads >= 2:
-        slots = on_two_halves(engine, xs, ys, c, out, exponent=exponent, seed=seed, threads=threads)
+        slots = on_two_halves(engine, c, out, seed=seed, threads=threads)
     else:
         slots = [
-            half(engine, xs, ys, rows, other, c, out, first, exponent=exponent, seed=seed, threads=1)
-            for rows, other, first in ((c.left, c.box_right, 0), (c.right, c.box_left, len(c.left)))
+            half(engine, side, rows, other, c, out, first, seed=seed, threads=1)
+            for side, rows, other, first in ((0, c.left, c.box_right, 0), (1, c.right, c.box_left, len(c.left)))
         ]
     left, right = slots
     if left is None or right is None:

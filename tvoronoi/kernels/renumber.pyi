@@ -23,9 +23,23 @@ def triangle_order_into(
     n_sites: int = -1,
 ) -> None: ...
 def take_sites(xs: np.ndarray, ys: np.ndarray, idx: np.ndarray, exponent: int = 0) -> tuple[np.ndarray, np.ndarray]: ...
-def split_rows(
-    xs: np.ndarray, ys: np.ndarray, axis: int, split: float
-) -> tuple[np.ndarray, int, tuple[float, float, float, float], tuple[float, float, float, float]]: ...
+def split_sites(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    axis: int,
+    split: float,
+    exponent: int = 0,
+    least: int = 0,
+    threads: int = 1,
+) -> (
+    tuple[
+        tuple[np.ndarray, np.ndarray, np.ndarray],
+        tuple[np.ndarray, np.ndarray, np.ndarray],
+        tuple[float, float, float, float],
+        tuple[float, float, float, float],
+    ]
+    | None
+): ...
 def sites_into(
     xs: np.ndarray,
     ys: np.ndarray,

@@ -315,69 +315,191 @@ def take_sites(const double[:] xs, const double[:] ys, const int32_t[::1] idx, i
     return out_x_arr, out_y_arr
 
 
-def split_rows(const double[:] xs, const double[:] ys, int axis, double split):
-    """The rows whose coordinate ``axis`` (0: x, 1: y) is below ``split``, then the others, in one pass.
+cdef enum:
+    MAX_SPLIT_PARTS = 64    # split_sites: runs of rows, one a thread
+    PARALLEL_MIN_ROWS = 1 << 16     # split_sites: fewer rows are split on one thread
 
-    Returns (rows, n_left, box_left, box_right): rows (n,) int32, the n_left rows below the split first,
-    then the others, each part in row order; each box (xmin, ymin, xmax, ymax) of its part's sites
-    ((inf, inf, -inf, -inf) for an empty part). xs, ys may be strided (the columns of an (n, 2) array).
-    """
-    cdef Py_ssize_t n = xs.shape[0], k, lo = 0, hi
-    if ys.shape[0] != n:
-        raise ValueError("split_rows: xs and ys differ in length")
-    rows_arr = np.empty(n, np.int32)
-    cdef int32_t[::1] rows = rows_arr
-    cdef int32_t tmp
-    cdef double x, y, c
+
+cdef struct SplitPart:
+    # split_sites: a run of rows [lo, hi), how many lie below the split, and each side's box
+    Py_ssize_t lo, hi, n_below, at_left, at_right
+    double box[8]           # left xmin, ymin, xmax, ymax, then right's
+
+
+cdef void split_count(SplitPart* P, const double[:] xs, const double[:] ys, int axis, double split,
+                      int32_t* rows) noexcept nogil:
+    # a run of rows: those below the split counted, and each side's box; with rows (not NULL), the run's
+    # rows written too, those below from P.lo up and the others from P.hi - 1 down (then the right ones
+    # are in reverse). No branch on the side (the sides of rows in input order are as good as random):
+    # the row by a select, each box's bounds by min and max over every site, the other side's moved to
+    # +-inf by adding up[side] or down[side] (-0.0 leaves any coordinate as it is, a signed zero too)
+    cdef Py_ssize_t k, lo = P.lo, hi = P.hi - 1, n_below = 0
+    cdef double x, y, lx, ly, rx, ry
     cdef double lx0 = INFINITY, ly0 = INFINITY, lx1 = -INFINITY, ly1 = -INFINITY
     cdef double rx0 = INFINITY, ry0 = INFINITY, rx1 = -INFINITY, ry1 = -INFINITY
-    cdef double lx, ly, rx, ry
     cdef double up[2]
     cdef double down[2]
     cdef bint below
     up[0] = INFINITY; up[1] = -0.0          # [not below, below]
     down[0] = -INFINITY; down[1] = -0.0
-    hi = n - 1
-    with nogil:
-        # the left rows from the front, the right ones from the back (in reverse, turned round below);
-        # no branch on the side (the sides of rows in input order are as good as random): the row by a
-        # select, each box's bounds by min and max over every site, the other side's moved to +-inf by
-        # adding up[side] or down[side] (-0.0 leaves any coordinate as it is, a signed zero too)
-        for k in range(n):
-            if (k & 3) == 0:
-                prefetch(<const char*> &xs[k] + AHEAD_BYTES)
-                prefetch(<const char*> &ys[k] + AHEAD_BYTES)
-            x = xs[k]
-            y = ys[k]
-            below = (x if axis == 0 else y) < split
+    for k in range(P.lo, P.hi):
+        if (k & 3) == 0:
+            prefetch(<const char*> &xs[k] + AHEAD_BYTES)
+            prefetch(<const char*> &ys[k] + AHEAD_BYTES)
+        x = xs[k]
+        y = ys[k]
+        below = (x if axis == 0 else y) < split
+        if rows != NULL:
             rows[lo if below else hi] = <int32_t> k
             lo += below
             hi -= 1 - below
-            lx = x + up[below]
-            ly = y + up[below]
-            rx = x + up[1 - below]
-            ry = y + up[1 - below]
-            lx0 = lx if lx < lx0 else lx0
-            ly0 = ly if ly < ly0 else ly0
-            rx0 = rx if rx < rx0 else rx0
-            ry0 = ry if ry < ry0 else ry0
-            lx = x + down[below]
-            ly = y + down[below]
-            rx = x + down[1 - below]
-            ry = y + down[1 - below]
-            lx1 = lx if lx > lx1 else lx1
-            ly1 = ly if ly > ly1 else ly1
-            rx1 = rx if rx > rx1 else rx1
-            ry1 = ry if ry > ry1 else ry1
-        hi = n - 1
-        k = lo
-        while k < hi:
-            tmp = rows[k]
-            rows[k] = rows[hi]
-            rows[hi] = tmp
-            k += 1
-            hi -= 1
-    return rows_arr, lo, (lx0, ly0, lx1, ly1), (rx0, ry0, rx1, ry1)
+        n_below += below
+        lx = x + up[below]
+        ly = y + up[below]
+        rx = x + up[1 - below]
+        ry = y + up[1 - below]
+        lx0 = lx if lx < lx0 else lx0
+        ly0 = ly if ly < ly0 else ly0
+        rx0 = rx if rx < rx0 else rx0
+        ry0 = ry if ry < ry0 else ry0
+        lx = x + down[below]
+        ly = y + down[below]
+        rx = x + down[1 - below]
+        ry = y + down[1 - below]
+        lx1 = lx if lx > lx1 else lx1
+        ly1 = ly if ly > ly1 else ly1
+        rx1 = rx if rx > rx1 else rx1
+        ry1 = ry if ry > ry1 else ry1
+    P.n_below = n_below
+    P.box[0] = lx0; P.box[1] = ly0; P.box[2] = lx1; P.box[3] = ly1
+    P.box[4] = rx0; P.box[5] = ry0; P.box[6] = rx1; P.box[7] = ry1
+
+
+cdef void split_place(const SplitPart* P, const double[:] xs, const double[:] ys, int axis, double split,
+                      int32_t* rows, Py_ssize_t n_left) noexcept nogil:
+    # a counted run's rows written at its places: those below from P.at_left, the others from n_left +
+    # P.at_right; the place by arithmetic on the side, not a select (which the compiler may make a branch,
+    # as good as random here)
+    cdef Py_ssize_t k, at_l = P.at_left, at_r = n_left + P.at_right
+    cdef Py_ssize_t below
+    for k in range(P.lo, P.hi):
+        if (k & 3) == 0:
+            prefetch(<const char*> &xs[k] + AHEAD_BYTES)
+            prefetch(<const char*> &ys[k] + AHEAD_BYTES)
+        below = (xs[k] if axis == 0 else ys[k]) < split
+        rows[at_r + ((at_l - at_r) & -below)] = <int32_t> k
+        at_l += below
+        at_r += 1 - below
+
+
+cdef void gather_sites(const double[:] xs, const double[:] ys, const int32_t* rows, Py_ssize_t lo, Py_ssize_t hi,
+                       int exponent, double* out_x, double* out_y) noexcept nogil:
+    # out[k] = (xs, ys)[rows[k]] * 2^-exponent for k in lo..hi - 1 (take_sites' pass, rows in range), its
+    # places faulted in first
+    cdef Py_ssize_t k
+    cdef int32_t i
+    cdef double factor = ldexp(1.0, -exponent)
+    if hi <= lo:
+        return
+    populate(&out_x[lo], (hi - lo) * sizeof(double))
+    populate(&out_y[lo], (hi - lo) * sizeof(double))
+    for k in range(lo, hi):
+        i = rows[k]
+        if (k & 3) == 0 and k + TAKE_AHEAD < hi:
+            prefetch(&xs[rows[k + TAKE_AHEAD]])
+            prefetch(&ys[rows[k + TAKE_AHEAD]])
+        if exponent == 0:
+            out_x[k] = xs[i]
+            out_y[k] = ys[i]
+        else:
+            out_x[k] = scaled(xs[i], exponent, factor)
+            out_y[k] = scaled(ys[i], exponent, factor)
+
+
+def split_sites(const double[:] xs, const double[:] ys, int axis, double split, int exponent=0,
+                Py_ssize_t least=0, int threads=1):
+    """The rows whose coordinate ``axis`` (0: x, 1: y) is below ``split``, then the others, each part with
+    its sites: the rows in row order and their coordinates scaled by 2^-exponent (as take_sites scales
+    them). On one thread the rows in one pass (those below from the front, the others from the back,
+    then turned round); on more, a run of rows on each thread counted, then written at their places;
+    then the sites gathered (on more threads, a part of each side on each): the same arrays for any
+    count.
+
+    Returns (left, right, box_left, box_right), left and right each (rows int32, xs, ys float64), the
+    rows views of one array; each box (xmin, ymin, xmax, ymax) of its part's sites, unscaled ((inf, inf,
+    -inf, -inf) for an empty part), each bound the first site's among equal extremes, bit for bit. None
+    when a part has fewer than ``least`` rows. xs, ys may be strided (the columns of an (n, 2) array).
+    """
+    cdef Py_ssize_t n = xs.shape[0], n_left = 0, k, i, lo, hi
+    cdef int T = max(1, min(threads, MAX_SPLIT_PARTS))
+    cdef SplitPart parts[MAX_SPLIT_PARTS]
+    cdef double box[8]
+    cdef int32_t tmp
+    if ys.shape[0] != n:
+        raise ValueError("split_sites: xs and ys differ in length")
+    if n < PARALLEL_MIN_ROWS:
+        T = 1
+    for k in range(T):
+        parts[k].lo = n * k // T
+        parts[k].hi = n * (k + 1) // T
+    rows_arr = np.empty(n, np.int32)
+    cdef int32_t[::1] rows = rows_arr
+    cdef int32_t* rows_p = &rows[0] if n > 0 else NULL
+    with nogil:
+        if T == 1:
+            split_count(&parts[0], xs, ys, axis, split, rows_p)
+            n_left = parts[0].n_below
+            lo = n_left
+            hi = n - 1
+            while lo < hi:
+                tmp = rows_p[lo]
+                rows_p[lo] = rows_p[hi]
+                rows_p[hi] = tmp
+                lo += 1
+                hi -= 1
+        else:
+            for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+                split_count(&parts[k], xs, ys, axis, split, NULL)
+            for k in range(T):
+                parts[k].at_left = n_left
+                parts[k].at_right = parts[k].lo - n_left
+                n_left += parts[k].n_below
+    # the runs' boxes in row order: a later run's bound only where it is strictly beyond (ties keep the
+    # first site's value, as one pass does)
+    for i in range(8):
+        box[i] = parts[0].box[i]
+    for k in range(1, T):
+        for i in range(8):
+            if (i & 3) < 2:
+                box[i] = parts[k].box[i] if parts[k].box[i] < box[i] else box[i]
+            else:
+                box[i] = parts[k].box[i] if parts[k].box[i] > box[i] else box[i]
+    if min(n_left, n - n_left) < least:
+        return None
+    xl_arr = np.empty(n_left, np.float64)
+    yl_arr = np.empty(n_left, np.float64)
+    xr_arr = np.empty(n - n_left, np.float64)
+    yr_arr = np.empty(n - n_left, np.float64)
+    cdef double[::1] xl = xl_arr, yl = yl_arr, xr = xr_arr, yr = yr_arr
+    # (an empty side: its arrays are never written, any address stands for them)
+    cdef double* p_xl = &xl[0] if n_left > 0 else NULL
+    cdef double* p_yl = &yl[0] if n_left > 0 else NULL
+    cdef double* p_xr = &xr[0] if n > n_left else NULL
+    cdef double* p_yr = &yr[0] if n > n_left else NULL
+    cdef Py_ssize_t n_right = n - n_left
+    with nogil:
+        if T == 1:
+            gather_sites(xs, ys, rows_p, 0, n_left, exponent, p_xl, p_yl)
+            gather_sites(xs, ys, rows_p + n_left, 0, n_right, exponent, p_xr, p_yr)
+        else:
+            for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+                split_place(&parts[k], xs, ys, axis, split, rows_p, n_left)
+            for k in prange(T, num_threads=T, schedule="static", chunksize=1):
+                gather_sites(xs, ys, rows_p, n_left * k // T, n_left * (k + 1) // T, exponent, p_xl, p_yl)
+                gather_sites(xs, ys, rows_p + n_left, n_right * k // T, n_right * (k + 1) // T, exponent,
+                             p_xr, p_yr)
+    return ((rows_arr[:n_left], xl_arr, yl_arr), (rows_arr[n_left:], xr_arr, yr_arr),
+            (box[0], box[1], box[2], box[3]), (box[4], box[5], box[6], box[7]))
 
 
 def sites_into(const double[::1] xs, const double[::1] ys, const int32_t[::1] rows, const int32_t[::1] perm,
