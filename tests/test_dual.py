@@ -141,6 +141,38 @@ def test_a_triangulation_given_up_gives_the_same_dcel_with_its_triangles_in_plac
 
 
 @pytest.mark.parametrize("engine", ["incremental", "fortune"])
+@pytest.mark.parametrize(
+    "name", ["concentric_exact", "circle_lattice_5525", "grid_with_holes_23deg_2dec", "heavy_duplicates"]
+)
+def test_half_edges_written_in_arrays_given_with_room(name, engine):
+    """he_room: arrays long enough (holding old values: every place is written) take the half-edges and
+    the result's are views of them, equal to those of a dual that makes its own; a room too short is
+    not used. Cocircular sites too (the merge moves the half-edges within them)."""
+    got = triangulated(adversarial.make(name).points, engine)
+    if got is None:
+        return
+    t, e = got
+    s = t.sites
+    for threads in (1, 2):
+        want = dual.voronoi_from_delaunay(s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, check=True)
+        room = tuple(np.full(len(t.tv) + 7, -5, np.int32) for _ in range(3))
+        given = dual.voronoi_from_delaunay(
+            s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, check=True, he_room=room
+        )
+        for key in want:
+            assert np.array_equal(given[key], want[key]), key
+        for key, a in zip(("he_origin", "he_twin", "he_face"), room, strict=True):
+            assert len(given[key]) == 0 or np.shares_memory(given[key], a), key
+        short = tuple(np.full(len(t.tv) - 1, -5, np.int32) for _ in range(3))
+        other = dual.voronoi_from_delaunay(
+            s.xs, s.ys, t.tv, t.opp, e, threads, parallel_min=1, check=True, he_room=short
+        )
+        assert (short[0] == -5).all()
+        for key in want:
+            assert np.array_equal(other[key], want[key]), key
+
+
+@pytest.mark.parametrize("engine", ["incremental", "fortune"])
 @pytest.mark.parametrize(("on_circle", "inside"), [(0, 20_000), (600, 12_000), (3_000, 12_000), (5_000, 2_000)])
 def test_triangles_given_up_move_to_the_front_alike_on_threads(engine, on_circle, inside):
     """The finite triangles are moved to the front of tv by runs of blocks on two threads (those that

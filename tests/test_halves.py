@@ -444,3 +444,30 @@ def test_the_right_half_is_laid_out_by_whichever_thread_is_free(monkeypatch, eng
         assert np.array_equal(getattr(one, name), getattr(two, name)), name
     assert np.array_equal(one.sites.perm, two.sites.perm)
     assert np.array_equal(one.sites.xs, two.sites.xs)
+
+
+def test_the_waiting_thread_faults_in_the_half_edges_up_to_the_bound_once():
+    """HalfEdgeFaults: runs of FAULT_RUN bytes of each of the three arrays, up to 3 (2 d - 2) half-edges
+    for the first bound given (a later one changes nothing), then nothing more; contents untouched;
+    without he_room (one thread), nothing at all."""
+    n = 3 * halves.FAULT_RUN // 4  # the bound below spans several runs
+    one = halves.HalfEdgeFaults(halves.Joined.empty(n))
+    one.bound(n)
+    assert not one.run()
+    out = halves.Joined.empty(n, he_room=True)
+    assert out.he_room is not None
+    for k, a in enumerate(out.he_room):
+        a[:] = k - 7
+    faults = halves.HalfEdgeFaults(out)
+    distinct = n - 1000
+    faults.bound(distinct)
+    faults.bound(n)  # (ignored: the first bound holds)
+    want = 4 * 3 * (2 * distinct - 2)
+    assert want < 4 * len(out.he_room[0])
+    runs = 0
+    while faults.run():
+        runs += 1
+    assert runs == -(-want // halves.FAULT_RUN) and faults.done == want
+    assert not faults.run() and faults.done == want
+    for k, a in enumerate(out.he_room):
+        assert (a == k - 7).all()

@@ -180,6 +180,7 @@ class Triangulation:
     None when the distinct sites are collinear (fewer than three, or all on one line); dup[k] is the
     earlier site that site k repeats, or -1. checked is False for Fortune's sweep without its closing
     guard (``triangulate(..., guard=False)``): ``voronoi`` then checks every edge in the dual.
+    he_room: arrays for the dual's half-edges, when the maker has them (dual.voronoi_from_delaunay).
     """
 
     engine: str
@@ -188,6 +189,7 @@ class Triangulation:
     opp: np.ndarray | None
     dup: np.ndarray
     checked: bool = True
+    he_room: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def flat(self) -> bool:
@@ -207,7 +209,7 @@ class Triangulation:
         if self.flat:
             return collinear_dcel(s.xs, s.ys)
         args = (s.xs, s.ys, self.tv, self.opp, s.exponent, threads)
-        given = {"clip_room": clip_room, "give_triangulation": give_triangulation}
+        given = {"clip_room": clip_room, "give_triangulation": give_triangulation, "he_room": self.he_room}
         out = dual.voronoi_from_delaunay(*args, check=not self.checked, **given)
         if "illegal" in out:
             if fortune.legalize(s.xs, s.ys, self.tv, self.opp, bounded=True) < 0:

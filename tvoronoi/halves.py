@@ -17,12 +17,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from tvoronoi import engines
-from tvoronoi.kernels import STOPPING, incremental, order, renumber, seam
+from tvoronoi.kernels import STOPPING, incremental, order, pages, renumber, seam
 
 # fewer sites: one triangulation (two halves and a seam cost more than they save on two threads)
 SPLIT_MIN_SITES = 1 << 16
 # a half with fewer than this share of the sites (many sites on the median line): no split on that axis
 LEAST_SHARE = 0.25
+# the runs in which a waiting thread faults in the dual's half-edge arrays (HalfEdgeFaults): a poll of the
+# other half between them
+FAULT_RUN = 2 << 20
 # more than twice as many sites: the cut is at the median of this many of them, spread over the rows by
 # a multiplicative hash (row k * SAMPLE_STEP mod n), not of all (at 10^6 sites in a build: 5 ms -> 0.7;
 # the halves then differ by about n / (2 sqrt(SAMPLE_SITES)) sites, 0.2%)
@@ -121,9 +124,12 @@ class Joined:
     opp: np.ndarray
     keep: np.ndarray  # (2 n - 2,) int8: seam.kept_triangles
     seam: np.ndarray  # (n,) int8: the seam sites, marked by seam.kept_triangles
+    # on two threads, the dual's half-edge arrays (origin, twin, face: 3 (2 n - 2) int32 each), faulted in
+    # by a thread that waits for the other half (fault_in_half_edges); else None
+    he_room: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @classmethod
-    def empty(cls, n: int) -> Joined:
+    def empty(cls, n: int, *, he_room: bool = False) -> Joined:
         cap = max(2 * n - 2, 1)
         return cls(
             np.empty(n, np.float64),
@@ -134,7 +140,45 @@ class Joined:
             np.empty(3 * cap, np.int32),
             np.zeros(cap, np.int8),
             np.zeros(n, np.int8),
+            (np.empty(3 * cap, np.int32), np.empty(3 * cap, np.int32), np.empty(3 * cap, np.int32))
+            if he_room
+            else None,
         )
+
+
+class HalfEdgeFaults:
+    """The pages of a Joined's he_room faulted in a run at a time (FAULT_RUN bytes of each array), by
+    whichever thread waits for the other half, up to the half-edges the dual can need: 3 (2 d - 2) for
+    d distinct sites (bound: ``distinct``). Calls after the last run, or without he_room, do nothing.
+    The dual faults in what is left (its own populate finds the rest resident): the same arrays either
+    way."""
+
+    def __init__(self, out: Joined):
+        self.out = out
+        self.lock = threading.Lock()
+        self.done = 0  # bytes of each array faulted in
+        self.limit = 0
+
+    def bound(self, distinct: int) -> None:
+        """At most ``distinct`` distinct sites (set once, by the first thread to wait)."""
+        with self.lock:
+            if self.limit == 0:
+                self.limit = 4 * 3 * max(2 * distinct - 2, 1)
+
+    def run(self) -> bool:
+        """Fault in the next run of each array; False when there is nothing more to do."""
+        room = self.out.he_room
+        if room is None:
+            return False
+        with self.lock:
+            lo = self.done
+            hi = min(lo + FAULT_RUN, self.limit)
+            if lo >= hi:
+                return False
+            self.done = hi
+        for a in room:
+            pages.populate_pages(a.view(np.int8)[lo:hi])
+        return True
 
 
 def half(
@@ -223,10 +267,16 @@ def on_two_halves(engine: str, c: Cut, out: Joined, *, seed: int, threads: int):
     """The slots of both halves (half() of each), made on two threads: the left half on this one, the
     right half's triangles on a second. That thread lays them out too if the left half is not done by
     then; else this one does, on ``threads`` threads (the second's first touches of fresh pages can cost
-    it several times what they cost this thread: at 10^6 sites, 60-100 ms against 25 for the same sort)."""
+    it several times what they cost this thread: at 10^6 sites, 60-100 ms against 25 for the same sort).
+    The thread done first faults in the dual's half-edge arrays while it waits (HalfEdgeFaults)."""
     lock = threading.Lock()
     left_done = [False]
     each = max(threads // 2, 1)
+    faults = HalfEdgeFaults(out)
+    n_left, n_right = len(c.left), len(c.right)
+
+    def repeats(lo: int, hi: int) -> int:
+        return int(np.count_nonzero(out.dup[lo:hi] >= 0))
 
     def left():
         try:
@@ -236,16 +286,24 @@ def on_two_halves(engine: str, c: Cut, out: Joined, *, seed: int, threads: int):
                 left_done[0] = True
 
     def right():
-        t = half_triangles(engine, c, 1, c.right, out, len(c.left), seed=seed)
+        t = half_triangles(engine, c, 1, c.right, out, n_left, seed=seed)
         with lock:
             mine = not left_done[0]
         if t is None or not mine:
             return t
-        return lay_out(t, c.box_left, c, out, len(c.left), threads=each)
+        slots = lay_out(t, c.box_left, c, out, n_left, threads=each)
+        faults.bound(n_left + n_right - repeats(n_left, n_left + n_right))
+        while not left_done[0] and faults.run():
+            pass
+        return slots
 
-    slots = on_two_threads([left, right])
+    def wait() -> bool:
+        faults.bound(n_left - repeats(0, n_left) + n_right)
+        return faults.run()
+
+    slots = on_two_threads([left, right], wait)
     if isinstance(slots[1], HalfTriangles):
-        slots[1] = lay_out(slots[1], c.box_left, c, out, len(c.left), threads=threads)
+        slots[1] = lay_out(slots[1], c.box_left, c, out, n_left, threads=threads)
     return slots
 
 
@@ -272,7 +330,7 @@ def triangulate(
     if c is None:
         return None
     c = scaled(c, exponent)
-    out = Joined.empty(len(xs))
+    out = Joined.empty(len(xs), he_room=threads >= 2)
     if threads >= 2:
         slots = on_two_halves(engine, c, out, seed=seed, threads=threads)
     else:
@@ -286,10 +344,12 @@ def triangulate(
     return joined(out, left[1], right[0], exponent, seed, engine)
 
 
-def on_two_threads(calls: list):
+def on_two_threads(calls: list, wait=None):
     """[calls[0](), calls[1]()], the second on a second thread, in this context (a build's arrays are made
     there as here). If the first raises (Ctrl-C), the second thread's kernels are asked to stop at their
-    next poll (tvoronoi.kernels.STOPPING) rather than run to their end before the exception goes on."""
+    next poll (tvoronoi.kernels.STOPPING) rather than run to their end before the exception goes on.
+    wait: called again and again while the first is done and the second is not, until it returns False
+    (a short piece of work each time)."""
     ident: list[int] = []
     stopped = threading.Event()
 
@@ -304,6 +364,8 @@ def on_two_threads(calls: list):
             job = pool.submit(contextvars.copy_context().run, second)
             try:
                 first = calls[0]()
+                while wait is not None and not job.done() and wait():
+                    pass
             except BaseException:
                 stopped.set()
                 job.cancel()
@@ -336,5 +398,11 @@ def joined(
     sites = engines.Sites(exponent, out.perm, out.xs, out.ys)
     # (Fortune's halves and seam were swept without their closing guard: the dual checks every edge)
     return engines.Triangulation(
-        engine, sites, out.tv[: 3 * expected], out.opp[: 3 * expected], out.dup, checked=engine != "fortune"
+        engine,
+        sites,
+        out.tv[: 3 * expected],
+        out.opp[: 3 * expected],
+        out.dup,
+        checked=engine != "fortune",
+        he_room=out.he_room,
     )

@@ -22,6 +22,7 @@ def voronoi_from_delaunay(
     walk_chunk: int = ...,
     check: bool = False,
     give_triangulation: bool = False,
+    he_room: tuple[I32, I32, I32] | None = None,
 ) -> dict[str, Any]: ...
 
 TRI_BLOCK_SIZE: int

@@ -108,7 +108,8 @@ cdef int find(int32_t* parent, int v) noexcept nogil:
 def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
                           const int32_t[::1] tv, const int32_t[::1] opp, int exponent=0, int threads=1,
                           int parallel_min=PARALLEL_MIN_SITES, bint clip_room=False,
-                          int walk_chunk=WALK_CHUNK, bint check=False, bint give_triangulation=False):
+                          int walk_chunk=WALK_CHUNK, bint check=False, bint give_triangulation=False,
+                          he_room=None):
     """Voronoi DCEL of n distinct sites from their Delaunay triangulation.
 
     Triangles whose circumcircles coincide (cocircular sites) share one
@@ -147,6 +148,9 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
         twins (walk_site: at each Delaunay half-edge, the Voronoi half-edge of its twin), instead of an
         array of their own. A result of only {"illegal": count} leaves both as they were (opp is
         restored from the half-edges).
+    he_room : optional (origin, twin, face) int32 arrays, writable and C-contiguous, for the half-edges:
+        used when each holds at least tv's length (the returned ones are views of them), else new
+        arrays are made (tvoronoi.halves faults theirs in on a thread that waits for the other half).
 
     Returns
     -------
@@ -166,9 +170,15 @@ def voronoi_from_delaunay(const double[::1] xs, const double[::1] ys,
     cdef int32_t[::1] vid = np.empty(max(n_tri, 1), np.int32)  # triangle -> its vertex, -1 if infinite
     cdef int32_t[::1] link_own      # Delaunay half-edge -> the Voronoi half-edge of its twin (walk_site)
     cdef int32_t* link              # (that, or opp itself when it is given up)
-    cdef int32_t[::1] he_origin = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] he_twin = np.empty(n_he_d, np.int32)
-    cdef int32_t[::1] he_face = np.empty(n_he_d, np.int32)
+    cdef int32_t[::1] he_origin
+    cdef int32_t[::1] he_twin
+    cdef int32_t[::1] he_face
+    if he_room is not None and all(len(a) >= n_he_d for a in he_room):
+        he_origin, he_twin, he_face = he_room
+    else:
+        he_origin = np.empty(n_he_d, np.int32)
+        he_twin = np.empty(n_he_d, np.int32)
+        he_face = np.empty(n_he_d, np.int32)
     cdef int32_t[::1] face_edge = np.empty(max(n, 1), np.int32)
     cdef int32_t[::1] parent                                  # vertices merged by cocircular sites
     cdef double[:, ::1] centre
