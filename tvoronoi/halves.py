@@ -140,10 +140,15 @@ class Joined:
             np.empty(3 * cap, np.int32),
             np.zeros(cap, np.int8),
             np.zeros(n, np.int8),
-            (np.empty(3 * cap, np.int32), np.empty(3 * cap, np.int32), np.empty(3 * cap, np.int32))
-            if he_room
-            else None,
+            half_edge_room(3 * cap) if he_room else None,
         )
+
+
+def half_edge_room(length: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Three int32 arrays for the dual's half-edges, in pages of 4 KiB (pages.small_pages): a thread
+    waiting for the other half faults them in (HalfEdgeFaults)."""
+    with pages.small_pages():
+        return (np.empty(length, np.int32), np.empty(length, np.int32), np.empty(length, np.int32))
 
 
 class HalfEdgeFaults:

@@ -44,6 +44,8 @@ cdef extern from *:
     #define TV_MAP_MIN ((size_t) 1 << 20)
     #define TV_HUGE_MIN ((size_t) 4 << 20)
     #define TV_HUGE_PAGE ((size_t) 2 << 20)
+    /* 1 in a thread inside small_pages(): its fresh mappings are not advised for huge pages */
+    static __thread int tv_small_pages = 0;
 
     #if TV_MAPS
     /* Mappings freed during a build are kept (up to TV_KEEP_BYTES) and given to the next large
@@ -131,7 +133,7 @@ cdef extern from *:
     static char* tv_map(size_t len) {
         char* p;
     #ifdef MADV_HUGEPAGE
-        if (len >= TV_HUGE_MIN) {
+        if (len >= TV_HUGE_MIN && !tv_small_pages) {
             /* a huge page more than needed, then what lies before the first boundary and after the
                array's pages handed back */
             size_t page = (size_t) sysconf(_SC_PAGESIZE), plen = (len + page - 1) / page * page;
@@ -255,6 +257,7 @@ cdef extern from *:
     int tv_trim() nogil
     void tv_enter() nogil
     void tv_leave() nogil
+    int tv_small_pages
 
 cdef extern from "numpy/arrayobject.h":
     void _import_array() except *
@@ -276,6 +279,22 @@ def mapped():
     finally:
         PyDataMem_SetHandler(old)
         tv_leave()
+
+
+@contextmanager
+def small_pages():
+    """Fresh mappings made in this block, in this thread, are not advised for huge pages: their pages come
+    one by one from the system's lists of small free pages. For arrays faulted in while the other
+    thread works (tvoronoi.halves): on a virtual machine whose host takes back memory left free (here,
+    in blocks of 8 MiB), a huge page is most often taken from such a block, and the host gives it back
+    slowly (a build's arrays faulted in by huge pages after a pause of 2.5 s took 40-100 ms more)."""
+    global tv_small_pages
+    was = tv_small_pages
+    tv_small_pages = 1
+    try:
+        yield
+    finally:
+        tv_small_pages = was
 
 
 def trim_heap():
