@@ -471,3 +471,17 @@ def test_the_waiting_thread_faults_in_the_half_edges_up_to_the_bound_once():
     assert not faults.run() and faults.done == want
     for k, a in enumerate(out.he_room):
         assert (a == k - 7).all()
+
+
+def test_the_second_thread_makes_its_arrays_in_the_pages_of_the_first():
+    """on_two_threads: inside pages.small_pages() (a build on two threads) the second thread's arrays are
+    made in small pages too; outside it, neither's are."""
+    from tvoronoi.kernels import pages
+
+    def flag():
+        return pages.small_pages_on()
+
+    assert halves.on_two_threads([flag, flag]) == [False, False]
+    with pages.small_pages():
+        assert halves.on_two_threads([flag, flag]) == [True, True]
+    assert not pages.small_pages_on()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 from concurrent.futures import ThreadPoolExecutor
 
@@ -29,7 +30,9 @@ def build_diagram(
     bounds: the points' own box when known, api.checked_points)."""
     e = engines.scale_exponent(pts if bounds is None else bounds)
     engines.check_box_scale(box, e)
-    with build_arrays():
+    # (on two threads, in pages of 4 KiB: huge pages faulted in by both threads at once cost more than
+    # they save, pages.small_pages)
+    with build_arrays(), pages.small_pages() if threads >= 2 else contextlib.nullcontext():
         t = triangulation(pts, e, engine=engine, insertion=insertion, seed=seed, threads=threads, bounds=bounds)
         s, out = dcel(t, threads)
         del t  # (its opp, written by the dual, is freed before the clipper's arrays are made)

@@ -8,6 +8,7 @@ SPLIT_MIN_SITES sites on (tvoronoi.build).
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import math
 import threading
@@ -351,18 +352,20 @@ def triangulate(
 
 def on_two_threads(calls: list, wait=None):
     """[calls[0](), calls[1]()], the second on a second thread, in this context (a build's arrays are made
-    there as here). If the first raises (Ctrl-C), the second thread's kernels are asked to stop at their
+    there as here, in pages of the same size: pages.small_pages). If the first raises (Ctrl-C), the second thread's kernels are asked to stop at their
     next poll (tvoronoi.kernels.STOPPING) rather than run to their end before the exception goes on.
     wait: called again and again while the first is done and the second is not, until it returns False
     (a short piece of work each time)."""
     ident: list[int] = []
     stopped = threading.Event()
+    small = pages.small_pages_on()  # (the pages this thread's arrays come in, for the second's too)
 
     def second():
         ident.append(threading.get_ident())
         if stopped.is_set():  # asked to stop before it started
             raise KeyboardInterrupt("the build this thread works for was interrupted")
-        return calls[1]()
+        with pages.small_pages() if small else contextlib.nullcontext():
+            return calls[1]()
 
     try:
         with ThreadPoolExecutor(max_workers=1) as pool:

@@ -284,10 +284,11 @@ def mapped():
 @contextmanager
 def small_pages():
     """Fresh mappings made in this block, in this thread, are not advised for huge pages: their pages come
-    one by one from the system's lists of small free pages. For arrays faulted in while the other
-    thread works (tvoronoi.halves): on a virtual machine whose host takes back memory left free (here,
-    in blocks of 8 MiB), a huge page is most often taken from such a block, and the host gives it back
-    slowly (a build's arrays faulted in by huge pages after a pause of 2.5 s took 40-100 ms more)."""
+    one by one from the system's lists of small free pages. On a virtual machine whose host takes back
+    memory left free (here, in blocks of 8 MiB), a huge page is most often taken from such a block, and
+    the host gives it back slowly; with two threads faulting at once, huge pages cost a build more than
+    they save (tvoronoi.build: at 10^6 uniform sites, builds on two threads 10-50 ms faster without
+    them, on one 6-50 ms slower)."""
     global tv_small_pages
     was = tv_small_pages
     tv_small_pages = 1
@@ -295,6 +296,11 @@ def small_pages():
         yield
     finally:
         tv_small_pages = was
+
+
+def small_pages_on():
+    """True inside small_pages() in this thread (a thread working for this one applies it too)."""
+    return bool(tv_small_pages)
 
 
 def trim_heap():
