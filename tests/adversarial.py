@@ -382,6 +382,19 @@ def ring_around_cloud(on_ring: int = 3000, inside: int = 6000, *, decimals: int 
     return Case(_pts(pts[rng.permutation(len(pts))]), note="a hull of thousands around a cloud")
 
 
+def median_line_crowded(n: int = 8000, *, share: float = 0.24, seed: int = SEED) -> Case:
+    """A quarter of the sites (less one percent) on the line x = 0, half of them at x = -0.0, at y to the
+    mm with repeats; the rest uniform in [-1, 1]^2 to the mm: the halves' cut falls on that line (its
+    median), every site on it goes right (-0.0 is not below 0.0), and the seam runs along a column of
+    thousands of collinear sites, repeated ones among them."""
+    rng = np.random.default_rng(seed)
+    k = int(share * n)
+    line = np.column_stack([np.where(rng.random(k) < 0.5, -0.0, 0.0), np.round(rng.uniform(-1, 1, k), 3)])
+    rest = np.round(rng.uniform(-1, 1, (n - k, 2)), 3)
+    pts = np.vstack([line, rest])
+    return Case(_pts(pts[rng.permutation(n)]), note="the cut's line holding a quarter of the sites")
+
+
 def gps_tracks(tracks: int = 6, steps: int = 300, *, decimals: int = 6, seed: int = SEED) -> Case:
     """GPS tracks: polylines of straight legs at random headings, a fix every ~1 m (1e-5 degrees) near
     lon -122.4 / lat 37.7, to 6 decimals: long runs of nearly collinear sites closer than the tracks are
@@ -983,6 +996,7 @@ FAMILIES: dict[str, Callable[..., Case]] = {
     "geometric_rows_3dec": geometric_rows,
     "rows_on_strip_edges": rows_on_strip_edges,
     "ring_around_cloud_mm": ring_around_cloud,
+    "median_line_crowded": median_line_crowded,
     # rounded random
     "uniform_1dec": partial(rounded_uniform, 500, decimals=1),
     "uniform_2dec": partial(rounded_uniform, 2000, decimals=2),
