@@ -272,9 +272,11 @@ def lay_out(
 def on_two_halves(engine: str, c: Cut, out: Joined, *, seed: int, threads: int):
     """The slots of both halves (half() of each), made on two threads: the left half on this one, the
     right half's triangles on a second. That thread lays them out too if the left half is not done by
-    then; else this one does, on ``threads`` threads (the second's first touches of fresh pages can cost
-    it several times what they cost this thread: at 10^6 sites, 60-100 ms against 25 for the same sort).
-    The thread done first faults in the dual's half-edge arrays while it waits (HalfEdgeFaults)."""
+    then; else this one does, on ``threads`` threads (with huge pages, the second's first touches of
+    fresh pages cost it up to 3-4 times what they cost this thread, at 10^6 sites 50-90 ms against
+    20-25 for the same sort; in the small pages a build on two threads now uses, 4-12 ms of system
+    time either way). The thread done first faults in the dual's half-edge arrays while it waits
+    (HalfEdgeFaults)."""
     lock = threading.Lock()
     left_done = [False]
     each = max(threads // 2, 1)
